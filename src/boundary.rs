@@ -1,0 +1,210 @@
+//! Road-boundary polylines and frames, validated on construction.
+//!
+//! A raw polyline from the camera front end is a `&[Pixel]`. A [`Boundary`]
+//! is known to be finite, inside the image, ordered and within capacity; the
+//! only way to make one is [`Frame::push_boundary`], which checks all that.
+//!
+//! **Ordered** means strictly monotone in the image row `v` (all increasing
+//! or all decreasing), as a row-scanning boundary detector produces: one
+//! point per row. A polyline that turns back in `v` (a zig-zag), repeats a
+//! point or repeats a row is rejected.
+
+use core::fmt;
+
+use crate::camera::{Camera, Pixel};
+
+/// Why a boundary was rejected. Indices refer to the offending point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum BoundaryError {
+    /// Fewer than two points.
+    TooFewPoints,
+    /// More points than the capacity `N`; nothing is truncated.
+    TooManyPoints {
+        /// Points offered.
+        len: usize,
+        /// Capacity `N`.
+        capacity: usize,
+    },
+    /// The frame already holds `B` boundaries.
+    TooManyBoundaries,
+    /// Point is NaN or infinite.
+    NotFinite {
+        /// Index of the point.
+        index: usize,
+    },
+    /// Point lies outside the image plus [`crate::IMAGE_MARGIN_PX`].
+    OutsideImage {
+        /// Index of the point.
+        index: usize,
+    },
+    /// Point equals its predecessor.
+    Duplicate {
+        /// Index of the point.
+        index: usize,
+    },
+    /// Row `v` does not keep strictly increasing (or strictly decreasing).
+    Unordered {
+        /// Index of the point.
+        index: usize,
+    },
+}
+
+impl fmt::Display for BoundaryError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::TooFewPoints => f.write_str("boundary has fewer than 2 points"),
+            Self::TooManyPoints { len, capacity } => {
+                write!(f, "boundary has {len} points, capacity is {capacity}")
+            }
+            Self::TooManyBoundaries => f.write_str("frame boundary capacity exhausted"),
+            Self::NotFinite { index } => write!(f, "point {index} is NaN or infinite"),
+            Self::OutsideImage { index } => write!(f, "point {index} is outside the image"),
+            Self::Duplicate { index } => write!(f, "point {index} repeats its predecessor"),
+            Self::Unordered { index } => {
+                write!(f, "point {index} breaks the strict row order")
+            }
+        }
+    }
+}
+
+/// A validated road-boundary polyline of at most `N` pixel points.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Boundary<const N: usize> {
+    points: heapless::Vec<Pixel, N>,
+}
+
+impl<const N: usize> Boundary<N> {
+    fn validate(points: &[Pixel], camera: &Camera) -> Result<Self, BoundaryError> {
+        if points.len() < 2 {
+            return Err(BoundaryError::TooFewPoints);
+        }
+        if points.len() > N {
+            return Err(BoundaryError::TooManyPoints {
+                len: points.len(),
+                capacity: N,
+            });
+        }
+        let mut direction = 0.0f32;
+        let mut prev: Option<Pixel> = None;
+        for (index, &p) in points.iter().enumerate() {
+            if !(p.u.is_finite() && p.v.is_finite()) {
+                return Err(BoundaryError::NotFinite { index });
+            }
+            if !camera.contains(p) {
+                return Err(BoundaryError::OutsideImage { index });
+            }
+            if let Some(q) = prev {
+                if p == q {
+                    return Err(BoundaryError::Duplicate { index });
+                }
+                let dv = p.v - q.v;
+                if dv == 0.0 || dv * direction < 0.0 {
+                    return Err(BoundaryError::Unordered { index });
+                }
+                direction = dv;
+            }
+            prev = Some(p);
+        }
+        let mut out = heapless::Vec::new();
+        for &p in points {
+            // Cannot fail: the length was checked against N above.
+            if out.push(p).is_err() {
+                return Err(BoundaryError::TooManyPoints {
+                    len: points.len(),
+                    capacity: N,
+                });
+            }
+        }
+        Ok(Self { points: out })
+    }
+
+    /// The points, in the order given.
+    pub fn points(&self) -> &[Pixel] {
+        &self.points
+    }
+}
+
+/// One camera frame: its intrinsics and up to `B` validated boundaries of up
+/// to `N` points each (index 0 = left road edge, 1 = right, by convention;
+/// boundary `k` of one frame corresponds to boundary `k` of the next).
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Frame<const N: usize, const B: usize> {
+    camera: Camera,
+    boundaries: heapless::Vec<Boundary<N>, B>,
+}
+
+impl<const N: usize, const B: usize> Frame<N, B> {
+    /// An empty frame seen by `camera`.
+    pub const fn new(camera: Camera) -> Self {
+        Self {
+            camera,
+            boundaries: heapless::Vec::new(),
+        }
+    }
+
+    /// Validate a raw polyline and append it as the next boundary.
+    /// On error the frame is unchanged.
+    ///
+    /// ```
+    /// use roadstereo::{BoundaryError, Camera, Frame, Pixel};
+    /// let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).unwrap();
+    /// let mut frame = Frame::<64, 2>::new(cam);
+    /// frame.push_boundary(&[Pixel::new(100.0, 470.0), Pixel::new(101.5, 469.0)])?;
+    /// assert_eq!(
+    ///     frame.push_boundary(&[Pixel::new(1.0, 1.0), Pixel::new(2.0, 5.0), Pixel::new(3.0, 2.0)]),
+    ///     Err(BoundaryError::Unordered { index: 2 })
+    /// );
+    /// assert_eq!(frame.boundaries().len(), 1);
+    /// # Ok::<(), BoundaryError>(())
+    /// ```
+    pub fn push_boundary(&mut self, points: &[Pixel]) -> Result<(), BoundaryError> {
+        if self.boundaries.is_full() {
+            return Err(BoundaryError::TooManyBoundaries);
+        }
+        let b = Boundary::validate(points, &self.camera)?;
+        self.boundaries
+            .push(b)
+            .map_err(|_| BoundaryError::TooManyBoundaries)
+    }
+
+    /// Make this frame a copy of `other` in place (no large temporaries).
+    pub(crate) fn assign(&mut self, other: &Self) {
+        self.camera = other.camera;
+        self.boundaries.truncate(other.boundaries.len());
+        for (i, src) in other.boundaries.iter().enumerate() {
+            if self.boundaries.len() <= i
+                && self
+                    .boundaries
+                    .push(Boundary {
+                        points: heapless::Vec::new(),
+                    })
+                    .is_err()
+            {
+                return;
+            }
+            if let Some(dst) = self.boundaries.get_mut(i) {
+                dst.points.clear();
+                // Same capacity N on both sides: cannot fail.
+                let _ = dst.points.extend_from_slice(&src.points);
+            }
+        }
+    }
+
+    /// Remove all boundaries (keeps the camera).
+    pub fn clear(&mut self) {
+        self.boundaries.clear();
+    }
+
+    /// The camera of this frame.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// The validated boundaries.
+    pub fn boundaries(&self) -> &[Boundary<N>] {
+        &self.boundaries
+    }
+}

@@ -1,0 +1,132 @@
+//! Triangulation (eqs. 2.1–2.3) and the error interval, the "stick" of
+//! Sec. 4.1, extended to a guaranteed bound.
+//!
+//! # Depth from the disparity (eq. 2.3, general `(U, V, W)`)
+//! With the notation of [`crate::epipolar`], the frame-2 point is
+//! `p₂ = p₁' + τ a` and `τ = 1/(s − W')`, hence
+//!
+//! `s = W' + 1/τ`,   `Z = s / q_z`,   `X = x₁ Z`, `Y = y₁ Z`
+//!
+//! where `(x₁, y₁)` are the normalised frame-1 coordinates. This is eq. 2.3
+//! solved in the least-squares sense along the disparity: `τ` is the
+//! projection `(d · a)/|a|²` of the full 2-D disparity `d` on the epipolar
+//! direction, so both components `d_x`, `d_y` contribute, each in proportion
+//! to its share of the line's direction, instead of picking the `x` or `y`
+//! form of eq. 2.3 (either of which is ill-conditioned when its component
+//! is small). Without rotation and with `f_x = f_y = f` it reduces to eq. 2.3
+//! exactly.
+//!
+//! # The stick, guaranteed
+//! The paper bounds the depth by a disparity error `e = e₁ + e₂` along `y`.
+//! Here both localisation errors are discs (any direction):
+//!
+//! * frame 1: the true point is within `e₁` pixels of `p₁`; after rotation
+//!   compensation within `r₁ = e₁ · stretch` of `p₁'` (the homography's
+//!   local stretch bound);
+//! * frame 2: the true boundary is within `e₂` pixels of the polyline.
+//!
+//! Let `D = τ|a|` be the disparity length, `φ` the angle between the
+//! epipolar line and the boundary at the intersection. Moving `p₁'` by at
+//! most `r₁` moves the start of the disparity along the line by at most
+//! `r₁`, changes `|a|` by at most `|W'| r₁`, and tilts the line about the FOE
+//! so that at `p₂` it is displaced sideways by at most
+//! `h₁ = r₁ (1 + W' τ)` (the ratio of the distances of `p₂` and `p₁'` from
+//! the FOE; `r₁` when `W' = 0`). The true intersection lies where a line
+//! within `h₁` of ours meets a curve within `e₂` of the polyline: a
+//! parallelogram whose extent along the line is
+//!
+//! `δ₂ = (e₂ + h₁ |cos φ|) / sin φ`.
+//!
+//! This is the `1/sin φ` growth of the frame-2 error: a boundary crossed at
+//! a flat angle localises the intersection poorly. The disparity thus lies
+//! in `D ± ε` with `ε = r₁ + δ₂`, and since
+//! `s = W' + (|a| ± |W'| r₁)/(D ∓ ε)` is monotone in both (for the sign of
+//! `W'` at hand the extremes fall on the corners, which coincide with the
+//! exact extremes of `s = W' ρ₂/(ρ₂ − ρ₁)` over the box of radial distances
+//! from the FOE):
+//!
+//! `s_far = W' + (1 + |W'| r₁/|a|) / (τ − ε/|a|)`,
+//! `s_near = W' + (1 − |W'| r₁/|a|) / (τ + ε/|a|)`.
+//!
+//! When `τ ≤ ε/|a|` the disparity is not larger than its error and the far
+//! end is unbounded ([`crate::Status::Unbounded`]). The boundary direction
+//! is measured over a chord of up to `2·CHORD_HALF_WINDOW + 1` points; the
+//! error of that chord's direction (at most `2 e₂ / L` for a chord of length
+//! `L`) is taken off `sin φ` before it is used, so the stick stays a bound;
+//! an intersection with `sin φ` below the configured minimum is
+//! [`crate::Status::Grazing`] and gets no depth. Without errors
+//! (`e₁ = e₂ = 0`) the stick collapses to the point. For `e₂ ≪ D` and
+//! `φ = 90°` the relative half-length is `≈ (e₁ + e₂)/D`: the paper's
+//! `|ΔZ/Z| ≈ e/d` (Sec. 4.1.1).
+
+use crate::camera::Pixel;
+use crate::math::{cross, dot, sqrt, sub};
+
+/// Half-width, in points, of the chord used to measure the boundary direction.
+pub const CHORD_HALF_WINDOW: usize = 4;
+
+/// Depth interval along the frame-1 ray: every depth consistent with the
+/// localisation errors lies in `[z_near, z_far]` (length unit of the motion).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DepthInterval {
+    /// Nearest consistent depth `Z_near` (≥ 0).
+    pub z_near: f32,
+    /// Farthest consistent depth `Z_far`.
+    pub z_far: f32,
+}
+
+/// Direction of the boundary around segment `j`: the chord between the
+/// points `CHORD_HALF_WINDOW` before `j` and after `j + 1` (clamped).
+pub(crate) fn chord(boundary: &[Pixel], j: usize) -> [f32; 2] {
+    let last = boundary.len().saturating_sub(1);
+    let i0 = j.saturating_sub(CHORD_HALF_WINDOW);
+    let i1 = (j + 1 + CHORD_HALF_WINDOW).min(last);
+    match (boundary.get(i0), boundary.get(i1)) {
+        (Some(a), Some(b)) => sub(b.arr(), a.arr()),
+        _ => [0.0, 0.0],
+    }
+}
+
+/// Angle terms of an intersection: `(sin φ_low, |cos φ|)`, where `φ_low`
+/// is the smallest angle consistent with the chord's own error.
+pub(crate) fn crossing_angle(a: [f32; 2], a_len: f32, chord: [f32; 2], e2: f32) -> (f32, f32) {
+    let l2 = dot(chord, chord);
+    if l2 <= 0.0 || a_len <= 0.0 {
+        return (0.0, 1.0);
+    }
+    let l = sqrt(l2);
+    let inv = 1.0 / (a_len * l);
+    let sin = cross(a, chord).abs() * inv;
+    let cos = dot(a, chord).abs() * inv;
+    (sin - 2.0 * e2 / l, cos.min(1.0))
+}
+
+/// The stick for a match at `tau` (see the module docs).
+/// Returns `None` when the far end is unbounded.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn stick(
+    w: f32,
+    tau: f32,
+    a_len: f32,
+    r1: f32,
+    e2: f32,
+    sin_low: f32,
+    cos: f32,
+    depth_scale: f32,
+) -> Option<DepthInterval> {
+    // Callers guarantee a_len > 0, sin_low > 0 and depth_scale > 0.
+    let h1 = r1 * (1.0 + w * tau).max(0.0);
+    let delta2 = (e2 + h1 * cos) / sin_low;
+    let eps_tau = (r1 + delta2) / a_len;
+    let rel = w.abs() * r1 / a_len;
+    let tau_far = tau - eps_tau;
+    if tau_far <= 0.0 {
+        return None;
+    }
+    let s_far = w + (1.0 + rel) / tau_far;
+    let s_near = w + (1.0 - rel).max(0.0) / (tau + eps_tau);
+    let z_far = s_far / depth_scale;
+    let z_near = (s_near / depth_scale).max(0.0);
+    (z_far.is_finite() && z_far >= z_near).then_some(DepthInterval { z_near, z_far })
+}

@@ -1,0 +1,40 @@
+//! # roadstereo
+//!
+//! 3-D structure of road boundaries from motion stereo, with a guaranteed
+//! error interval ("stick") on every point, after M. Asada, *3-D Road
+//! Structure from Motion Stereo*, Center for Automation Research, 1987.
+//!
+//! `#![no_std]`, no allocator, no `unsafe`, single precision only; every
+//! buffer has a compile-time capacity and nothing panics on any input.
+//!
+//! The pipeline, one module per concept of the paper:
+//! [`camera`] (intrinsics), [`motion`] (frame-to-frame motion and its
+//! conventions), [`boundary`] (validated polylines and frames),
+//! [`epipolar`] (rotation compensation, FOE, epipolar search, Sec. 2),
+//! [`depth`] (triangulation, eq. 2.3, and the stick, Sec. 4.1), and
+//! [`processor`] (the per-frame driver and its output).
+//!
+//! See the README for the coordinate conventions and a worked example.
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+#![warn(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing)]
+#![cfg_attr(test, allow(clippy::unwrap_used, clippy::indexing_slicing))]
+
+pub mod boundary;
+pub mod camera;
+pub mod depth;
+pub mod epipolar;
+mod math;
+pub mod motion;
+pub mod processor;
+
+pub use boundary::{Boundary, BoundaryError, Frame};
+pub use camera::{Camera, CameraError, Pixel, IMAGE_MARGIN_PX};
+pub use depth::DepthInterval;
+pub use epipolar::{CrossingSearch, Crossings, EpipolarLine, PairGeometry, MAX_CROSSINGS};
+pub use motion::{Motion, MotionError};
+pub use processor::{
+    BoundaryStructure, Config, ConfigError, PointResult, ProcessError, Processor, Status, Step,
+    Structure,
+};

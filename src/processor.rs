@@ -1,0 +1,591 @@
+//! The per-frame processor: keeps the previous frame and turns each new
+//! frame plus its motion into the 3-D road structure.
+//!
+//! Memory is fixed at compile time: a `Processor<N, B>` holds the previous
+//! frame (`B` boundaries of up to `N` points), the search index of one
+//! boundary and the output (`B × N` [`PointResult`]s), nothing else; see
+//! [`Processor`] for the byte counts. Work per frame is one pass over the
+//! points of each boundary (see [`crate::epipolar::IndexedSearch`]).
+
+use core::fmt;
+
+use crate::boundary::Frame;
+use crate::camera::{Camera, Pixel};
+use crate::depth::{chord, crossing_angle, stick, DepthInterval};
+use crate::epipolar::{
+    CrossingSearch, Crossings, EpipolarLine, IndexedSearch, PairGeometry, MAX_CROSSINGS,
+};
+use crate::math::sqrt;
+use crate::motion::Motion;
+
+/// Tuning of the reconstruction. All values are validated by [`Config::new`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Config {
+    e1: f32,
+    e2: f32,
+    sin_min_angle: f32,
+    max_depth: f32,
+}
+
+/// Why a configuration was rejected.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ConfigError {
+    /// A localisation error is negative, NaN or above 100 px.
+    LocalisationError,
+    /// The minimum crossing angle is not in `[0.1°, 89°]`.
+    MinAngle,
+    /// The maximum depth is not finite and positive.
+    MaxDepth,
+}
+
+impl fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::LocalisationError => "localisation error must be in [0, 100] px",
+            Self::MinAngle => "minimum crossing angle must be in [0.1, 89] degrees",
+            Self::MaxDepth => "maximum depth must be finite and positive",
+        })
+    }
+}
+
+impl Default for Config {
+    /// `e₁ = e₂ = 0.5` px (the paper's `e = 1` px), minimum crossing angle
+    /// 10°, maximum depth 1000 length units.
+    fn default() -> Self {
+        Self {
+            e1: 0.5,
+            e2: 0.5,
+            sin_min_angle: 0.173_648_18,
+            max_depth: 1000.0,
+        }
+    }
+}
+
+impl Config {
+    /// Checked constructor.
+    ///
+    /// * `e1`, `e2`: largest localisation error of a boundary point in frame 1
+    ///   and of the boundary in frame 2, pixels (the paper's `e = e₁ + e₂`).
+    /// * `min_angle_deg`: intersections flatter than this are [`Status::Grazing`].
+    /// * `max_depth`: depths beyond it are [`Status::BeyondMaxDepth`].
+    ///
+    /// ```
+    /// use roadstereo::Config;
+    /// let c = Config::new(0.5, 0.5, 10.0, 200.0)?;
+    /// assert_eq!(c.total_error(), 1.0);
+    /// assert!(Config::new(-1.0, 0.5, 10.0, 200.0).is_err());
+    /// # Ok::<(), roadstereo::ConfigError>(())
+    /// ```
+    pub fn new(e1: f32, e2: f32, min_angle_deg: f32, max_depth: f32) -> Result<Self, ConfigError> {
+        let ok_e = |e: f32| (0.0..=100.0).contains(&e);
+        if !(ok_e(e1) && ok_e(e2)) {
+            return Err(ConfigError::LocalisationError);
+        }
+        if !(0.1..=89.0).contains(&min_angle_deg) {
+            return Err(ConfigError::MinAngle);
+        }
+        if !(max_depth.is_finite() && max_depth > 0.0) {
+            return Err(ConfigError::MaxDepth);
+        }
+        Ok(Self {
+            e1,
+            e2,
+            sin_min_angle: libm::sinf(min_angle_deg.to_radians()),
+            max_depth,
+        })
+    }
+
+    /// `e = e₁ + e₂`, pixels.
+    pub fn total_error(&self) -> f32 {
+        self.e1 + self.e2
+    }
+    /// Frame-1 localisation error `e₁`, pixels.
+    pub fn e1(&self) -> f32 {
+        self.e1
+    }
+    /// Frame-2 localisation error `e₂`, pixels.
+    pub fn e2(&self) -> f32 {
+        self.e2
+    }
+    /// Maximum depth, length units.
+    pub fn max_depth(&self) -> f32 {
+        self.max_depth
+    }
+}
+
+/// Outcome for one frame-1 boundary point. Only [`Status::Ok`] is unflagged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u8)]
+pub enum Status {
+    /// Matched; depth and stick given.
+    Ok,
+    /// Several intersections (2 to [`MAX_CROSSINGS`]); the one nearest to the
+    /// rotated point along the epipolar line (smallest disparity, ties to the
+    /// lower segment index) was taken. Depth and stick given, but flagged.
+    Ambiguous,
+    /// The point's error disc contains the focus of expansion: no disparity.
+    AtFoe,
+    /// After rotation compensation the ray points behind the frame-2 camera.
+    BehindCamera,
+    /// The epipolar search range does not meet the corresponding frame-2
+    /// boundary (or frame 2 has no boundary with this index).
+    #[default]
+    NoIntersection,
+    /// More than [`MAX_CROSSINGS`] intersections: the boundary runs along the
+    /// epipolar line.
+    Tangled,
+    /// The epipolar line meets the boundary flatter than the minimum angle.
+    Grazing,
+    /// The triangulated depth is not positive (numerically degenerate).
+    NonPositiveDepth,
+    /// The depth exceeds [`Config::max_depth`].
+    BeyondMaxDepth,
+    /// The disparity is not larger than its error: the stick's far end is
+    /// unbounded.
+    Unbounded,
+}
+
+impl Status {
+    /// Whether a depth, 3-D point and stick are given.
+    pub fn has_depth(self) -> bool {
+        matches!(self, Status::Ok | Status::Ambiguous)
+    }
+    /// Whether a frame-2 intersection was chosen.
+    pub fn has_match(self) -> bool {
+        matches!(
+            self,
+            Status::Ok
+                | Status::Ambiguous
+                | Status::Grazing
+                | Status::NonPositiveDepth
+                | Status::BeyondMaxDepth
+                | Status::Unbounded
+        )
+    }
+    /// Whether the point is flagged (anything but [`Status::Ok`]).
+    pub fn is_flagged(self) -> bool {
+        self != Status::Ok
+    }
+    /// Short lower-case name, as used in the replay output.
+    pub fn name(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Ambiguous => "ambiguous",
+            Status::AtFoe => "at_foe",
+            Status::BehindCamera => "behind_camera",
+            Status::NoIntersection => "no_intersection",
+            Status::Tangled => "tangled",
+            Status::Grazing => "grazing",
+            Status::NonPositiveDepth => "non_positive_depth",
+            Status::BeyondMaxDepth => "beyond_max_depth",
+            Status::Unbounded => "unbounded",
+        }
+    }
+    /// Every status, in declaration order.
+    pub const ALL: [Status; 10] = [
+        Status::Ok,
+        Status::Ambiguous,
+        Status::AtFoe,
+        Status::BehindCamera,
+        Status::NoIntersection,
+        Status::Tangled,
+        Status::Grazing,
+        Status::NonPositiveDepth,
+        Status::BeyondMaxDepth,
+        Status::Unbounded,
+    ];
+}
+
+impl fmt::Display for Status {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Result for one frame-1 boundary point (32 bytes).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PointResult {
+    pixel1: Pixel,
+    pixel2: Pixel,
+    z: f32,
+    z_near: f32,
+    z_far: f32,
+    status: Status,
+}
+
+impl PointResult {
+    /// The outcome.
+    pub fn status(&self) -> Status {
+        self.status
+    }
+    /// The frame-1 pixel (as given, before rotation compensation).
+    pub fn pixel1(&self) -> Pixel {
+        self.pixel1
+    }
+    /// The matched frame-2 pixel, if an intersection was chosen.
+    pub fn pixel2(&self) -> Option<Pixel> {
+        self.status.has_match().then_some(self.pixel2)
+    }
+    /// Depth `Z` in frame-1 camera coordinates, if given.
+    pub fn depth(&self) -> Option<f32> {
+        self.status.has_depth().then_some(self.z)
+    }
+    /// The stick `[Z_near, Z_far]`, if given.
+    pub fn interval(&self) -> Option<DepthInterval> {
+        self.status.has_depth().then_some(DepthInterval {
+            z_near: self.z_near,
+            z_far: self.z_far,
+        })
+    }
+}
+
+/// Per-point results of one boundary, in the order of its frame-1 points.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct BoundaryStructure<const N: usize> {
+    points: heapless::Vec<PointResult, N>,
+}
+
+impl<const N: usize> BoundaryStructure<N> {
+    /// The per-point results.
+    pub fn points(&self) -> &[PointResult] {
+        &self.points
+    }
+}
+
+/// The 3-D road structure recovered from one frame pair, in frame-1 camera
+/// coordinates.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Structure<const N: usize, const B: usize> {
+    camera1: Camera,
+    boundaries: heapless::Vec<BoundaryStructure<N>, B>,
+}
+
+impl<const N: usize, const B: usize> Structure<N, B> {
+    /// Per-boundary results (index as in frame 1).
+    pub fn boundaries(&self) -> &[BoundaryStructure<N>] {
+        &self.boundaries
+    }
+
+    /// The camera of frame 1, in whose coordinates the points are given.
+    pub fn camera1(&self) -> &Camera {
+        &self.camera1
+    }
+
+    /// 3-D point `(X, Y, Z)` of a result: `X = x₁ Z`, `Y = y₁ Z` (eq. 2.3).
+    pub fn point(&self, r: &PointResult) -> Option<[f32; 3]> {
+        let z = r.depth()?;
+        let (x, y) = self.camera1.normalise(r.pixel1);
+        Some([x * z, y * z, z])
+    }
+
+    /// The stick's two 3-D end points (near, far) on the frame-1 ray.
+    pub fn stick(&self, r: &PointResult) -> Option<([f32; 3], [f32; 3])> {
+        let i = r.interval()?;
+        let (x, y) = self.camera1.normalise(r.pixel1);
+        Some((
+            [x * i.z_near, y * i.z_near, i.z_near],
+            [x * i.z_far, y * i.z_far, i.z_far],
+        ))
+    }
+
+    /// How many points have each status, indexed like [`Status::ALL`].
+    pub fn status_counts(&self) -> [usize; 10] {
+        let mut c = [0usize; 10];
+        for r in self.boundaries.iter().flat_map(|b| b.points.iter()) {
+            if let Some(slot) = c.get_mut(r.status as usize) {
+                *slot += 1;
+            }
+        }
+        c
+    }
+}
+
+/// What [`Processor::process`] produced.
+#[derive(Debug)]
+pub enum Step<'a, const N: usize, const B: usize> {
+    /// There was no previous frame: this one is kept, nothing reconstructed.
+    First,
+    /// The structure recovered from the previous frame and this one.
+    Structure(&'a Structure<N, B>),
+}
+
+/// Why a frame was rejected. The kept state is unchanged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ProcessError {
+    /// A previous frame exists but no motion was given.
+    MissingMotion,
+}
+
+impl fmt::Display for ProcessError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::MissingMotion => "a motion from the previous frame is required",
+        })
+    }
+}
+
+/// The per-frame motion-stereo processor for up to `B` boundaries of up to
+/// `N` points. No heap: everything lives inside this value, so it can be a
+/// `static`.
+///
+/// Size (bytes, 32-bit target): about `8·B·N` (previous frame) + `12·N`
+/// (search index) + `32·B·N` (output) + ~100; for `N = 256, B = 2` about
+/// 23.6 KiB, checked by a test.
+///
+/// ```
+/// use roadstereo::{Camera, Config, Frame, Motion, Pixel, Processor, Step};
+/// let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).unwrap();
+/// let mut p = Processor::<64, 2>::new(Config::default());
+///
+/// // Frame 1: one boundary, a line on the ground to the left.
+/// let mut f1 = Frame::new(cam);
+/// f1.push_boundary(&[Pixel::new(100.0, 400.0), Pixel::new(150.0, 300.0)]).unwrap();
+/// assert!(matches!(p.process(&f1, None), Ok(Step::First)));
+///
+/// // Frame 2 after moving forward: the boundary moved outwards.
+/// let mut f2 = Frame::new(cam);
+/// f2.push_boundary(&[Pixel::new(40.0, 470.0), Pixel::new(130.0, 300.0)]).unwrap();
+/// let m = Motion::new([0.0, 0.0, 0.4], [0.0, 0.0, 0.0]).unwrap();
+/// if let Ok(Step::Structure(s)) = p.process(&f2, Some(&m)) {
+///     let r = &s.boundaries()[0].points()[1];
+///     assert!(r.depth().is_some());
+/// } else {
+///     panic!("expected a structure");
+/// }
+/// ```
+#[derive(Debug, Clone)]
+pub struct Processor<const N: usize, const B: usize> {
+    config: Config,
+    previous: Frame<N, B>,
+    has_previous: bool,
+    search: IndexedSearch<N>,
+    output: Structure<N, B>,
+}
+
+impl<const N: usize, const B: usize> Processor<N, B> {
+    /// A processor with no previous frame.
+    pub const fn new(config: Config) -> Self {
+        Self {
+            config,
+            previous: Frame::new(Camera::PLACEHOLDER),
+            has_previous: false,
+            search: IndexedSearch::new(),
+            output: Structure {
+                camera1: Camera::PLACEHOLDER,
+                boundaries: heapless::Vec::new(),
+            },
+        }
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// The kept previous frame, if any.
+    pub fn previous(&self) -> Option<&Frame<N, B>> {
+        self.has_previous.then_some(&self.previous)
+    }
+
+    /// Forget the previous frame (e.g. after a camera reset).
+    pub fn reset(&mut self) {
+        self.has_previous = false;
+    }
+
+    /// Process the next frame with the motion from the previous one.
+    ///
+    /// The first frame (or the first after [`Processor::reset`]) is kept and
+    /// [`Step::First`] returned; `motion` is then ignored. On error nothing
+    /// changes. On success the new frame becomes the previous one.
+    pub fn process(
+        &mut self,
+        frame: &Frame<N, B>,
+        motion: Option<&Motion>,
+    ) -> Result<Step<'_, N, B>, ProcessError> {
+        let Self {
+            config,
+            previous,
+            has_previous,
+            search,
+            output,
+        } = self;
+        let first = run(config, previous, has_previous, output, frame, motion, search)?;
+        Ok(if first {
+            Step::First
+        } else {
+            Step::Structure(&self.output)
+        })
+    }
+
+    /// [`Processor::process`] with a caller-chosen crossing search (tests use
+    /// a brute-force one). Returns `Ok(true)` for a first frame.
+    pub fn process_with<S: CrossingSearch>(
+        &mut self,
+        frame: &Frame<N, B>,
+        motion: Option<&Motion>,
+        search: &mut S,
+    ) -> Result<bool, ProcessError> {
+        let Self {
+            config,
+            previous,
+            has_previous,
+            output,
+            ..
+        } = self;
+        run(config, previous, has_previous, output, frame, motion, search)
+    }
+
+    /// The output of the last successful reconstruction (empty before one).
+    pub fn structure(&self) -> &Structure<N, B> {
+        &self.output
+    }
+}
+
+fn run<const N: usize, const B: usize, S: CrossingSearch>(
+    config: &Config,
+    previous: &mut Frame<N, B>,
+    has_previous: &mut bool,
+    out: &mut Structure<N, B>,
+    frame: &Frame<N, B>,
+    motion: Option<&Motion>,
+    search: &mut S,
+) -> Result<bool, ProcessError> {
+    if !*has_previous {
+        previous.assign(frame);
+        *has_previous = true;
+        return Ok(true);
+    }
+    let Some(motion) = motion else {
+        return Err(ProcessError::MissingMotion);
+    };
+    let geom = PairGeometry::new(previous.camera(), frame.camera(), motion);
+    out.camera1 = *previous.camera();
+    out.boundaries.clear();
+    for (k, b1) in previous.boundaries().iter().enumerate() {
+        if out
+            .boundaries
+            .push(BoundaryStructure {
+                points: heapless::Vec::new(),
+            })
+            .is_err()
+        {
+            break;
+        }
+        let Some(bs) = out.boundaries.last_mut() else {
+            break;
+        };
+        let b2 = frame.boundaries().get(k).map(|b| b.points());
+        if let Some(b2) = b2 {
+            search.prepare(b2, geom.key());
+        }
+        for &p1 in b1.points() {
+            let r = evaluate(config, &geom, p1, b2, search);
+            if bs.points.push(r).is_err() {
+                break;
+            }
+        }
+    }
+    previous.assign(frame);
+    Ok(false)
+}
+
+fn flagged(pixel1: Pixel, status: Status) -> PointResult {
+    PointResult {
+        pixel1,
+        status,
+        ..PointResult::default()
+    }
+}
+
+/// The whole per-point pipeline: compensate, draw the line, intersect,
+/// triangulate, bound.
+fn evaluate<S: CrossingSearch>(
+    config: &Config,
+    geom: &PairGeometry,
+    p1: Pixel,
+    b2: Option<&[Pixel]>,
+    search: &mut S,
+) -> PointResult {
+    let Some(c) = geom.compensate(p1) else {
+        return flagged(p1, Status::BehindCamera);
+    };
+    let line: EpipolarLine = geom.line(&c);
+    let w = geom.w();
+    let r1 = config.e1 * c.stretch;
+    // |a| = |W'| ρ₁ (distance to the FOE): the error disc holds the FOE.
+    let foe_guard = w.abs() * r1.max(1.0e-3);
+    if line.a2 <= foe_guard * foe_guard || line.a2 <= 1.0e-12 {
+        return flagged(p1, Status::AtFoe);
+    }
+    let Some(b2) = b2 else {
+        return flagged(p1, Status::NoIntersection);
+    };
+    let mut crossings = Crossings::new();
+    search.search(&line, b2, &mut crossings);
+    if crossings.len() > MAX_CROSSINGS {
+        return flagged(p1, Status::Tangled);
+    }
+    let mut best: Option<crate::epipolar::Crossing> = None;
+    for x in crossings.iter() {
+        best = match best {
+            Some(b) if (b.tau, b.segment) <= (x.tau, x.segment) => Some(b),
+            _ => Some(*x),
+        };
+    }
+    let Some(best) = best else {
+        return flagged(p1, Status::NoIntersection);
+    };
+    let status = if crossings.len() > 1 {
+        Status::Ambiguous
+    } else {
+        Status::Ok
+    };
+    let mut r = PointResult {
+        pixel1: p1,
+        pixel2: line.at(best.tau),
+        status,
+        ..PointResult::default()
+    };
+    let a_len = sqrt(line.a2);
+    let (sin_low, cos) = crossing_angle(line.a, a_len, chord(b2, best.segment), config.e2);
+    if sin_low < config.sin_min_angle {
+        r.status = Status::Grazing;
+        return r;
+    }
+    // Eq. 2.3 along the disparity: s = W' + 1/τ (τ > 0 by construction).
+    let s = w + 1.0 / best.tau;
+    let z = s / c.depth_scale;
+    if z.is_nan() || z <= 0.0 {
+        r.status = Status::NonPositiveDepth;
+        return r;
+    }
+    if z > config.max_depth {
+        r.status = Status::BeyondMaxDepth;
+        return r;
+    }
+    match stick(
+        w,
+        best.tau,
+        a_len,
+        r1,
+        config.e2,
+        sin_low,
+        cos,
+        c.depth_scale,
+    ) {
+        Some(i) => {
+            r.z = z;
+            r.z_near = i.z_near.min(z);
+            r.z_far = i.z_far.max(z);
+        }
+        None => r.status = Status::Unbounded,
+    }
+    r
+}

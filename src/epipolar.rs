@@ -128,7 +128,7 @@ impl PencilKey {
     }
 
     /// Key of an epipolar line, [`NO_KEY`] if it has none usable.
-    fn line(&self, line: &EpipolarLine) -> f32 {
+    pub(crate) fn line(&self, line: &EpipolarLine) -> f32 {
         match *self {
             PencilKey::Angular { sign_w, .. } => {
                 pseudo_angle([sign_w * line.a[0], sign_w * line.a[1]])
@@ -448,6 +448,65 @@ impl<const N: usize> IndexedSearch<N> {
         }
     }
 
+    /// Build the tree over the vertex keys `keys` (at most `N` are used).
+    fn build(&mut self, key: &PencilKey, keys: impl Iterator<Item = f32>) {
+        self.key = *key;
+        let mut n: usize = 0;
+        for (slot, k) in self.keys.iter_mut().zip(keys) {
+            *slot = k;
+            n += 1;
+        }
+        self.segments = n.saturating_sub(1);
+        // Inner nodes 1..S, children 2x and 2x+1; indices >= S are leaves.
+        for x in (1..self.segments).rev() {
+            let i = self
+                .node_interval(2 * x)
+                .union(&self.node_interval(2 * x + 1));
+            if let Some(slot) = self.nodes.get_mut(x) {
+                *slot = i;
+            }
+        }
+    }
+
+    /// Index the rotation-compensated frame-1 boundary (for the fold test).
+    pub(crate) fn prepare_compensated(&mut self, boundary: &[Pixel], geom: &PairGeometry) {
+        let key = geom.key;
+        self.build(
+            &key,
+            boundary
+                .iter()
+                .map(|p| geom.compensate(*p).map_or(NO_KEY, |c| key.vertex(c.pixel))),
+        );
+    }
+
+    /// Whether the indexed polyline meets the line with key `q` at a segment
+    /// outside `skip` (inclusive segment range). Unkeyable lines answer yes.
+    pub(crate) fn meets_outside(&self, q: f32, skip: (usize, usize)) -> bool {
+        let s = self.segments;
+        if s == 0 {
+            return false;
+        }
+        if !q.is_finite() {
+            return true;
+        }
+        let mut stack: heapless::Vec<usize, 64> = heapless::Vec::new();
+        let _ = stack.push(1);
+        while let Some(x) = stack.pop() {
+            if !self.key.admits(&self.node_interval(x), q) {
+                continue;
+            }
+            if x >= s {
+                let j = x - s;
+                if j < skip.0 || j > skip.1 {
+                    return true;
+                }
+            } else if stack.push(2 * x).is_err() || stack.push(2 * x + 1).is_err() {
+                return true;
+            }
+        }
+        false
+    }
+
     fn scan_all(line: &EpipolarLine, boundary: &[Pixel], out: &mut Crossings) {
         for (j, w) in boundary.windows(2).enumerate() {
             if let [v0, v1] = w {
@@ -463,21 +522,7 @@ impl<const N: usize> IndexedSearch<N> {
 
 impl<const N: usize> CrossingSearch for IndexedSearch<N> {
     fn prepare(&mut self, boundary: &[Pixel], key: &PencilKey) {
-        self.key = *key;
-        let n = boundary.len().min(N);
-        for (k, p) in self.keys.iter_mut().zip(boundary.iter()) {
-            *k = key.vertex(p.arr());
-        }
-        self.segments = n.saturating_sub(1);
-        // Inner nodes 1..S, children 2x and 2x+1; indices >= S are leaves.
-        for x in (1..self.segments).rev() {
-            let i = self
-                .node_interval(2 * x)
-                .union(&self.node_interval(2 * x + 1));
-            if let Some(slot) = self.nodes.get_mut(x) {
-                *slot = i;
-            }
-        }
+        self.build(key, boundary.iter().map(|p| key.vertex(p.arr())));
     }
 
     fn search(&mut self, line: &EpipolarLine, boundary: &[Pixel], out: &mut Crossings) {

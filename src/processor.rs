@@ -11,7 +11,7 @@ use core::fmt;
 
 use crate::boundary::Frame;
 use crate::camera::{Camera, Pixel};
-use crate::depth::{chord, crossing_angle, stick, DepthInterval};
+use crate::depth::{chord, crossing_angle, stick, DepthInterval, CHORD_HALF_WINDOW};
 use crate::epipolar::{
     CrossingSearch, Crossings, EpipolarLine, IndexedSearch, PairGeometry, MAX_CROSSINGS,
 };
@@ -146,6 +146,12 @@ pub enum Status {
     /// The disparity is not larger than its error: the stick's far end is
     /// unbounded.
     Unbounded,
+    /// The point's epipolar line meets the frame-1 boundary again, more
+    /// than [`crate::depth::CHORD_HALF_WINDOW`] points away: the boundary
+    /// folds across the epipolar lines, so the frame-2 intersection may be
+    /// the image of another part of the curve (one possibly not visible in
+    /// frame 2). The correspondence is not unique; no depth is given.
+    Folded,
 }
 
 impl Status {
@@ -182,10 +188,11 @@ impl Status {
             Status::NonPositiveDepth => "non_positive_depth",
             Status::BeyondMaxDepth => "beyond_max_depth",
             Status::Unbounded => "unbounded",
+            Status::Folded => "folded",
         }
     }
     /// Every status, in declaration order.
-    pub const ALL: [Status; 10] = [
+    pub const ALL: [Status; 11] = [
         Status::Ok,
         Status::Ambiguous,
         Status::AtFoe,
@@ -196,6 +203,7 @@ impl Status {
         Status::NonPositiveDepth,
         Status::BeyondMaxDepth,
         Status::Unbounded,
+        Status::Folded,
     ];
 }
 
@@ -295,8 +303,8 @@ impl<const N: usize, const B: usize> Structure<N, B> {
     }
 
     /// How many points have each status, indexed like [`Status::ALL`].
-    pub fn status_counts(&self) -> [usize; 10] {
-        let mut c = [0usize; 10];
+    pub fn status_counts(&self) -> [usize; 11] {
+        let mut c = [0usize; 11];
         for r in self.boundaries.iter().flat_map(|b| b.points.iter()) {
             if let Some(slot) = c.get_mut(r.status as usize) {
                 *slot += 1;
@@ -416,7 +424,15 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             search,
             output,
         } = self;
-        let first = run(config, previous, has_previous, output, frame, motion, search)?;
+        let first = run(
+            config,
+            previous,
+            has_previous,
+            output,
+            frame,
+            motion,
+            &mut OwnIndex(search),
+        )?;
         Ok(if first {
             Step::First
         } else {
@@ -425,7 +441,8 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     }
 
     /// [`Processor::process`] with a caller-chosen crossing search (tests use
-    /// a brute-force one). Returns `Ok(true)` for a first frame.
+    /// a brute-force one); the fold test still uses the built-in index.
+    /// Returns `Ok(true)` for a first frame.
     pub fn process_with<S: CrossingSearch>(
         &mut self,
         frame: &Frame<N, B>,
@@ -436,10 +453,18 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             config,
             previous,
             has_previous,
+            search: index,
             output,
-            ..
         } = self;
-        run(config, previous, has_previous, output, frame, motion, search)
+        run(
+            config,
+            previous,
+            has_previous,
+            output,
+            frame,
+            motion,
+            &mut WithSearch(index, search),
+        )
     }
 
     /// The output of the last successful reconstruction (empty before one).
@@ -448,14 +473,47 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     }
 }
 
-fn run<const N: usize, const B: usize, S: CrossingSearch>(
+/// The two uses of search scratch in one frame, one after the other: the
+/// fold test over frame 1, then the crossing search over frame 2. With the
+/// built-in index both share one tree (no extra memory).
+trait Searches<const N: usize> {
+    type Crossing: CrossingSearch;
+    fn index(&mut self) -> &mut IndexedSearch<N>;
+    fn crossing(&mut self) -> &mut Self::Crossing;
+}
+
+struct OwnIndex<'a, const N: usize>(&'a mut IndexedSearch<N>);
+
+impl<const N: usize> Searches<N> for OwnIndex<'_, N> {
+    type Crossing = IndexedSearch<N>;
+    fn index(&mut self) -> &mut IndexedSearch<N> {
+        self.0
+    }
+    fn crossing(&mut self) -> &mut IndexedSearch<N> {
+        self.0
+    }
+}
+
+struct WithSearch<'a, const N: usize, S>(&'a mut IndexedSearch<N>, &'a mut S);
+
+impl<const N: usize, S: CrossingSearch> Searches<N> for WithSearch<'_, N, S> {
+    type Crossing = S;
+    fn index(&mut self) -> &mut IndexedSearch<N> {
+        self.0
+    }
+    fn crossing(&mut self) -> &mut S {
+        self.1
+    }
+}
+
+fn run<const N: usize, const B: usize, S: Searches<N>>(
     config: &Config,
     previous: &mut Frame<N, B>,
     has_previous: &mut bool,
     out: &mut Structure<N, B>,
     frame: &Frame<N, B>,
     motion: Option<&Motion>,
-    search: &mut S,
+    searches: &mut S,
 ) -> Result<bool, ProcessError> {
     if !*has_previous {
         previous.assign(frame);
@@ -481,14 +539,43 @@ fn run<const N: usize, const B: usize, S: CrossingSearch>(
         let Some(bs) = out.boundaries.last_mut() else {
             break;
         };
+        // Pass 1, the fold test (frame 1 only): does a point's epipolar line
+        // meet the frame-1 boundary again, away from the point itself?
+        let index = searches.index();
+        index.prepare_compensated(b1.points(), &geom);
+        for (i, &p1) in b1.points().iter().enumerate() {
+            let folded = geom.compensate(p1).is_some_and(|c| {
+                let line = geom.line(&c);
+                line.a2 > 0.0
+                    && index.meets_outside(
+                        geom.key().line(&line),
+                        (
+                            i.saturating_sub(CHORD_HALF_WINDOW),
+                            i + CHORD_HALF_WINDOW - 1,
+                        ),
+                    )
+            });
+            let status = if folded {
+                Status::Folded
+            } else {
+                Status::NoIntersection
+            };
+            if bs.points.push(flagged(p1, status)).is_err() {
+                break;
+            }
+        }
+        // Pass 2: intersect, triangulate, bound.
         let b2 = frame.boundaries().get(k).map(|b| b.points());
+        let search = searches.crossing();
         if let Some(b2) = b2 {
             search.prepare(b2, geom.key());
         }
-        for &p1 in b1.points() {
-            let r = evaluate(config, &geom, p1, b2, search);
-            if bs.points.push(r).is_err() {
-                break;
+        for r in bs.points.iter_mut() {
+            let folded = r.status == Status::Folded;
+            let fresh = evaluate(config, &geom, r.pixel1, b2, search);
+            // The fold only matters where a depth would otherwise be given.
+            if !(folded && fresh.status.has_depth()) {
+                *r = fresh;
             }
         }
     }

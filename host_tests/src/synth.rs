@@ -230,6 +230,9 @@ pub struct TruePoint {
     pub v: f64,
     /// The 3-D point in this frame's camera coordinates.
     pub camera: V3,
+    /// Position along the world polyline (fine-segment index + fraction):
+    /// the same 3-D point has the same `arc` in every frame.
+    pub arc: f64,
 }
 
 /// Project the world polyline and keep, for each integer image row, the
@@ -252,7 +255,7 @@ pub fn detect(curve: &[V3], pose: &Pose, k: &Intrinsics, max_depth: f64) -> Vec<
     let mut out: Vec<TruePoint> = Vec::new();
     let mut started = false;
     let mut last_v = f64::INFINITY;
-    for w in proj.windows(2) {
+    for (seg, w) in proj.windows(2).enumerate() {
         let ((c0, v0), (c1, v1)) = (w[0], w[1]);
         if !(v0.is_finite() && v1.is_finite()) || c0[2] < 0.05 {
             if started {
@@ -293,6 +296,7 @@ pub fn detect(curve: &[V3], pose: &Pose, k: &Intrinsics, max_depth: f64) -> Vec<
                             u,
                             v: r,
                             camera: p,
+                            arc: seg as f64 + lam,
                         });
                     }
                 }
@@ -424,6 +428,25 @@ impl Rendered {
                 .collect()
         })
             .collect()
+    }
+
+    /// Whether the true frame-2 correspondent of frame-1 point `i` of
+    /// boundary `b` is in the frame-2 data: its 3-D point lies within the
+    /// stretch of the curve the frame-2 detector returned (the paper's
+    /// assumption (1), Sec. 2: the correspondence exists).
+    pub fn correspondent_observed(&self, b: usize, i: usize) -> bool {
+        let (Some(b1), Some(b2)) = (self.frame1.get(b), self.frame2.get(b)) else {
+            return false;
+        };
+        let (Some(p), Some(first), Some(last)) = (b1.get(i), b2.first(), b2.last()) else {
+            return false;
+        };
+        let (lo, hi) = if first.arc <= last.arc {
+            (first.arc, last.arc)
+        } else {
+            (last.arc, first.arc)
+        };
+        (lo..=hi).contains(&p.arc)
     }
 
     /// The rotation-compensated position and the true frame-2 position of a

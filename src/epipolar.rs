@@ -113,7 +113,12 @@ impl PencilKey {
 
     fn projective(&self, v: [f32; 2]) -> f32 {
         match *self {
-            PencilKey::Projective { c, g_hat, g_norm, w } => {
+            PencilKey::Projective {
+                c,
+                g_hat,
+                g_norm,
+                w,
+            } => {
                 let d = sub(v, c);
                 let n_hat = [-g_hat[1], g_hat[0]];
                 let den = g_norm - w * dot(g_hat, d);
@@ -339,7 +344,10 @@ impl PairGeometry {
         if self.w == 0.0 {
             return None;
         }
-        let f = [self.c2[0] + self.g[0] / self.w, self.c2[1] + self.g[1] / self.w];
+        let f = [
+            self.c2[0] + self.g[0] / self.w,
+            self.c2[1] + self.g[1] / self.w,
+        ];
         (f[0].is_finite() && f[1].is_finite()).then_some(Pixel::new(f[0], f[1]))
     }
 

@@ -79,7 +79,11 @@ impl Motion {
     /// # Ok::<(), MotionError>(())
     /// ```
     pub fn new(translation: [f32; 3], rotation: [f32; 3]) -> Result<Self, MotionError> {
-        if translation.iter().chain(rotation.iter()).any(|x| !x.is_finite()) {
+        if translation
+            .iter()
+            .chain(rotation.iter())
+            .any(|x| !x.is_finite())
+        {
             return Err(MotionError::NotFinite);
         }
         if translation.iter().any(|x| x.abs() > MAX_TRANSLATION) {

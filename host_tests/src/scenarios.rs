@@ -1,6 +1,6 @@
 //! The named scenario set and the seeded random scenarios.
 
-use crate::synth::{Drive, Road, Rng, Scenario};
+use crate::synth::{Drive, Rng, Road, Scenario};
 
 fn deg(x: f64) -> f64 {
     x.to_radians()
@@ -33,8 +33,16 @@ pub fn named() -> Vec<Scenario> {
         },
     ));
     for r in [8.0, 15.0, 30.0, 60.0] {
-        v.push(Scenario::new(&format!("right_r{r}"), curve(1.0 / r), follow(1.0 / r, 0.4)));
-        v.push(Scenario::new(&format!("left_r{r}"), curve(-1.0 / r), follow(-1.0 / r, 0.4)));
+        v.push(Scenario::new(
+            &format!("right_r{r}"),
+            curve(1.0 / r),
+            follow(1.0 / r, 0.4),
+        ));
+        v.push(Scenario::new(
+            &format!("left_r{r}"),
+            curve(-1.0 / r),
+            follow(-1.0 / r, 0.4),
+        ));
     }
     v.push(Scenario::new(
         "s_curve",

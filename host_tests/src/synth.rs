@@ -420,13 +420,13 @@ impl Rendered {
         frame
             .iter()
             .map(|b| {
-            b.iter()
-                .map(|p| {
-                    let u = if quantised { p.u.round() } else { p.u };
-                    roadstereo::Pixel::new(u as f32, p.v as f32)
-                })
-                .collect()
-        })
+                b.iter()
+                    .map(|p| {
+                        let u = if quantised { p.u.round() } else { p.u };
+                        roadstereo::Pixel::new(u as f32, p.v as f32)
+                    })
+                    .collect()
+            })
             .collect()
     }
 

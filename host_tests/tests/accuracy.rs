@@ -15,12 +15,21 @@ fn run(s: &synth::Scenario, quantised: bool) -> (synth::Rendered, Vec<PointStat>
 /// truth, on every named scenario, and each scenario yields depths.
 #[test]
 fn exact_boundaries_give_depth_within_half_a_percent() {
-    println!("{:20} {:>6} {:>6} {:>10}", "scenario", "points", "ok", "worst %");
+    println!(
+        "{:20} {:>6} {:>6} {:>10}",
+        "scenario", "points", "ok", "worst %"
+    );
     for s in scenarios::named() {
         let (_, st) = run(&s, false);
         let ok: Vec<&PointStat> = st.iter().filter(|p| p.status == Status::Ok).collect();
         let worst = ok.iter().map(|p| p.rel_error()).fold(0.0, f64::max);
-        println!("{:20} {:6} {:6} {:10.4}", s.name, st.len(), ok.len(), worst * 100.0);
+        println!(
+            "{:20} {:6} {:6} {:10.4}",
+            s.name,
+            st.len(),
+            ok.len(),
+            worst * 100.0
+        );
         assert!(ok.len() >= 100, "{}: only {} depths", s.name, ok.len());
         for p in &ok {
             assert!(
@@ -121,7 +130,10 @@ fn sticks_are_tight_where_the_crossing_is_steep() {
     let mut ratios = Vec::new();
     for s in scenarios::named() {
         let (_, st) = run(&s, true);
-        for p in st.iter().filter(|p| p.status == Status::Ok && p.angle_deg > 60.0) {
+        for p in st
+            .iter()
+            .filter(|p| p.status == Status::Ok && p.angle_deg > 60.0)
+        {
             let half = (p.z_far - p.z_near) / (2.0 * p.z);
             ratios.push(half / (e / p.disparity));
         }
@@ -140,7 +152,10 @@ fn relative_stick_length_is_inverse_to_disparity() {
     let (mut x, mut y) = (Vec::new(), Vec::new());
     for s in scenarios::named() {
         let (_, st) = run(&s, true);
-        for p in st.iter().filter(|p| p.status == Status::Ok && p.angle_deg > 60.0) {
+        for p in st
+            .iter()
+            .filter(|p| p.status == Status::Ok && p.angle_deg > 60.0)
+        {
             x.push(p.disparity.ln());
             y.push(((p.z_far - p.z_near) / p.z).ln());
         }

@@ -28,7 +28,9 @@ fn good() -> Good {
 }
 
 fn line(n: usize) -> Vec<Pixel> {
-    (0..n).map(|i| Pixel::new(100.0 + i as f32 * 0.3, 470.0 - i as f32)).collect()
+    (0..n)
+        .map(|i| Pixel::new(100.0 + i as f32 * 0.3, 470.0 - i as f32))
+        .collect()
 }
 
 /// What a bad input does: the error it gets. It may touch the processor
@@ -73,7 +75,13 @@ fn cases() -> Vec<Case> {
             let e = boundary_err(p, g.cam);
             assert_eq!(
                 e,
-                format!("{:?}", BoundaryError::TooManyPoints { len: N + 1, capacity: N })
+                format!(
+                    "{:?}",
+                    BoundaryError::TooManyPoints {
+                        len: N + 1,
+                        capacity: N
+                    }
+                )
             );
             e
         }),
@@ -157,7 +165,10 @@ fn cases() -> Vec<Case> {
 fn reference(g: &Good) -> Box<Processor<N, B>> {
     let mut p = Box::new(Processor::new(Config::default()));
     assert!(matches!(p.process(&g.f1, None), Ok(Step::First)));
-    assert!(matches!(p.process(&g.f2, Some(&g.m)), Ok(Step::Structure(_))));
+    assert!(matches!(
+        p.process(&g.f2, Some(&g.m)),
+        Ok(Step::Structure(_))
+    ));
     p
 }
 
@@ -172,7 +183,10 @@ fn each_bad_input_gets_a_typed_error_and_leaves_the_state_untouched() {
         let err = case(&g, &mut p);
         println!("{name:32} -> {err}");
         assert_eq!(p.previous().cloned(), kept, "{name}: kept frame changed");
-        assert!(matches!(p.process(&g.f2, Some(&g.m)), Ok(Step::Structure(_))));
+        assert!(matches!(
+            p.process(&g.f2, Some(&g.m)),
+            Ok(Step::Structure(_))
+        ));
         assert_eq!(p.structure(), want.structure(), "{name}: result differs");
     }
 }

@@ -13,7 +13,10 @@ fn both(s: &synth::Scenario, quantised: bool) {
     let mut slow = Box::new(Processor::<N, B>::new(Config::default()));
     assert!(matches!(fast.process(&f1, None), Ok(Step::First)));
     assert_eq!(slow.process_with(&f1, None, &mut BruteForce), Ok(true));
-    assert!(matches!(fast.process(&f2, Some(&m)), Ok(Step::Structure(_))));
+    assert!(matches!(
+        fast.process(&f2, Some(&m)),
+        Ok(Step::Structure(_))
+    ));
     assert_eq!(slow.process_with(&f2, Some(&m), &mut BruteForce), Ok(false));
     assert_eq!(
         fast.structure(),

@@ -1,0 +1,198 @@
+//! Render the documentation figures and the replay example:
+//! `figures [OUT_DIR]` (default `../docs`) writes
+//! * `fig7_sticks.svg`: the paper's Fig. 7 from our code — top and side view
+//!   of the reconstructed boundary points of the Fig. 6 set-up (quantised
+//!   boundaries), each with its stick, and the true boundary;
+//! * `example.jsonl` / `example_out.jsonl`: a two-frame replay example.
+
+use host_tests::{jsonl, point_stats, reconstruct, scenarios, synth};
+use plotters::prelude::*;
+use roadstereo::{Config, Processor, Status};
+
+type V3 = [f64; 3];
+
+fn world(pose: &synth::Pose, p: [f32; 3]) -> V3 {
+    let c = pose.centre;
+    let r = pose.rot;
+    let p = p.map(f64::from);
+    [0, 1, 2].map(|i| c[i] + r[i][0] * p[0] + r[i][1] * p[1] + r[i][2] * p[2])
+}
+
+fn fig7(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
+    let s = scenarios::named().remove(0); // fig6
+    let k = s.intrinsics;
+    let r = s.render();
+    let p = reconstruct(&r, &k, true, Config::default());
+    let st = p.structure();
+    let stats = point_stats(&r, &k, &p);
+    let path = dir.join("fig7_sticks.svg");
+    let root = SVGBackend::new(&path, (1100, 560)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (left, right) = root.split_horizontally(440);
+    let zmax = 12.0;
+    // Sticks and points in world coordinates (x right, y down, z forward).
+    let mut sticks = Vec::new();
+    let mut points = Vec::new();
+    for b in st.boundaries() {
+        for pr in b.points() {
+            if pr.status() != Status::Ok {
+                continue;
+            }
+            if let (Some(pt), Some((n, f))) = (st.point(pr), st.stick(pr)) {
+                let (pw, nw, fw) = (world(&r.pose1, pt), world(&r.pose1, n), world(&r.pose1, f));
+                if pw[2] < zmax {
+                    sticks.push((nw, fw));
+                    points.push(pw);
+                }
+            }
+        }
+    }
+    let truth: Vec<Vec<V3>> = r
+        .world
+        .iter()
+        .map(|c| {
+            c.iter()
+                .copied()
+                .filter(|p| p[2] > 0.0 && p[2] < zmax)
+                .collect()
+        })
+        .collect();
+    // Top view.
+    let mut top = ChartBuilder::on(&left)
+        .caption("Top view (Fig. 7): sticks for e = 1 px", ("sans-serif", 18))
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(45)
+        .build_cartesian_2d(-3.0f64..3.0, 0.0f64..zmax)?;
+    top.configure_mesh()
+        .x_desc("x (right), camera heights")
+        .y_desc("forward, camera heights")
+        .draw()?;
+    for c in &truth {
+        top.draw_series(LineSeries::new(
+            c.iter().map(|p| (p[0], p[2])),
+            &BLUE.mix(0.5),
+        ))?;
+    }
+    top.draw_series(
+        sticks
+            .iter()
+            .map(|(n, f)| PathElement::new(vec![(n[0], n[2]), (f[0], f[2])], RED)),
+    )?;
+    top.draw_series(
+        points
+            .iter()
+            .map(|p| Circle::new((p[0], p[2]), 1, BLACK.filled())),
+    )?;
+    top.draw_series(std::iter::once(Circle::new((0.0, 0.0), 6, BLACK)))?;
+    // Side view.
+    let mut side = ChartBuilder::on(&right)
+        .caption(
+            "Side view: height above the start ground vs forward distance",
+            ("sans-serif", 18),
+        )
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(45)
+        .build_cartesian_2d(0.0f64..zmax, -0.6f64..1.4)?;
+    side.configure_mesh()
+        .x_desc("forward, camera heights")
+        .y_desc("height")
+        .draw()?;
+    for c in &truth {
+        side.draw_series(LineSeries::new(
+            c.iter().map(|p| (p[2], -p[1])),
+            &BLUE.mix(0.5),
+        ))?;
+    }
+    side.draw_series(
+        sticks
+            .iter()
+            .map(|(n, f)| PathElement::new(vec![(n[2], -n[1]), (f[2], -f[1])], RED)),
+    )?;
+    side.draw_series(
+        points
+            .iter()
+            .map(|p| Circle::new((p[2], -p[1]), 1, BLACK.filled())),
+    )?;
+    side.draw_series(std::iter::once(Circle::new(
+        (r.pose1.centre[2], -r.pose1.centre[1]),
+        6,
+        BLACK,
+    )))?;
+    root.present()?;
+    let ok = stats.iter().filter(|p| p.status == Status::Ok).count();
+    let inside = stats
+        .iter()
+        .filter(|p| p.status == Status::Ok && p.contained())
+        .count();
+    println!(
+        "wrote {} ({ok} points with sticks, {inside} contain the truth)",
+        path.display()
+    );
+    Ok(())
+}
+
+fn example(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
+    // The Fig. 6 set-up, boundaries thinned to every 24th row for reading.
+    let s = scenarios::named().remove(0);
+    let r = s.render();
+    let k = s.intrinsics;
+    let thin = |f: &[Vec<synth::TruePoint>]| -> Vec<Vec<[f32; 2]>> {
+        f.iter()
+            .map(|b| {
+                b.iter()
+                    .filter(|p| (p.v as i64) % 24 == 0)
+                    .map(|p| [p.u.round() as f32, p.v as f32])
+                    .collect()
+            })
+            .collect()
+    };
+    let camera = jsonl::CameraIn {
+        fx: k.f as f32,
+        fy: k.f as f32,
+        cx: k.cx as f32,
+        cy: k.cy as f32,
+        width: k.width,
+        height: k.height,
+    };
+    let m = r.motion();
+    let lines = [
+        jsonl::FrameIn {
+            camera: camera.clone(),
+            motion: None,
+            boundaries: thin(&r.frame1),
+        },
+        jsonl::FrameIn {
+            camera,
+            motion: Some(jsonl::MotionIn {
+                translation: m.translation(),
+                rotation: m.angles(),
+            }),
+            boundaries: thin(&r.frame2),
+        },
+    ];
+    let mut input = String::new();
+    let mut output = String::new();
+    let mut p = Box::new(Processor::<64, 2>::new(Config::default()));
+    for (i, l) in lines.iter().enumerate() {
+        let text = serde_json::to_string(l)?;
+        let out = jsonl::process_line(&mut p, i + 1, &text);
+        input.push_str(&text);
+        input.push('\n');
+        output.push_str(&serde_json::to_string(&out)?);
+        output.push('\n');
+    }
+    std::fs::write(dir.join("example.jsonl"), input)?;
+    std::fs::write(dir.join("example_out.jsonl"), output)?;
+    println!("wrote example.jsonl and example_out.jsonl");
+    Ok(())
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let dir = std::path::PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| "../docs".into()));
+    std::fs::create_dir_all(&dir)?;
+    fig7(&dir)?;
+    example(&dir)?;
+    Ok(())
+}

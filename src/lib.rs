@@ -43,3 +43,8 @@ pub use processor::{
     BoundaryStructure, Config, ConfigError, PointResult, ProcessError, Processor, Status, Step,
     Structure,
 };
+
+// The README's Rust examples are compiled and run as doc tests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

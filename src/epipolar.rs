@@ -414,6 +414,7 @@ pub trait CrossingSearch {
 /// the line can meet, and at most `O(M)` for a line that runs along the
 /// boundary (a degenerate, grazing configuration).
 #[derive(Debug, Clone)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct IndexedSearch<const N: usize> {
     keys: [f32; N],
     nodes: [Interval; N],

@@ -316,6 +316,7 @@ impl<const N: usize, const B: usize> Structure<N, B> {
 
 /// What [`Processor::process`] produced.
 #[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Step<'a, const N: usize, const B: usize> {
     /// There was no previous frame: this one is kept, nothing reconstructed.
     First,

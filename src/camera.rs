@@ -196,8 +196,8 @@ impl Camera {
     /// image (with its margin) can hold.
     pub(crate) fn reach(&self) -> f32 {
         let m = IMAGE_MARGIN_PX;
-        let dx = (self.cx + m).max(f32::from(self.width) - 1.0 + m - self.cx);
-        let dy = (self.cy + m).max(f32::from(self.height) - 1.0 + m - self.cy);
+        let dx = crate::math::fmax(self.cx + m, f32::from(self.width) - 1.0 + m - self.cx);
+        let dy = crate::math::fmax(self.cy + m, f32::from(self.height) - 1.0 + m - self.cy);
         crate::math::sqrt(dx * dx + dy * dy)
     }
 }

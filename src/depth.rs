@@ -60,7 +60,7 @@
 //! `|ΔZ/Z| ≈ e/d` (Sec. 4.1.1).
 
 use crate::camera::Pixel;
-use crate::math::{cross, dot, sqrt, sub};
+use crate::math::{cross, dot, fmax, fmin, sqrt, sub};
 
 /// Half-width, in points, of the chord used to measure the boundary direction.
 pub const CHORD_HALF_WINDOW: usize = 4;
@@ -99,7 +99,7 @@ pub(crate) fn crossing_angle(a: [f32; 2], a_len: f32, chord: [f32; 2], e2: f32) 
     let inv = 1.0 / (a_len * l);
     let sin = cross(a, chord).abs() * inv;
     let cos = dot(a, chord).abs() * inv;
-    (sin - 2.0 * e2 / l, cos.min(1.0))
+    (sin - 2.0 * e2 / l, fmin(cos, 1.0))
 }
 
 /// The stick for a match at `tau` (see the module docs).
@@ -116,7 +116,7 @@ pub(crate) fn stick(
     depth_scale: f32,
 ) -> Option<DepthInterval> {
     // Callers guarantee a_len > 0, sin_low > 0 and depth_scale > 0.
-    let h1 = r1 * (1.0 + w * tau).max(0.0);
+    let h1 = r1 * fmax(1.0 + w * tau, 0.0);
     let delta2 = (e2 + h1 * cos) / sin_low;
     let eps_tau = (r1 + delta2) / a_len;
     let rel = w.abs() * r1 / a_len;
@@ -125,8 +125,8 @@ pub(crate) fn stick(
         return None;
     }
     let s_far = w + (1.0 + rel) / tau_far;
-    let s_near = w + (1.0 - rel).max(0.0) / (tau + eps_tau);
+    let s_near = w + fmax(1.0 - rel, 0.0) / (tau + eps_tau);
     let z_far = s_far / depth_scale;
-    let z_near = (s_near / depth_scale).max(0.0);
+    let z_near = fmax(s_near / depth_scale, 0.0);
     (z_far.is_finite() && z_far >= z_near).then_some(DepthInterval { z_near, z_far })
 }

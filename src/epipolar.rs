@@ -38,7 +38,9 @@
 //! every crossing segment gives identical results.
 
 use crate::camera::{Camera, Pixel};
-use crate::math::{cross, dot, mat3_mul, mat3_transpose, mat3_vec, pseudo_angle, sub};
+use crate::math::{
+    ceil_i32, cross, dot, fmax, fmin, mat3_mul, mat3_transpose, mat3_vec, pseudo_angle, sub,
+};
 use crate::motion::Motion;
 
 /// At most this many intersections of one epipolar line with one boundary
@@ -142,77 +144,9 @@ impl PencilKey {
         }
     }
 
-    /// Key interval of the segment between vertices with keys `k0`, `k1`.
-    fn segment(&self, k0: f32, k1: f32) -> Interval {
-        if !(k0.is_finite() && k1.is_finite()) {
-            return Interval::ALL;
-        }
-        let (lo, hi) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
-        match self {
-            PencilKey::Angular { .. } => {
-                let span = hi - lo;
-                if (span - 2.0).abs() < 1.0e-3 {
-                    // The segment passes (almost) through the FOE.
-                    Interval::ALL
-                } else if span > 2.0 {
-                    // The shorter arc wraps through the cut at "up".
-                    Interval {
-                        lo: hi - ANGULAR_EPS,
-                        hi: lo + 4.0 + ANGULAR_EPS,
-                    }
-                } else {
-                    Interval {
-                        lo: lo - ANGULAR_EPS,
-                        hi: hi + ANGULAR_EPS,
-                    }
-                }
-            }
-            PencilKey::Projective { .. } => {
-                let eps = PROJECTIVE_EPS + 1.0e-5 * lo.abs().max(hi.abs());
-                Interval {
-                    lo: lo - eps,
-                    hi: hi + eps,
-                }
-            }
-        }
-    }
-
-    /// Whether a line with key `q` may meet a segment with interval `i`.
-    fn admits(&self, i: &Interval, q: f32) -> bool {
-        if !q.is_finite() {
-            return true;
-        }
-        match self {
-            PencilKey::Angular { .. } => i.holds(q) || i.holds(q + 4.0),
-            PencilKey::Projective { .. } => i.holds(q),
-        }
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-struct Interval {
-    lo: f32,
-    hi: f32,
-}
-
-impl Interval {
-    const ALL: Interval = Interval {
-        lo: f32::NEG_INFINITY,
-        hi: f32::INFINITY,
-    };
-    const EMPTY: Interval = Interval {
-        lo: f32::INFINITY,
-        hi: f32::NEG_INFINITY,
-    };
-    fn holds(&self, q: f32) -> bool {
-        self.lo <= q && q <= self.hi
-    }
-    fn union(&self, o: &Interval) -> Interval {
-        Interval {
-            lo: self.lo.min(o.lo),
-            hi: self.hi.max(o.hi),
-        }
+    /// Key of a boundary vertex (public within the crate for the fold test).
+    pub(crate) fn vertex_key(&self, v: [f32; 2]) -> f32 {
+        self.vertex(v)
     }
 }
 
@@ -366,12 +300,12 @@ impl PairGeometry {
         let j01 = (h01 - px * h21) * iz;
         let j10 = (h10 - py * h20) * iz;
         let j11 = (h11 - py * h21) * iz;
-        let n1 = (j00.abs() + j10.abs()).max(j01.abs() + j11.abs());
-        let ninf = (j00.abs() + j01.abs()).max(j10.abs() + j11.abs());
+        let n1 = fmax(j00.abs() + j10.abs(), j01.abs() + j11.abs());
+        let ninf = fmax(j00.abs() + j01.abs(), j10.abs() + j11.abs());
         Some(Compensated {
             pixel: [px, py],
             depth_scale: z,
-            stretch: n1.max(ninf),
+            stretch: fmax(n1, ninf),
         })
     }
 
@@ -406,19 +340,60 @@ pub trait CrossingSearch {
     fn search(&mut self, line: &EpipolarLine, boundary: &[Pixel], out: &mut Crossings);
 }
 
-/// The indexed search: a key-range tree over the segments of one boundary.
+/// Segments with an unkeyable end (at the FOE) an index keeps aside; with
+/// more, every search scans the whole boundary.
+const MAX_UNKEYED: usize = 4;
+/// Linear probes before a search for the candidate run falls back to bisection.
+const PROBES: usize = 8;
+
+/// The sweep index of one boundary: the crossing search of the processor.
 ///
-/// Memory: `12 N` bytes (one key per vertex, one interval per inner node).
-/// Work: `O(M)` to prepare a boundary of `M` points; per line, the nodes
-/// whose key range holds the line's key, i.e. `O(log M)` for each segment
-/// the line can meet, and at most `O(M)` for a line that runs along the
-/// boundary (a degenerate, grazing configuration).
+/// Every line through the FOE has a key (see the module docs); a segment
+/// can only cross the line whose key lies between its end points' keys.
+/// Along a road boundary the keys move mostly one way (oriented here so
+/// that they increase), with quantisation jitter and, where the boundary
+/// folds across the epipolar lines, reversals. The index keeps for every
+/// segment `j` the running maximum `hi[j]` of the (oriented) keys from the
+/// start and the running minimum `lo[j]` to the end. Both are
+/// non-decreasing whatever the keys do, so the segments whose key range can
+/// hold a key `q` lie in the one run `a ≤ j < b` with `hi[j] ≥ q` and
+/// `lo[j] ≤ q`. The run is found by probing from where the previous search
+/// found it (consecutive boundary points have nearby keys: `O(1)` per
+/// point along a sweep), falling back to bisection (`O(log M)`).
+/// Every candidate is confirmed by the exact side test of
+/// [`EpipolarLine::crossing`], so the result is that of a brute-force
+/// search; only the work depends on the shape: `O(M)` to build, and per
+/// point `O(1)` plus the candidates, which are few unless the boundary runs
+/// along the epipolar lines (grazing, degenerate) or folds across them
+/// between two intersections.
+///
+/// Memory: `12 N` bytes plus a few words.
 #[derive(Debug, Clone)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct IndexedSearch<const N: usize> {
+    /// Unwrapped vertex keys ([`NO_KEY`] where unkeyable).
     keys: [f32; N],
-    nodes: [Interval; N],
+    /// Per segment: running max of the oriented keys from the start.
+    hi: [f32; N],
+    /// Per segment: running min of the oriented keys to the end.
+    lo: [f32; N],
+    /// +1 if the keys increase along the boundary overall, −1 if not.
+    orient: f32,
+    /// Where the last search found its candidates.
+    hint: usize,
+    /// Segments touching an unkeyable vertex or passing through the FOE
+    /// (always examined in the crossing search).
+    unkeyed: heapless::Vec<usize, MAX_UNKEYED>,
+    /// Too many unkeyed segments: every search scans the whole boundary.
+    scan: bool,
     segments: usize,
+    /// Range of the unwrapped keys.
+    kmin: f32,
+    kmax: f32,
+    /// Widening of key comparisons (covers rounding).
+    eps: f32,
+    /// 4 for pseudo-angles (keys repeat every turn), 0 for projective keys.
+    period: f32,
     key: PencilKey,
 }
 
@@ -428,13 +403,74 @@ impl<const N: usize> Default for IndexedSearch<N> {
     }
 }
 
+/// First index in `[0, len)` where the monotone (false … true) predicate
+/// holds, or `len`: linear probes from `hint`, then bisection.
+fn first_true(len: usize, hint: usize, pred: impl Fn(usize) -> bool) -> usize {
+    if len == 0 {
+        return 0;
+    }
+    let mut h = if hint < len { hint } else { len - 1 };
+    // Bracket (a, b]: pred(a) false or a = "-1", pred(b) true or b = len.
+    let (mut a, mut b): (Option<usize>, usize);
+    if pred(h) {
+        b = h;
+        a = None;
+        for _ in 0..PROBES {
+            if h == 0 {
+                return 0;
+            }
+            h -= 1;
+            if !pred(h) {
+                return b;
+            }
+            b = h;
+        }
+        if b == 0 {
+            return 0;
+        }
+    } else {
+        a = Some(h);
+        b = len;
+        for _ in 0..PROBES {
+            h += 1;
+            if h >= len {
+                return len;
+            }
+            if pred(h) {
+                return h;
+            }
+            a = Some(h);
+        }
+    }
+    // Bisection on (a, b].
+    let mut lo = a.map_or(0, |x| x + 1);
+    while lo < b {
+        let m = lo + (b - lo) / 2;
+        if pred(m) {
+            b = m;
+        } else {
+            lo = m + 1;
+        }
+    }
+    b
+}
+
 impl<const N: usize> IndexedSearch<N> {
     /// An empty index.
     pub const fn new() -> Self {
         Self {
             keys: [0.0; N],
-            nodes: [Interval::EMPTY; N],
+            hi: [0.0; N],
+            lo: [0.0; N],
+            orient: 1.0,
+            hint: 0,
+            unkeyed: heapless::Vec::new(),
+            scan: false,
             segments: 0,
+            kmin: 0.0,
+            kmax: 0.0,
+            eps: ANGULAR_EPS,
+            period: 4.0,
             key: PencilKey::Angular {
                 foe: [0.0, 0.0],
                 sign_w: 1.0,
@@ -442,128 +478,253 @@ impl<const N: usize> IndexedSearch<N> {
         }
     }
 
-    fn seg_interval(&self, j: usize) -> Interval {
-        match (self.keys.get(j), self.keys.get(j + 1)) {
-            (Some(&k0), Some(&k1)) => self.key.segment(k0, k1),
-            _ => Interval::ALL,
-        }
+    /// Whether segment `(k0, k1)` has usable keys and does not pass
+    /// through the FOE (half a turn between its ends).
+    #[inline(always)]
+    fn keyed(&self, k0: f32, k1: f32) -> bool {
+        k0.is_finite()
+            && k1.is_finite()
+            && !(self.period > 0.0 && ((k1 - k0).abs() - 2.0).abs() < 1.0e-3)
     }
 
-    fn node_interval(&self, x: usize) -> Interval {
-        if x >= self.segments {
-            self.seg_interval(x - self.segments)
-        } else {
-            self.nodes.get(x).copied().unwrap_or(Interval::ALL)
-        }
-    }
-
-    /// Build the tree over the vertex keys `keys` (at most `N` are used).
-    fn build(&mut self, key: &PencilKey, keys: impl Iterator<Item = f32>) {
+    /// Build the index over the vertex keys `keys` (at most `N` are used).
+    /// `unkeyed_meets_all`: whether a segment with an unkeyable end may meet
+    /// every line (the crossing search) or none (the fold test, where such
+    /// a vertex is at the FOE or behind the camera).
+    fn build(&mut self, key: &PencilKey, unkeyed_meets_all: bool, keys: impl Iterator<Item = f32>) {
         self.key = *key;
+        self.unkeyed.clear();
+        self.scan = false;
+        self.hint = 0;
+        self.period = match key {
+            PencilKey::Angular { .. } => 4.0,
+            PencilKey::Projective { .. } => 0.0,
+        };
+        let (mut kmin, mut kmax) = (f32::INFINITY, f32::NEG_INFINITY);
+        let (mut first, mut last) = (NO_KEY, NO_KEY);
         let mut n: usize = 0;
-        for (slot, k) in self.keys.iter_mut().zip(keys) {
+        let mut prev = NO_KEY;
+        let mut offset = 0.0f32;
+        for (slot, raw) in self.keys.iter_mut().zip(keys) {
+            let mut k = raw;
+            if k.is_finite() {
+                k += offset;
+                if self.period > 0.0 && prev.is_finite() {
+                    // Unwrap: raw keys are in [0, 4) and consecutive keys
+                    // differ by less than half a turn, so one correction of
+                    // the running offset (a multiple of 4) suffices.
+                    let d = k - prev;
+                    if d > 2.0 {
+                        offset -= 4.0;
+                        k -= 4.0;
+                    } else if d < -2.0 {
+                        offset += 4.0;
+                        k += 4.0;
+                    }
+                }
+                kmin = fmin(kmin, k);
+                kmax = fmax(kmax, k);
+                if !first.is_finite() {
+                    first = k;
+                }
+                last = k;
+            }
             *slot = k;
+            prev = k;
             n += 1;
         }
         self.segments = n.saturating_sub(1);
-        // Inner nodes 1..S, children 2x and 2x+1; indices >= S are leaves.
-        for x in (1..self.segments).rev() {
-            let i = self
-                .node_interval(2 * x)
-                .union(&self.node_interval(2 * x + 1));
-            if let Some(slot) = self.nodes.get_mut(x) {
-                *slot = i;
+        self.kmin = kmin;
+        self.kmax = kmax;
+        self.eps = match key {
+            PencilKey::Angular { .. } => ANGULAR_EPS,
+            PencilKey::Projective { .. } => PROJECTIVE_EPS + 1.0e-5 * fmax(kmin.abs(), kmax.abs()),
+        };
+        let o = if last >= first { 1.0 } else { -1.0 };
+        self.orient = o;
+        let s = self.segments;
+        let (Some(keys), Some(hi), Some(lo)) = (
+            self.keys.get(..n),
+            self.hi.get_mut(..s),
+            self.lo.get_mut(..s),
+        ) else {
+            self.scan = true;
+            return;
+        };
+        let keyed = |k0: f32, k1: f32, period: f32| {
+            k0.is_finite()
+                && k1.is_finite()
+                && !(period > 0.0 && ((k1 - k0).abs() - 2.0).abs() < 1.0e-3)
+        };
+        let mut run = f32::NEG_INFINITY;
+        for (j, (w, h)) in keys.windows(2).zip(hi.iter_mut()).enumerate() {
+            if let [k0, k1] = *w {
+                if keyed(k0, k1, self.period) {
+                    run = fmax(run, fmax(o * k0, o * k1));
+                } else if unkeyed_meets_all && self.unkeyed.push(j).is_err() {
+                    self.scan = true;
+                }
+            }
+            *h = run;
+        }
+        let mut run = f32::INFINITY;
+        for (w, l) in keys.windows(2).rev().zip(lo.iter_mut().rev()) {
+            if let [k0, k1] = *w {
+                if keyed(k0, k1, self.period) {
+                    run = fmin(run, fmin(o * k0, o * k1));
+                }
+            }
+            *l = run;
+        }
+    }
+
+    fn key_at(&self, i: usize) -> f32 {
+        self.keys.get(i).copied().unwrap_or(NO_KEY)
+    }
+
+    /// The run of candidate segments `[a, b)` for the (unwrapped) key `qq`.
+    #[inline(always)]
+    fn run_for(&mut self, qq: f32) -> (usize, usize) {
+        let s = self.segments;
+        let oq = self.orient * qq;
+        let eps = self.eps;
+        let (hi, lo) = (&self.hi, &self.lo);
+        let top = hi
+            .get(s.wrapping_sub(1))
+            .copied()
+            .unwrap_or(f32::NEG_INFINITY);
+        let bottom = lo.first().copied().unwrap_or(f32::INFINITY);
+        if top < oq - eps || bottom > oq + eps {
+            return (0, 0);
+        }
+        let a = first_true(s, self.hint, |j| hi.get(j).is_none_or(|&h| h >= oq - eps));
+        let b = a + first_true(s - a, 0, |j| lo.get(a + j).is_none_or(|&l| l > oq + eps));
+        self.hint = a;
+        (a, b)
+    }
+
+    /// The unwrapped keys equal to `q` modulo the period that can occur.
+    /// `None`: the boundary winds around the FOE; scan it all.
+    #[inline(always)]
+    fn turns(&self, q: f32) -> Option<[f32; 3]> {
+        let p = self.period;
+        if p > 0.0 && self.kmax - self.kmin >= 2.0 * p {
+            return None;
+        }
+        let (lo, hi) = (self.kmin - self.eps, self.kmax + self.eps);
+        let pick = |x: f32| if lo <= x && x <= hi { x } else { NO_KEY };
+        Some(if p > 0.0 {
+            // Shift q into [kmin, kmin + 4) first: |q - kmin| may be many turns.
+            let base = q + p * ceil_i32((self.kmin - q) / p) as f32;
+            [pick(base - p), pick(base), pick(base + p)]
+        } else {
+            [pick(q), NO_KEY, NO_KEY]
+        })
+    }
+
+    /// Visit every segment whose key range (widened) holds the key `q`,
+    /// until `visit` returns `false`. Unkeyed segments are always visited.
+    fn sweep(&mut self, q: f32, mut visit: impl FnMut(usize) -> bool) {
+        let turns = if self.scan || !q.is_finite() {
+            None
+        } else {
+            self.turns(q)
+        };
+        let Some(turns) = turns else {
+            for j in 0..self.segments {
+                if !visit(j) {
+                    return;
+                }
+            }
+            return;
+        };
+        for &j in self.unkeyed.iter() {
+            if !visit(j) {
+                return;
+            }
+        }
+        for qq in turns {
+            if !qq.is_finite() {
+                continue;
+            }
+            let (a, b) = self.run_for(qq);
+            let eps = self.eps;
+            for j in a..b {
+                let (k0, k1) = (self.key_at(j), self.key_at(j + 1));
+                let (mn, mx) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
+                if mn - eps <= qq && qq <= mx + eps && self.keyed(k0, k1) && !visit(j) {
+                    return;
+                }
             }
         }
     }
 
-    /// Index the rotation-compensated frame-1 boundary (for the fold test).
-    pub(crate) fn prepare_compensated(&mut self, boundary: &[Pixel], geom: &PairGeometry) {
-        let key = geom.key;
-        self.build(
-            &key,
-            boundary
-                .iter()
-                .map(|p| geom.compensate(*p).map_or(NO_KEY, |c| key.vertex(c.pixel))),
-        );
+    /// Index the rotation-compensated frame-1 boundary (for the fold test)
+    /// from the keys of its compensated points.
+    pub(crate) fn prepare_keys(&mut self, key: &PencilKey, keys: impl Iterator<Item = f32>) {
+        self.build(key, false, keys);
     }
 
     /// Whether the indexed polyline meets the line with key `q` at a segment
     /// outside `skip` (inclusive segment range). Unkeyable lines answer yes.
-    pub(crate) fn meets_outside(&self, q: f32, skip: (usize, usize)) -> bool {
-        let s = self.segments;
-        if s == 0 {
+    pub(crate) fn meets_outside(&mut self, q: f32, skip: (usize, usize)) -> bool {
+        if self.segments == 0 {
             return false;
         }
         if !q.is_finite() {
             return true;
         }
-        let mut stack: heapless::Vec<usize, 64> = heapless::Vec::new();
-        let _ = stack.push(1);
-        while let Some(x) = stack.pop() {
-            if !self.key.admits(&self.node_interval(x), q) {
+        let Some(turns) = self.turns(q) else {
+            return self.segments > skip.1.saturating_sub(skip.0) + 1;
+        };
+        let eps = self.eps;
+        for qq in turns {
+            if !qq.is_finite() {
                 continue;
             }
-            if x >= s {
-                let j = x - s;
-                if j < skip.0 || j > skip.1 {
+            let (a, b) = self.run_for(qq);
+            // Only the candidates outside the skipped window matter.
+            let left = a..b.min(skip.0);
+            let right = a.max(skip.1.saturating_add(1))..b;
+            for j in left.chain(right) {
+                let (k0, k1) = (self.key_at(j), self.key_at(j + 1));
+                let (mn, mx) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
+                if mn - eps <= qq && qq <= mx + eps && self.keyed(k0, k1) {
                     return true;
                 }
-            } else if stack.push(2 * x).is_err() || stack.push(2 * x + 1).is_err() {
-                return true;
             }
         }
         false
-    }
-
-    fn scan_all(line: &EpipolarLine, boundary: &[Pixel], out: &mut Crossings) {
-        for (j, w) in boundary.windows(2).enumerate() {
-            if let [v0, v1] = w {
-                if let Some(c) = line.crossing(j, *v0, *v1) {
-                    if out.push(c).is_err() {
-                        return;
-                    }
-                }
-            }
-        }
     }
 }
 
 impl<const N: usize> CrossingSearch for IndexedSearch<N> {
     fn prepare(&mut self, boundary: &[Pixel], key: &PencilKey) {
-        self.build(key, boundary.iter().map(|p| key.vertex(p.arr())));
+        self.build(key, true, boundary.iter().map(|p| key.vertex(p.arr())));
     }
 
     fn search(&mut self, line: &EpipolarLine, boundary: &[Pixel], out: &mut Crossings) {
-        let s = self.segments;
-        let q = self.key.line(line);
-        if s == 0 || !q.is_finite() || boundary.len() != s + 1 {
-            Self::scan_all(line, boundary, out);
-            return;
-        }
-        let mut stack: heapless::Vec<usize, 64> = heapless::Vec::new();
-        // Cannot fail: the stack is empty.
-        let _ = stack.push(1);
-        while let Some(x) = stack.pop() {
-            if !self.key.admits(&self.node_interval(x), q) {
-                continue;
-            }
-            if x >= s {
-                let j = x - s;
-                if let (Some(v0), Some(v1)) = (boundary.get(j), boundary.get(j + 1)) {
+        if boundary.len() != self.segments + 1 {
+            // Not the boundary this index was prepared for: scan it.
+            for (j, w) in boundary.windows(2).enumerate() {
+                if let [v0, v1] = w {
                     if let Some(c) = line.crossing(j, *v0, *v1) {
                         if out.push(c).is_err() {
                             return;
                         }
                     }
                 }
-            } else if stack.push(2 * x).is_err() || stack.push(2 * x + 1).is_err() {
-                // Unreachable for any N below 2^62 (the tree is shallower
-                // than the stack), but never give a wrong answer: rescan.
-                out.clear();
-                Self::scan_all(line, boundary, out);
-                return;
             }
+            return;
         }
+        let q = self.key.line(line);
+        self.sweep(q, |j| {
+            if let (Some(v0), Some(v1)) = (boundary.get(j), boundary.get(j + 1)) {
+                if let Some(c) = line.crossing(j, *v0, *v1) {
+                    return out.push(c).is_ok();
+                }
+            }
+            true
+        });
     }
 }

@@ -4,16 +4,84 @@
 //! correctly rounded or near-correctly rounded results on every target, so the
 //! host build and the firmware build compute the same numbers.
 
-/// Square root (`libm`, identical on host and target).
+/// Square root, for `x ≥ 0` (0 for anything else, NaN included).
+///
+/// The hot path needs two square roots per point and the Cortex-M4F build
+/// of `libm::sqrtf` is a ~60-instruction software routine (the `VSQRT`
+/// instruction is not reachable from stable `no_std` Rust without `asm!`).
+/// So: `micromath`'s bit-level estimate (within ~5 %), then three Newton
+/// steps (`y ← (y + x/y)/2`, quadratic convergence: 5e-2 → 1.3e-3 → 8e-7 →
+/// f32 rounding). The test `sqrt_matches_libm` pins the relative error at
+/// 2e-7 over the whole range used. Same operations on host and target, so
+/// both compute the same bits.
 #[inline]
 pub(crate) fn sqrt(x: f32) -> f32 {
-    libm::sqrtf(x)
+    if !(x > 0.0) || x == f32::INFINITY {
+        return if x == f32::INFINITY { x } else { 0.0 };
+    }
+    let mut y = micromath::F32(x).sqrt().0;
+    y = 0.5 * (y + x / y);
+    y = 0.5 * (y + x / y);
+    0.5 * (y + x / y)
 }
 
-/// Sine and cosine of an angle in radians.
-#[inline]
+/// Sine and cosine of an angle in radians, `|x| ≤ π/2` (callers validate).
+///
+/// `libm`'s `sinf`/`cosf` reduce their argument in double precision, which
+/// on the single-precision FPU becomes software `f64` (`__aeabi_d*`), and
+/// `micromath`'s are accurate to ~1e-3 only (0.8 px at f = 800 px). On
+/// `|x| ≤ π/2` the Taylor series to x¹³ is exact to ~6e-11 before rounding;
+/// evaluated in Horner form in `f32`. The test `sin_cos_match_libm` pins
+/// the error at 3e-7.
 pub(crate) fn sin_cos(x: f32) -> (f32, f32) {
-    (libm::sinf(x), libm::cosf(x))
+    let x2 = x * x;
+    let s = x
+        * (1.0
+            + x2 * (-1.0 / 6.0
+                + x2 * (1.0 / 120.0
+                    + x2 * (-1.0 / 5040.0
+                        + x2 * (1.0 / 362_880.0
+                            + x2 * (-1.0 / 39_916_800.0 + x2 * (1.0 / 6_227_020_800.0)))))));
+    let c = 1.0
+        + x2 * (-0.5
+            + x2 * (1.0 / 24.0
+                + x2 * (-1.0 / 720.0
+                    + x2 * (1.0 / 40_320.0
+                        + x2 * (-1.0 / 3_628_800.0
+                            + x2 * (1.0 / 479_001_600.0 + x2 * (-1.0 / 87_178_291_200.0)))))));
+    (s, c)
+}
+
+/// `max` by comparison. `f32::max` is a call to `fmaxf` on the Cortex-M4F
+/// (no `VMAXNM` before Armv8); inputs here are never NaN.
+#[inline(always)]
+pub(crate) fn fmax(a: f32, b: f32) -> f32 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// `min` by comparison (see [`fmax`]).
+#[inline(always)]
+pub(crate) fn fmin(a: f32, b: f32) -> f32 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
+/// Smallest integer ≥ `x`, for `|x| < 2³¹` (no `libm` call).
+#[inline]
+pub(crate) fn ceil_i32(x: f32) -> i32 {
+    let t = x as i32;
+    if (t as f32) < x {
+        t + 1
+    } else {
+        t
+    }
 }
 
 /// 2-D cross product `a.x*b.y - a.y*b.x`.
@@ -104,6 +172,44 @@ mod tests {
             assert!(p > last, "not increasing at step {i}: {p} <= {last}");
             assert!((0.0..4.0).contains(&p));
             last = p;
+        }
+    }
+
+    #[test]
+    fn sqrt_matches_libm() {
+        let mut x = 1.0e-30f32;
+        while x < 1.0e30 {
+            for f in [1.0f32, 1.37, 2.0, 3.1, 5.9, 7.77] {
+                let v = x * f;
+                let want = libm::sqrtf(v);
+                let got = sqrt(v);
+                assert!(
+                    ((got - want) / want).abs() <= 2.0e-7,
+                    "sqrt({v}) = {got}, want {want}"
+                );
+            }
+            x *= 10.0;
+        }
+        assert_eq!(sqrt(0.0), 0.0);
+        assert_eq!(sqrt(-1.0), 0.0);
+        assert_eq!(sqrt(f32::NAN), 0.0);
+    }
+
+    #[test]
+    fn sin_cos_match_libm() {
+        for i in -1000..=1000 {
+            let x = i as f32 * core::f32::consts::FRAC_PI_2 / 1000.0;
+            let (s, c) = sin_cos(x);
+            assert!((s - libm::sinf(x)).abs() <= 3.0e-7, "sin({x})");
+            assert!((c - libm::cosf(x)).abs() <= 3.0e-7, "cos({x})");
+        }
+    }
+
+    #[test]
+    fn integer_rounding() {
+        for (x, c, f) in [(1.5f32, 2, 1), (-1.5, -1, -2), (2.0, 2, 2), (-0.0, 0, 0)] {
+            assert_eq!(ceil_i32(x), c);
+            assert_eq!(-ceil_i32(-x), f);
         }
     }
 

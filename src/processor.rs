@@ -13,7 +13,8 @@ use crate::boundary::Frame;
 use crate::camera::{Camera, Pixel};
 use crate::depth::{chord, crossing_angle, stick, DepthInterval, CHORD_HALF_WINDOW};
 use crate::epipolar::{
-    CrossingSearch, Crossings, EpipolarLine, IndexedSearch, PairGeometry, MAX_CROSSINGS,
+    Compensated, CrossingSearch, Crossings, EpipolarLine, IndexedSearch, PairGeometry,
+    MAX_CROSSINGS,
 };
 use crate::math::sqrt;
 use crate::motion::Motion;
@@ -92,7 +93,7 @@ impl Config {
         Ok(Self {
             e1,
             e2,
-            sin_min_angle: libm::sinf(min_angle_deg.to_radians()),
+            sin_min_angle: crate::math::sin_cos(min_angle_deg.to_radians()).0,
             max_depth,
         })
     }
@@ -300,6 +301,31 @@ impl<const N: usize, const B: usize> Structure<N, B> {
             [x * i.z_near, y * i.z_near, i.z_near],
             [x * i.z_far, y * i.z_far, i.z_far],
         ))
+    }
+
+    /// A 32-bit FNV-1a digest of every result, bit for bit (status, both
+    /// pixels, depth and stick of every point, boundary by boundary): two
+    /// runs agree exactly iff their digests agree (up to hash collisions).
+    /// Used to check that the firmware computes what the host computes.
+    pub fn digest(&self) -> u32 {
+        let mut h: u32 = 0x811c_9dc5;
+        let mut eat = |x: u32| {
+            for b in x.to_le_bytes() {
+                h = (h ^ u32::from(b)).wrapping_mul(0x0100_0193);
+            }
+        };
+        for b in self.boundaries.iter() {
+            eat(0xB0B0_B0B0);
+            for r in b.points.iter() {
+                eat(r.status as u32);
+                for x in [
+                    r.pixel1.u, r.pixel1.v, r.pixel2.u, r.pixel2.v, r.z, r.z_near, r.z_far,
+                ] {
+                    eat(x.to_bits());
+                }
+            }
+        }
+        h
     }
 
     /// How many points have each status, indexed like [`Status::ALL`].
@@ -540,44 +566,78 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
         let Some(bs) = out.boundaries.last_mut() else {
             break;
         };
-        // Pass 1, the fold test (frame 1 only): does a point's epipolar line
-        // meet the frame-1 boundary again, away from the point itself?
-        let index = searches.index();
-        index.prepare_compensated(b1.points(), &geom);
-        for (i, &p1) in b1.points().iter().enumerate() {
-            let folded = geom.compensate(p1).is_some_and(|c| {
-                let line = geom.line(&c);
-                line.a2 > 0.0
-                    && index.meets_outside(
-                        geom.key().line(&line),
-                        (
-                            i.saturating_sub(CHORD_HALF_WINDOW),
-                            i + CHORD_HALF_WINDOW - 1,
-                        ),
-                    )
-            });
-            let status = if folded {
-                Status::Folded
-            } else {
-                Status::NoIntersection
+        // Pass 1: compensate every frame-1 point once. The output entry
+        // holds the compensated point until pass 2 overwrites it: p₁' in
+        // `pixel2`, q_z in `z`, the stretch in `z_near`, the key of its
+        // epipolar line in `z_far` (no extra memory).
+        let key = *geom.key();
+        for &p1 in b1.points() {
+            let r = match geom.compensate(p1) {
+                Some(c) => PointResult {
+                    pixel1: p1,
+                    pixel2: Pixel::new(c.pixel[0], c.pixel[1]),
+                    z: c.depth_scale,
+                    z_near: c.stretch,
+                    z_far: key.vertex_key(c.pixel),
+                    status: Status::NoIntersection,
+                },
+                None => flagged(p1, Status::BehindCamera),
             };
-            if bs.points.push(flagged(p1, status)).is_err() {
+            if bs.points.push(r).is_err() {
                 break;
+            }
+        }
+        // The fold test (frame 1 only): does a point's epipolar line meet
+        // the frame-1 boundary again, away from the point itself? The line
+        // through the FOE and p₁' has p₁''s own key.
+        let index = searches.index();
+        index.prepare_keys(
+            &key,
+            bs.points.iter().map(|r| {
+                if r.status == Status::BehindCamera {
+                    f32::INFINITY
+                } else {
+                    r.z_far
+                }
+            }),
+        );
+        for (i, r) in bs.points.iter_mut().enumerate() {
+            if r.status != Status::BehindCamera
+                && index.meets_outside(
+                    r.z_far,
+                    (
+                        i.saturating_sub(CHORD_HALF_WINDOW),
+                        i + CHORD_HALF_WINDOW - 1,
+                    ),
+                )
+            {
+                r.status = Status::Folded;
             }
         }
         // Pass 2: intersect, triangulate, bound.
         let b2 = frame.boundaries().get(k).map(|b| b.points());
         let search = searches.crossing();
         if let Some(b2) = b2 {
-            search.prepare(b2, geom.key());
+            search.prepare(b2, &key);
         }
         for r in bs.points.iter_mut() {
-            let folded = r.status == Status::Folded;
-            let fresh = evaluate(config, &geom, r.pixel1, b2, search);
-            // The fold only matters where a depth would otherwise be given.
-            if !(folded && fresh.status.has_depth()) {
-                *r = fresh;
+            if r.status == Status::BehindCamera {
+                continue;
             }
+            let c = Compensated {
+                pixel: [r.pixel2.u, r.pixel2.v],
+                depth_scale: r.z,
+                stretch: r.z_near,
+            };
+            *r = evaluate(
+                config,
+                &geom,
+                r.pixel1,
+                &c,
+                r.status == Status::Folded,
+                b2,
+                search,
+            );
         }
     }
     previous.assign(frame);
@@ -598,19 +658,21 @@ fn evaluate<S: CrossingSearch>(
     config: &Config,
     geom: &PairGeometry,
     p1: Pixel,
+    c: &Compensated,
+    folded: bool,
     b2: Option<&[Pixel]>,
     search: &mut S,
 ) -> PointResult {
-    let Some(c) = geom.compensate(p1) else {
-        return flagged(p1, Status::BehindCamera);
-    };
-    let line: EpipolarLine = geom.line(&c);
+    let line: EpipolarLine = geom.line(c);
     let w = geom.w();
     let r1 = config.e1 * c.stretch;
     // |a| = |W'| ρ₁ (distance to the FOE): the error disc holds the FOE.
-    let foe_guard = w.abs() * r1.max(1.0e-3);
+    let foe_guard = w.abs() * crate::math::fmax(r1, 1.0e-3);
     if line.a2 <= foe_guard * foe_guard || line.a2 <= 1.0e-12 {
         return flagged(p1, Status::AtFoe);
+    }
+    if folded {
+        return flagged(p1, Status::Folded);
     }
     let Some(b2) = b2 else {
         return flagged(p1, Status::NoIntersection);
@@ -670,8 +732,8 @@ fn evaluate<S: CrossingSearch>(
     ) {
         Some(i) => {
             r.z = z;
-            r.z_near = i.z_near.min(z);
-            r.z_far = i.z_far.max(z);
+            r.z_near = crate::math::fmin(i.z_near, z);
+            r.z_far = crate::math::fmax(i.z_far, z);
         }
         None => r.status = Status::Unbounded,
     }

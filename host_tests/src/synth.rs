@@ -7,7 +7,7 @@
 //! World frame: x right, y **down**, z forward; the ground at the vehicle is
 //! `y = 0`; the camera sits `h` above it, pitched down by the tilt `θ`.
 
-type V3 = [f64; 3];
+pub type V3 = [f64; 3];
 type M3 = [[f64; 3]; 3];
 
 fn mm(a: &M3, b: &M3) -> M3 {
@@ -136,6 +136,25 @@ impl Road {
         }
     }
 
+    /// Centreline at arc length `s` ≥ 0: `(position on the ground, heading,
+    /// grade)` with the same integration as [`Road::boundaries`].
+    pub fn centre_at(&self, s: f64, ds: f64) -> (V3, f64, f64) {
+        let (mut t, mut p, mut psi) = (0.0, [self.centre_offset, 0.0, 0.0], self.heading);
+        while t + 0.5 * ds < s {
+            let k = self.curvature(t + 0.5 * ds);
+            let pm = psi + 0.5 * k * ds;
+            p = [p[0] + ds * pm.sin(), 0.0, p[2] + ds * pm.cos()];
+            psi += k * ds;
+            t += ds;
+        }
+        let grade = if t <= self.grade_from {
+            0.0
+        } else {
+            self.grade + self.vertical_curvature * (t - self.grade_from)
+        };
+        ([p[0], -self.height(t), p[2]], psi, grade)
+    }
+
     /// The two boundary curves (left, right) as fine 3-D polylines in the
     /// world frame, from arc length `-back` to `ahead`, step `ds`.
     pub fn boundaries(&self, back: f64, ahead: f64, ds: f64) -> [Vec<V3>; 2] {
@@ -194,6 +213,22 @@ impl Pose {
         }
     }
 
+    /// A camera on a vehicle that is also pitched (nose up by `pitch`).
+    pub fn vehicle_camera_pitched(
+        position: V3,
+        yaw: f64,
+        pitch: f64,
+        height: f64,
+        tilt: f64,
+    ) -> Self {
+        // "Up" from the vehicle is along its own -y axis.
+        let body = mm(&ry(yaw), &rx(pitch));
+        Self {
+            centre: add(position, mv(&body, [0.0, -height, 0.0])),
+            rot: mm(&body, &rx(-tilt)),
+        }
+    }
+
     /// World point → camera coordinates.
     pub fn to_camera(&self, p: V3) -> V3 {
         mv(&tr(&self.rot), sub(p, self.centre))
@@ -240,6 +275,18 @@ pub struct TruePoint {
 /// upwards, stopping where the curve leaves the image, folds back in the
 /// image (a crest hides the rest) or passes `max_depth`.
 pub fn detect(curve: &[V3], pose: &Pose, k: &Intrinsics, max_depth: f64) -> Vec<TruePoint> {
+    let rows: Vec<f64> = (0..k.height).rev().map(f64::from).collect();
+    detect_rows(curve, pose, k, max_depth, &rows)
+}
+
+/// [`detect`] at the given rows (in decreasing order, may be fractional).
+pub fn detect_rows(
+    curve: &[V3],
+    pose: &Pose,
+    k: &Intrinsics,
+    max_depth: f64,
+    rows: &[f64],
+) -> Vec<TruePoint> {
     let proj: Vec<(V3, f64)> = curve
         .iter()
         .map(|&p| {
@@ -254,7 +301,7 @@ pub fn detect(curve: &[V3], pose: &Pose, k: &Intrinsics, max_depth: f64) -> Vec<
         .collect();
     let mut out: Vec<TruePoint> = Vec::new();
     let mut started = false;
-    let mut last_v = f64::INFINITY;
+    let mut next = 0; // index into rows
     for (seg, w) in proj.windows(2).enumerate() {
         let ((c0, v0), (c1, v1)) = (w[0], w[1]);
         if !(v0.is_finite() && v1.is_finite()) || c0[2] < 0.05 {
@@ -273,35 +320,38 @@ pub fn detect(curve: &[V3], pose: &Pose, k: &Intrinsics, max_depth: f64) -> Vec<
         if c1[2] > max_depth {
             break;
         }
-        // Rows r with v0 >= r > v1.
-        let mut r = v0.floor();
-        while r > v1 {
-            if r < last_v && r <= f64::from(k.height) - 1.0 && r >= 0.0 {
-                // Exact point on the 3-D segment whose row is r.
-                let d = sub(c1, c0);
-                let rr = r - k.cy;
-                let den = k.f * d[1] - rr * d[2];
-                if den.abs() > 1e-15 {
-                    let lam = ((rr * c0[2]) - k.f * c0[1]) / den;
-                    let p = [c0[0] + lam * d[0], c0[1] + lam * d[1], c0[2] + lam * d[2]];
-                    let u = k.cx + k.f * p[0] / p[2];
-                    if !(0.0..=f64::from(k.width) - 1.0).contains(&u) {
-                        if started {
-                            return out;
-                        }
-                    } else {
-                        started = true;
-                        last_v = r;
-                        out.push(TruePoint {
-                            u,
-                            v: r,
-                            camera: p,
-                            arc: seg as f64 + lam,
-                        });
-                    }
-                }
+        // Skip rows below this segment (not reached yet by the curve).
+        while next < rows.len() && rows[next] > v0 {
+            next += 1;
+        }
+        while next < rows.len() && rows[next] > v1 {
+            let r = rows[next];
+            next += 1;
+            let d = sub(c1, c0);
+            let rr = r - k.cy;
+            let den = k.f * d[1] - rr * d[2];
+            if den.abs() <= 1e-15 {
+                continue;
             }
-            r -= 1.0;
+            let lam = ((rr * c0[2]) - k.f * c0[1]) / den;
+            let p = [c0[0] + lam * d[0], c0[1] + lam * d[1], c0[2] + lam * d[2]];
+            let u = k.cx + k.f * p[0] / p[2];
+            if !(0.0..=f64::from(k.width) - 1.0).contains(&u) {
+                if started {
+                    return out;
+                }
+            } else {
+                started = true;
+                out.push(TruePoint {
+                    u,
+                    v: r,
+                    camera: p,
+                    arc: seg as f64 + lam,
+                });
+            }
+        }
+        if next >= rows.len() {
+            break;
         }
     }
     out

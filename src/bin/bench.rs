@@ -1,0 +1,207 @@
+//! Benchmark on the emulated vehicle controller: instructions for the whole
+//! per-frame call at N = 32 … 512 points per boundary (two boundaries), the
+//! cost of each stage at N = 256, the worst-case stack of one per-frame call
+//! (stack painting), and the library's state and output sizes on the target.
+//! `cargo xtask bench` runs it, prints the tables and checks the budgets.
+
+#![no_std]
+#![no_main]
+
+mod fw;
+
+use core::hint::black_box;
+
+use cortex_m_rt::{entry, exception, ExceptionFrame};
+use defmt_semihosting as _;
+use roadstereo::{
+    epipolar::IndexedSearch, Config, CrossingSearch, Crossings, Frame, PairGeometry, Processor,
+    Structure,
+};
+
+static BENCH: [(u32, &[u8]); 5] = [
+    (32, include_bytes!("data/bench_32.bin")),
+    (64, include_bytes!("data/bench_64.bin")),
+    (128, include_bytes!("data/bench_128.bin")),
+    (256, include_bytes!("data/bench_256.bin")),
+    (512, include_bytes!("data/bench_512.bin")),
+];
+
+const CAP: usize = 512;
+
+fn load(
+    data: &'static [u8],
+    f1: &mut Frame<CAP, 2>,
+    f2: &mut Frame<CAP, 2>,
+) -> Option<roadstereo::Motion> {
+    let mut d = fw::Drive::new(data).ok()?;
+    *f1 = Frame::new(d.camera);
+    *f2 = Frame::new(d.camera);
+    d.next_frame(f1).ok()?;
+    d.next_frame(f2).ok()?
+}
+
+/// Stack painting: fill the free stack below the current stack pointer with
+/// a pattern, run `f`, and find how deep it wrote. Reading and writing raw
+/// stack memory needs `unsafe`; this is measurement code in the benchmark
+/// binary only (the library forbids `unsafe`).
+mod stack {
+    const PATTERN: u32 = 0xDEAD_BEEF;
+    extern "C" {
+        static mut __sheap: u32;
+    }
+
+    #[inline(never)]
+    pub fn high_water(f: impl FnOnce()) -> u32 {
+        let sp = cortex_m::register::msp::read() as usize;
+        let bottom = core::ptr::addr_of_mut!(__sheap) as usize;
+        // Leave 256 bytes below the current frame for this function itself.
+        let top = (sp - 256) & !3;
+        let mut a = bottom;
+        while a < top {
+            // SAFETY: [bottom, top) is free stack memory below the live stack
+            // (cortex-m-rt puts the stack at the top of RAM, growing down to
+            // the end of .bss at __sheap); nothing else uses it.
+            unsafe { core::ptr::write_volatile(a as *mut u32, PATTERN) };
+            a += 4;
+        }
+        f();
+        let mut a = bottom;
+        // SAFETY: as above; reading back the painted region.
+        while a < top && unsafe { core::ptr::read_volatile(a as *const u32) } == PATTERN {
+            a += 4;
+        }
+        (sp - a) as u32
+    }
+}
+
+#[entry]
+fn main() -> ! {
+    let Some(mut core) = cortex_m::Peripherals::take() else {
+        fw::exit(false)
+    };
+    fw::start_counter(&mut core.SYST);
+    let mut processor = Processor::<CAP, 2>::new(Config::default());
+    let cam = match roadstereo::Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480) {
+        Ok(c) => c,
+        Err(_) => fw::exit(false),
+    };
+    let mut f1 = Frame::<CAP, 2>::new(cam);
+    let mut f2 = Frame::<CAP, 2>::new(cam);
+    for (n, data) in BENCH.iter() {
+        let Some(m) = load(data, &mut f1, &mut f2) else {
+            defmt::error!("bad bench data for n={=u32}", n);
+            fw::exit(false)
+        };
+        processor.reset();
+        let _ = processor.process(&f1, None);
+        let (ok, instr) = fw::measure(|| processor.process(black_box(&f2), Some(&m)).is_ok());
+        let points: usize = processor
+            .structure()
+            .boundaries()
+            .iter()
+            .map(|b| b.points().len())
+            .sum();
+        let c = processor.structure().status_counts();
+        defmt::info!(
+            "bench n={=u32} points={=u32} instr={=u32} per_point={=u32} ok={=u32} digest={=u32:08x} processed={=bool}",
+            n,
+            points as u32,
+            instr,
+            instr / (points.max(1) as u32),
+            c.first().copied().unwrap_or(0) as u32,
+            processor.structure().digest(),
+            ok
+        );
+        if *n == 256 {
+            stages(&f1, &f2, &m);
+            processor.reset();
+            let _ = processor.process(&f1, None);
+            let bytes = stack::high_water(|| {
+                let _ = black_box(processor.process(black_box(&f2), Some(&m)));
+            });
+            defmt::info!("stack per_frame_call={=u32}", bytes);
+        }
+    }
+    defmt::info!(
+        "sizes processor_256_2={=u32} frame_256_2={=u32} structure_256_2={=u32} search_256={=u32}",
+        core::mem::size_of::<Processor<256, 2>>() as u32,
+        core::mem::size_of::<Frame<256, 2>>() as u32,
+        core::mem::size_of::<Structure<256, 2>>() as u32,
+        core::mem::size_of::<IndexedSearch<256>>() as u32
+    );
+    fw::exit(true)
+}
+
+/// Cost of each stage at N = 256, through the public API.
+fn stages(f1: &Frame<CAP, 2>, f2: &Frame<CAP, 2>, m: &roadstereo::Motion) {
+    let pts = f1
+        .boundaries()
+        .iter()
+        .map(|b| b.points().len())
+        .sum::<usize>() as u32;
+    let (geom, g_instr) = fw::measure(|| PairGeometry::new(f1.camera(), f2.camera(), black_box(m)));
+    defmt::info!(
+        "stage name=geometry instr={=u32} per_point={=u32}",
+        g_instr,
+        g_instr / pts
+    );
+    let (_, c_instr) = fw::measure(|| {
+        for b in f1.boundaries() {
+            for p in b.points() {
+                if let Some(c) = geom.compensate(black_box(*p)) {
+                    black_box(geom.line(&c));
+                }
+            }
+        }
+    });
+    defmt::info!(
+        "stage name=compensate_and_line instr={=u32} per_point={=u32}",
+        c_instr,
+        c_instr / pts
+    );
+    let mut index = IndexedSearch::<CAP>::new();
+    let (_, p_instr) = fw::measure(|| {
+        for b in f2.boundaries() {
+            index.prepare(black_box(b.points()), geom.key());
+        }
+    });
+    defmt::info!(
+        "stage name=index_build instr={=u32} per_point={=u32}",
+        p_instr,
+        p_instr / pts
+    );
+    let mut found = 0u32;
+    let (_, s_instr) = fw::measure(|| {
+        for (b1, b2) in f1.boundaries().iter().zip(f2.boundaries()) {
+            index.prepare(b2.points(), geom.key());
+            for p in b1.points() {
+                if let Some(c) = geom.compensate(*p) {
+                    let line = geom.line(&c);
+                    if line.a2 > 0.0 {
+                        let mut out = Crossings::new();
+                        index.search(black_box(&line), b2.points(), &mut out);
+                        found += out.len() as u32;
+                    }
+                }
+            }
+        }
+    });
+    let search = s_instr.saturating_sub(c_instr + p_instr);
+    defmt::info!(
+        "stage name=search instr={=u32} per_point={=u32} crossings={=u32}",
+        search,
+        search / pts,
+        found
+    );
+}
+
+#[exception]
+unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
+    fw::exit(false)
+}
+
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo) -> ! {
+    defmt::error!("panic");
+    fw::exit(false)
+}

@@ -39,7 +39,8 @@
 
 use crate::camera::{Camera, Pixel};
 use crate::math::{
-    ceil_i32, cross, dot, fmax, fmin, mat3_mul, mat3_transpose, mat3_vec, pseudo_angle, sub,
+    ceil_i32, cross, dot, fmax, fmin, mat3_mul, mat3_transpose, mat3_vec, next_up, pseudo_angle,
+    sub,
 };
 use crate::motion::Motion;
 
@@ -403,56 +404,46 @@ impl<const N: usize> Default for IndexedSearch<N> {
     }
 }
 
-/// First index in `[0, len)` where the monotone (false … true) predicate
-/// holds, or `len`: linear probes from `hint`, then bisection.
-fn first_true(len: usize, hint: usize, pred: impl Fn(usize) -> bool) -> usize {
-    if len == 0 {
+/// First index `j` in `[0, v.len())` with `v[j] ≥ t` in a non-decreasing
+/// slice (or `v.len()`): linear probes from `hint`, then bisection.
+#[inline]
+fn first_at_least(v: &[f32], t: f32, hint: usize) -> usize {
+    let n = v.len();
+    let at = |j: usize| v.get(j).copied().unwrap_or(f32::INFINITY);
+    if n == 0 {
         return 0;
     }
-    let mut h = if hint < len { hint } else { len - 1 };
-    // Bracket (a, b]: pred(a) false or a = "-1", pred(b) true or b = len.
-    let (mut a, mut b): (Option<usize>, usize);
-    if pred(h) {
-        b = h;
-        a = None;
+    let mut j = if hint < n { hint } else { n - 1 };
+    if at(j) >= t {
         for _ in 0..PROBES {
-            if h == 0 {
-                return 0;
+            if j == 0 || at(j - 1) < t {
+                return j;
             }
-            h -= 1;
-            if !pred(h) {
-                return b;
-            }
-            b = h;
+            j -= 1;
         }
-        if b == 0 {
-            return 0;
-        }
+        bisect(v, 0, j, t)
     } else {
-        a = Some(h);
-        b = len;
         for _ in 0..PROBES {
-            h += 1;
-            if h >= len {
-                return len;
+            j += 1;
+            if j >= n || at(j) >= t {
+                return j;
             }
-            if pred(h) {
-                return h;
-            }
-            a = Some(h);
         }
+        bisect(v, j + 1, n, t)
     }
-    // Bisection on (a, b].
-    let mut lo = a.map_or(0, |x| x + 1);
-    while lo < b {
-        let m = lo + (b - lo) / 2;
-        if pred(m) {
-            b = m;
+}
+
+/// First index in `[lo, hi)` with `v[j] ≥ t` (non-decreasing `v`), or `hi`.
+fn bisect(v: &[f32], mut lo: usize, mut hi: usize, t: f32) -> usize {
+    while lo < hi {
+        let m = lo + (hi - lo) / 2;
+        if v.get(m).copied().unwrap_or(f32::INFINITY) >= t {
+            hi = m;
         } else {
             lo = m + 1;
         }
     }
-    b
+    hi
 }
 
 impl<const N: usize> IndexedSearch<N> {
@@ -578,48 +569,84 @@ impl<const N: usize> IndexedSearch<N> {
         }
     }
 
-    fn key_at(&self, i: usize) -> f32 {
-        self.keys.get(i).copied().unwrap_or(NO_KEY)
-    }
-
     /// The run of candidate segments `[a, b)` for the (unwrapped) key `qq`.
-    #[inline(always)]
+    #[inline]
     fn run_for(&mut self, qq: f32) -> (usize, usize) {
         let s = self.segments;
-        let oq = self.orient * qq;
-        let eps = self.eps;
-        let (hi, lo) = (&self.hi, &self.lo);
-        let top = hi
-            .get(s.wrapping_sub(1))
-            .copied()
-            .unwrap_or(f32::NEG_INFINITY);
-        let bottom = lo.first().copied().unwrap_or(f32::INFINITY);
-        if top < oq - eps || bottom > oq + eps {
+        let (Some(hi), Some(lo)) = (self.hi.get(..s), self.lo.get(..s)) else {
             return (0, 0);
+        };
+        let oq = self.orient * qq;
+        let (t_lo, t_hi) = (oq - self.eps, oq + self.eps);
+        match (hi.last(), lo.first()) {
+            (Some(&top), Some(&bottom)) if top >= t_lo && bottom <= t_hi => {}
+            _ => return (0, 0),
         }
-        let a = first_true(s, self.hint, |j| hi.get(j).is_none_or(|&h| h >= oq - eps));
-        let b = a + first_true(s - a, 0, |j| lo.get(a + j).is_none_or(|&l| l > oq + eps));
+        let a = first_at_least(hi, t_lo, self.hint);
         self.hint = a;
-        (a, b)
+        // lo[j] > t_hi for the first time at b (usually a step or two on).
+        let rest = lo.get(a..).unwrap_or(&[]);
+        let mut b = rest.len();
+        for (i, &l) in rest.iter().take(PROBES).enumerate() {
+            if l > t_hi {
+                b = i;
+                break;
+            }
+        }
+        if b == rest.len() && rest.len() > PROBES {
+            // Bisection for "l > t_hi" = "l ≥ next float after t_hi".
+            b = bisect(rest, PROBES, rest.len(), next_up(t_hi));
+        }
+        (a, a + b)
     }
 
-    /// The unwrapped keys equal to `q` modulo the period that can occur.
-    /// `None`: the boundary winds around the FOE; scan it all.
-    #[inline(always)]
-    fn turns(&self, q: f32) -> Option<[f32; 3]> {
+    /// The first unwrapped key equal to `q` modulo the period that can
+    /// occur, and how many (one period apart) follow it; `None` when the
+    /// boundary winds round the FOE more than once (scan it all).
+    #[inline]
+    fn turns(&self, q: f32) -> Option<(f32, u32)> {
         let p = self.period;
-        if p > 0.0 && self.kmax - self.kmin >= 2.0 * p {
+        let (lo, hi) = (self.kmin - self.eps, self.kmax + self.eps);
+        if p <= 0.0 {
+            return Some((q, u32::from(lo <= q && q <= hi)));
+        }
+        if hi - lo >= 2.0 * p {
             return None;
         }
-        let (lo, hi) = (self.kmin - self.eps, self.kmax + self.eps);
-        let pick = |x: f32| if lo <= x && x <= hi { x } else { NO_KEY };
-        Some(if p > 0.0 {
-            // Shift q into [kmin, kmin + 4) first: |q - kmin| may be many turns.
-            let base = q + p * ceil_i32((self.kmin - q) / p) as f32;
-            [pick(base - p), pick(base), pick(base + p)]
+        // Smallest q + 4m ≥ lo (the division by 4 is exact).
+        let first = q + p * ceil_i32((lo - q) * 0.25) as f32;
+        let count = if first > hi {
+            0
+        } else if first + p > hi {
+            1
         } else {
-            [pick(q), NO_KEY, NO_KEY]
-        })
+            2
+        };
+        Some((first, count))
+    }
+
+    /// The candidate segments for the key `q`, with the visiting order.
+    #[inline]
+    fn candidates(
+        &self,
+        j0: usize,
+        j1: usize,
+        qq: f32,
+        mut visit: impl FnMut(usize) -> bool,
+    ) -> bool {
+        let eps = self.eps;
+        let Some(keys) = self.keys.get(j0..(j1 + 1).min(self.segments + 1)) else {
+            return true;
+        };
+        for (i, w) in keys.windows(2).enumerate() {
+            if let [k0, k1] = *w {
+                let (mn, mx) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
+                if mn - eps <= qq && qq <= mx + eps && self.keyed(k0, k1) && !visit(j0 + i) {
+                    return false;
+                }
+            }
+        }
+        true
     }
 
     /// Visit every segment whose key range (widened) holds the key `q`,
@@ -630,7 +657,7 @@ impl<const N: usize> IndexedSearch<N> {
         } else {
             self.turns(q)
         };
-        let Some(turns) = turns else {
+        let Some((first, count)) = turns else {
             for j in 0..self.segments {
                 if !visit(j) {
                     return;
@@ -643,19 +670,13 @@ impl<const N: usize> IndexedSearch<N> {
                 return;
             }
         }
-        for qq in turns {
-            if !qq.is_finite() {
-                continue;
-            }
+        let mut qq = first;
+        for _ in 0..count {
             let (a, b) = self.run_for(qq);
-            let eps = self.eps;
-            for j in a..b {
-                let (k0, k1) = (self.key_at(j), self.key_at(j + 1));
-                let (mn, mx) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
-                if mn - eps <= qq && qq <= mx + eps && self.keyed(k0, k1) && !visit(j) {
-                    return;
-                }
+            if a < b && !self.candidates(a, b, qq, &mut visit) {
+                return;
             }
+            qq += self.period;
         }
     }
 
@@ -674,25 +695,22 @@ impl<const N: usize> IndexedSearch<N> {
         if !q.is_finite() {
             return true;
         }
-        let Some(turns) = self.turns(q) else {
+        let Some((first, count)) = self.turns(q) else {
             return self.segments > skip.1.saturating_sub(skip.0) + 1;
         };
-        let eps = self.eps;
-        for qq in turns {
-            if !qq.is_finite() {
-                continue;
-            }
+        let mut qq = first;
+        for _ in 0..count {
             let (a, b) = self.run_for(qq);
             // Only the candidates outside the skipped window matter.
-            let left = a..b.min(skip.0);
-            let right = a.max(skip.1.saturating_add(1))..b;
-            for j in left.chain(right) {
-                let (k0, k1) = (self.key_at(j), self.key_at(j + 1));
-                let (mn, mx) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
-                if mn - eps <= qq && qq <= mx + eps && self.keyed(k0, k1) {
-                    return true;
-                }
+            let (l0, l1) = (a, b.min(skip.0));
+            let (r0, r1) = (a.max(skip.1.saturating_add(1)), b);
+            let met = |_| false;
+            if (l0 < l1 && !self.candidates(l0, l1, qq, met))
+                || (r0 < r1 && !self.candidates(r0, r1, qq, met))
+            {
+                return true;
             }
+            qq += self.period;
         }
         false
     }

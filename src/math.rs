@@ -84,6 +84,16 @@ pub(crate) fn ceil_i32(x: f32) -> i32 {
     }
 }
 
+/// The smallest `f32` greater than `x` (finite `x`).
+#[inline]
+pub(crate) fn next_up(x: f32) -> f32 {
+    if x == 0.0 {
+        return f32::from_bits(1);
+    }
+    let b = x.to_bits();
+    f32::from_bits(if x > 0.0 { b + 1 } else { b - 1 })
+}
+
 /// 2-D cross product `a.x*b.y - a.y*b.x`.
 #[inline]
 pub(crate) fn cross(a: [f32; 2], b: [f32; 2]) -> f32 {

@@ -147,11 +147,12 @@ pub enum Status {
     /// The disparity is not larger than its error: the stick's far end is
     /// unbounded.
     Unbounded,
-    /// The point's epipolar line meets the frame-1 boundary again, more
-    /// than [`crate::depth::CHORD_HALF_WINDOW`] points away: the boundary
-    /// folds across the epipolar lines, so the frame-2 intersection may be
-    /// the image of another part of the curve (one possibly not visible in
-    /// frame 2). The correspondence is not unique; no depth is given.
+    /// The point would have a depth, but its epipolar line meets the
+    /// frame-1 boundary again, more than [`crate::depth::CHORD_HALF_WINDOW`]
+    /// points away: the boundary folds across the epipolar lines, so the
+    /// frame-2 intersection may be the image of another part of the curve
+    /// (one possibly not visible in frame 2). The correspondence is not
+    /// unique; no depth is given.
     Folded,
 }
 
@@ -671,9 +672,6 @@ fn evaluate<S: CrossingSearch>(
     if line.a2 <= foe_guard * foe_guard || line.a2 <= 1.0e-12 {
         return flagged(p1, Status::AtFoe);
     }
-    if folded {
-        return flagged(p1, Status::Folded);
-    }
     let Some(b2) = b2 else {
         return flagged(p1, Status::NoIntersection);
     };
@@ -736,6 +734,11 @@ fn evaluate<S: CrossingSearch>(
             r.z_far = crate::math::fmax(i.z_far, z);
         }
         None => r.status = Status::Unbounded,
+    }
+    // The fold test only matters where a depth would otherwise be given:
+    // elsewhere the status already says why there is none.
+    if folded && r.status.has_depth() {
+        r.status = Status::Folded;
     }
     r
 }

@@ -160,3 +160,51 @@ pub fn bench_pair(n: usize) -> (Intrinsics, Vec<DriveFrame>) {
     }
     (k, frames)
 }
+
+/// Decode the binary format written by [`encode`]: camera and, per frame,
+/// the motion (zero for the first) and pixel boundaries.
+pub fn decode(b: &[u8]) -> Option<(roadstereo::Camera, Vec<DriveFrame>)> {
+    let mut at = 0usize;
+    let mut take = |n: usize| -> Option<&[u8]> {
+        let s = b.get(at..at + n)?;
+        at += n;
+        Some(s)
+    };
+    if take(4)? != b"RSD1" {
+        return None;
+    }
+    let mut f32s = Vec::new();
+    for _ in 0..4 {
+        f32s.push(f32::from_le_bytes(take(4)?.try_into().ok()?));
+    }
+    let w = u16::from_le_bytes(take(2)?.try_into().ok()?);
+    let h = u16::from_le_bytes(take(2)?.try_into().ok()?);
+    let cam = roadstereo::Camera::new(f32s[0], f32s[1], f32s[2], f32s[3], w, h).ok()?;
+    let nf = u32::from_le_bytes(take(4)?.try_into().ok()?);
+    let mut frames = Vec::new();
+    for _ in 0..nf {
+        let mut v = [0f32; 6];
+        for x in v.iter_mut() {
+            *x = f32::from_le_bytes(take(4)?.try_into().ok()?);
+        }
+        let nb = u32::from_le_bytes(take(4)?.try_into().ok()?);
+        let mut boundaries = Vec::new();
+        for _ in 0..nb {
+            let np = u32::from_le_bytes(take(4)?.try_into().ok()?);
+            let mut pts = Vec::new();
+            for _ in 0..np {
+                let u = f32::from_le_bytes(take(4)?.try_into().ok()?);
+                let v = f32::from_le_bytes(take(4)?.try_into().ok()?);
+                pts.push([u, v]);
+            }
+            boundaries.push(pts);
+        }
+        frames.push(DriveFrame {
+            translation: [v[0], v[1], v[2]],
+            rotation: [v[3], v[4], v[5]],
+            boundaries,
+            depths: Vec::new(),
+        });
+    }
+    Some((cam, frames))
+}

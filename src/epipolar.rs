@@ -44,15 +44,19 @@ use crate::math::{
 };
 use crate::motion::Motion;
 
-/// At most this many intersections of one epipolar line with one boundary
-/// are told apart; a line meeting the boundary more often is
-/// [`crate::Status::Tangled`].
+/// At most this many intersections of one epipolar search range with one
+/// boundary are told apart; more is [`crate::Status::Tangled`].
 pub const MAX_CROSSINGS: usize = 8;
 
-/// The intersections found for one epipolar line: up to
-/// [`MAX_CROSSINGS`]` + 1` (one more than can be told apart, so "too many"
-/// is visible).
-pub type Crossings = heapless::Vec<Crossing, { MAX_CROSSINGS + 1 }>;
+/// At most this many intersections of the whole ray from the FOE through a
+/// point are collected; a boundary meeting the ray more often runs along
+/// it, and the point is [`crate::Status::Tangled`] without further search.
+pub const MAX_RAY_CROSSINGS: usize = 16;
+
+/// The intersections found for one epipolar ray: up to
+/// [`MAX_RAY_CROSSINGS`]` + 1` (one more than can be told apart, so "too
+/// many" is visible).
+pub type Crossings = heapless::Vec<Crossing, { MAX_RAY_CROSSINGS + 1 }>;
 
 /// One intersection of an epipolar line with a boundary segment.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -186,13 +190,20 @@ pub struct EpipolarLine {
     pub a: [f32; 2],
     /// `|a|²`.
     pub a2: f32,
-    /// Largest admissible `τ` (`1/|W'|` when `W' < 0`, else infinity).
+    /// Largest admissible `τ` of the search range (`1/|W'|` when `W' < 0`,
+    /// else infinity); the smallest is 0 (exclusive).
     pub tau_max: f32,
+    /// The ray from the FOE through `p₁'` is `ray_min < τ < ray_max`
+    /// (`τ > −1/W'` when `W' > 0`, `τ < 1/|W'|` when `W' < 0`, the whole
+    /// line when `W' = 0`); the search range is the part with `τ > 0`.
+    pub ray_min: f32,
+    /// See `ray_min`.
+    pub ray_max: f32,
 }
 
 impl EpipolarLine {
-    /// The intersection of this line's search range with the segment
-    /// `v0 → v1` (segment index `segment`), if any.
+    /// The intersection of the ray from the FOE through `p₁'` with the
+    /// segment `v0 → v1` (segment index `segment`), if any.
     ///
     /// The crossing test is the exact side test on the signs of
     /// `σ = a × (v − p₁')` (a vertex on the line counts as on the positive
@@ -210,7 +221,13 @@ impl EpipolarLine {
         let p = [v0[0] + u * (v1[0] - v0[0]), v0[1] + u * (v1[1] - v0[1])];
         // a2 > 0 is guaranteed by the caller (the point is not at the FOE).
         let tau = dot(sub(p, self.origin), self.a) / self.a2;
-        (tau > 0.0 && tau < self.tau_max).then_some(Crossing { segment, tau })
+        (tau > self.ray_min && tau < self.ray_max).then_some(Crossing { segment, tau })
+    }
+
+    /// Whether a crossing lies in the search range: the half-line away from
+    /// the FOE (`W' ≥ 0`) or the segment towards it (`W' < 0`), Sec. 2 (3).
+    pub fn in_search_range(&self, c: &Crossing) -> bool {
+        c.tau > 0.0 && c.tau < self.tau_max
     }
 
     /// The frame-2 pixel at position `tau` on the line.
@@ -325,6 +342,16 @@ impl PairGeometry {
             } else {
                 f32::INFINITY
             },
+            ray_min: if self.w > 0.0 {
+                -1.0 / self.w
+            } else {
+                f32::NEG_INFINITY
+            },
+            ray_max: if self.w < 0.0 {
+                -1.0 / self.w
+            } else {
+                f32::INFINITY
+            },
         }
     }
 }
@@ -335,9 +362,9 @@ impl PairGeometry {
 pub trait CrossingSearch {
     /// Called once for each frame-2 boundary before its lines are searched.
     fn prepare(&mut self, boundary: &[Pixel], key: &PencilKey);
-    /// Push the crossings of `line` with `boundary` (the one last prepared)
-    /// into `out`, each found by [`EpipolarLine::crossing`], stopping when
-    /// `out` is full. The order does not matter.
+    /// Push the crossings of `line`'s ray with `boundary` (the one last
+    /// prepared) into `out`, each found by [`EpipolarLine::crossing`],
+    /// stopping when `out` is full. The order does not matter.
     fn search(&mut self, line: &EpipolarLine, boundary: &[Pixel], out: &mut Crossings);
 }
 

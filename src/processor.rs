@@ -135,7 +135,9 @@ pub enum Status {
     /// boundary (or frame 2 has no boundary with this index).
     #[default]
     NoIntersection,
-    /// More than [`MAX_CROSSINGS`] intersections: the boundary runs along the
+    /// More than [`MAX_CROSSINGS`] intersections with the search range, or
+    /// more than [`crate::epipolar::MAX_RAY_CROSSINGS`] with the whole ray
+    /// from the FOE through the point: the boundary runs along the
     /// epipolar line.
     Tangled,
     /// The epipolar line meets the boundary flatter than the minimum angle.
@@ -677,20 +679,26 @@ fn evaluate<S: CrossingSearch>(
     };
     let mut crossings = Crossings::new();
     search.search(&line, b2, &mut crossings);
-    if crossings.len() > MAX_CROSSINGS {
+    if crossings.is_full() {
+        // More than MAX_RAY_CROSSINGS: the boundary runs along the ray.
         return flagged(p1, Status::Tangled);
     }
     let mut best: Option<crate::epipolar::Crossing> = None;
-    for x in crossings.iter() {
+    let mut valid = 0;
+    for x in crossings.iter().filter(|x| line.in_search_range(x)) {
+        valid += 1;
         best = match best {
             Some(b) if (b.tau, b.segment) <= (x.tau, x.segment) => Some(b),
             _ => Some(*x),
         };
     }
+    if valid > MAX_CROSSINGS {
+        return flagged(p1, Status::Tangled);
+    }
     let Some(best) = best else {
         return flagged(p1, Status::NoIntersection);
     };
-    let status = if crossings.len() > 1 {
+    let status = if valid > 1 {
         Status::Ambiguous
     } else {
         Status::Ok

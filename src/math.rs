@@ -16,8 +16,11 @@
 /// both compute the same bits.
 #[inline]
 pub(crate) fn sqrt(x: f32) -> f32 {
-    if !(x > 0.0) || x == f32::INFINITY {
-        return if x == f32::INFINITY { x } else { 0.0 };
+    if x.is_nan() || x <= 0.0 {
+        return 0.0;
+    }
+    if x == f32::INFINITY {
+        return x;
     }
     let mut y = micromath::F32(x).sqrt().0;
     y = 0.5 * (y + x / y);

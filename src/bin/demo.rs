@@ -107,11 +107,7 @@ fn main() -> ! {
             }
         }
     }
-    let per_point = if total_points > 0 {
-        (total_instr / total_points) as u32
-    } else {
-        0
-    };
+    let per_point = total_instr.checked_div(total_points).unwrap_or(0) as u32;
     defmt::info!(
         "done frames={=u32} points={=u64} instr={=u64} per_point={=u32} worst_frame={=u32}",
         drive.frames,

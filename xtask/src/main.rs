@@ -85,14 +85,14 @@ fn ci() -> Result<(), String> {
     let r = root();
     let h = r.join("host_tests");
     setup_toolchain()?;
-    run(&r, "cargo", &["fmt", "--check"])?;
-    run(&h, "cargo", &["fmt", "--check"])?;
-    run(&r.join("xtask"), "cargo", &["fmt", "--check"])?;
+    let cargo = |dir: &Path, args: &[&str]| run(dir, "cargo", args);
+    cargo(&r, &["fmt", "--check"])?;
+    cargo(&h, &["fmt", "--check"])?;
+    cargo(&r.join("xtask"), &["fmt", "--check"])?;
     // The library for the vehicle controller, without and with defmt.
-    run(&r, "cargo", &["build", "--release", "--target", THUMB])?;
-    run(
+    cargo(&r, &["build", "--release", "--target", THUMB])?;
+    cargo(
         &r,
-        "cargo",
         &[
             "build",
             "--release",
@@ -102,14 +102,9 @@ fn ci() -> Result<(), String> {
             "defmt",
         ],
     )?;
-    run(
+    cargo(&r, &["clippy", "--target", THUMB, "--", "-D", "warnings"])?;
+    cargo(
         &r,
-        "cargo",
-        &["clippy", "--target", THUMB, "--", "-D", "warnings"],
-    )?;
-    run(
-        &r,
-        "cargo",
         &[
             "clippy",
             "--target",
@@ -121,9 +116,8 @@ fn ci() -> Result<(), String> {
             "warnings",
         ],
     )?;
-    run(
+    cargo(
         &r,
-        "cargo",
         &[
             "clippy",
             "--target",
@@ -134,12 +128,28 @@ fn ci() -> Result<(), String> {
             "warnings",
         ],
     )?;
-    run(
-        &h,
-        "cargo",
-        &["clippy", "--all-targets", "--", "-D", "warnings"],
+    cargo(&h, &["clippy", "--all-targets", "--", "-D", "warnings"])?;
+    cargo(
+        &r,
+        &[
+            "clippy",
+            "--release",
+            "--target",
+            THUMB,
+            "--features",
+            "firmware",
+            "--bins",
+            "--",
+            "-D",
+            "warnings",
+        ],
     )?;
-    test()
+    // The README's test command.
+    test()?;
+    // The firmware on the emulated controller: the demo, compared frame by
+    // frame with the host build, then the benchmark, budgets and proofs.
+    demo(true)?;
+    bench(&bench_args(&[])?)
 }
 
 fn have(program: &str, arg: &str) -> bool {

@@ -12,7 +12,8 @@
 //! conventions), [`boundary`] (validated polylines and frames),
 //! [`epipolar`] (rotation compensation, FOE, epipolar search, Sec. 2),
 //! [`depth`] (triangulation, eq. 2.3, and the stick, Sec. 4.1), and
-//! [`processor`] (the per-frame driver and its output).
+//! [`processor`] (the per-frame driver and its output), and
+//! [`calibration`] (intrinsics from foci of expansion, Appendix II B).
 //!
 //! See the README for the coordinate conventions and a worked example.
 #![no_std]
@@ -27,6 +28,7 @@
 #![cfg_attr(test, allow(clippy::unwrap_used, clippy::indexing_slicing))]
 
 pub mod boundary;
+pub mod calibration;
 pub mod camera;
 pub mod depth;
 pub mod epipolar;

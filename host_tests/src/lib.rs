@@ -2,6 +2,7 @@
 //! (independent `f64` geometry), scenario sets, a brute-force crossing
 //! search, and helpers shared by the tests and the host tools.
 
+pub mod calib;
 pub mod drive;
 pub mod jsonl;
 pub mod scenarios;

@@ -1,0 +1,770 @@
+//! Intrinsic calibration from foci of expansion (paper, Appendix II B).
+//!
+//! The camera is moved by known translations without rotation. Each
+//! motion's focus of expansion (FOE) is found from the flow of feature
+//! points ([`focus_of_expansion`]); the FOEs give the image origin, the
+//! aspect ratio, the roll angle and the focal lengths.
+//!
+//! # Model
+//! Translations are given in the robot (arm) frame, `x` right, `y` down,
+//! `z` forward. The camera's axes are those of the robot rolled by `γ` about
+//! the optical axis (`+γ` clockwise seen from behind, as in
+//! [`crate::motion`]): a robot translation `T` is `T_c = R_z(γ)ᵀ T` in camera
+//! coordinates, and its FOE is (eq. A.1, with two focal lengths)
+//!
+//! `FOE = (c_x + f_x T_cx / T_cz, c_y + f_y T_cy / T_cz)`.
+//!
+//! The aspect ratio is `r = f_x / f_y` (the paper's `f_x = r f_y`).
+//!
+//! # Step by step (the paper's procedure)
+//! 1. `c` is the FOE of the straight translation `(0, 0, t)`.
+//! 2. With `d_k = FOE_k − c` for the four diagonal translations
+//!    `(±t, ±t, t)`, `D⁻¹ d_k = R_zᵀ (±1, ±1)` (`D = diag(f_x, f_y)`), so
+//!    adjacent `D⁻¹ d_k` are perpendicular:
+//!    `d_Px d_Qx + r² d_Py d_Qy = 0` (the paper's scalar product, with `y`
+//!    down here); `r²` is the least-squares solution over the four adjacent
+//!    pairs.
+//! 3. `γ` is the mean angle between `(d_kx, r d_ky)` and `(±1, ±1)`.
+//! 4. `|D⁻¹ d_k| = √2` gives `f_y` (mean over the four), `f_x = r f_y`.
+//!
+//! # Jointly (beyond the paper)
+//! [`calibrate_jointly`] fits `c_x, c_y, γ, f_x, f_y` to every flow of every
+//! motion at once: each flow must point away from (or towards) its motion's
+//! predicted FOE. Gauss–Newton on the point-to-line distances (pixels), started from
+//! the step-by-step result, a bounded number of iterations; it reports the
+//! RMS residual and the standard deviation of each parameter.
+
+use core::fmt;
+
+use crate::camera::{Camera, CameraError, Pixel};
+use crate::math::{cross, dot, fmax, sin_cos, sqrt, sub};
+use crate::motion::{Motion, MotionError};
+
+/// One feature point's flow between two frames of a pure translation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Flow {
+    /// Position in the first frame, pixels.
+    pub from: Pixel,
+    /// Position in the second frame, pixels.
+    pub to: Pixel,
+}
+
+/// Why an FOE or a calibration could not be computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum CalibrationError {
+    /// A coordinate or translation is NaN or infinite.
+    NotFinite,
+    /// Fewer than two usable (non-zero) flows, or more than the capacity.
+    TooFewFlows,
+    /// More flows than the estimator's capacity `N`.
+    TooManyFlows,
+    /// The flows are (nearly) parallel: the FOE is at infinity.
+    Parallel,
+    /// A translation has no forward component (`t_z ≤ 0`) or is zero.
+    BadTranslation,
+    /// The FOEs are inconsistent with the model (e.g. `r² ≤ 0`).
+    Degenerate,
+    /// The result is not a valid camera.
+    Camera(CameraError),
+}
+
+impl fmt::Display for CalibrationError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::NotFinite => f.write_str("a coordinate is NaN or infinite"),
+            Self::TooFewFlows => f.write_str("fewer than two usable flows"),
+            Self::TooManyFlows => f.write_str("more flows than the capacity"),
+            Self::Parallel => f.write_str("flows are parallel: FOE at infinity"),
+            Self::BadTranslation => f.write_str("translation without forward component"),
+            Self::Degenerate => f.write_str("FOEs inconsistent with the camera model"),
+            Self::Camera(e) => write!(f, "calibrated camera invalid: {e}"),
+        }
+    }
+}
+
+/// A focus of expansion fitted to flows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FoeFit {
+    /// The FOE, pixels.
+    pub foe: Pixel,
+    /// RMS distance of the FOE from the inlier flow lines, pixels (the
+    /// paper's "variance of the intersections", as a spread).
+    pub rms: f32,
+    /// Flows kept.
+    pub inliers: usize,
+    /// Flows rejected as outliers.
+    pub outliers: usize,
+}
+
+/// Outlier-rejection rounds of [`focus_of_expansion`].
+pub const FOE_ROUNDS: usize = 8;
+
+/// A flow agrees with an FOE when its end point lies within this many
+/// pixels of the line from the FOE through its start (quantisation of both
+/// end points to the pixel grid moves it by up to about one pixel).
+pub const FLOW_TOLERANCE_PX: f32 = 2.0;
+
+/// How far (pixels) the end of flow `f` lies from the line through `foe`
+/// and the start of `f`: the flow's own misalignment, whose noise does not
+/// grow with the distance to the FOE (unlike the FOE's distance from the
+/// flow line).
+fn misalignment(f: &Flow, foe: [f32; 2]) -> f32 {
+    let d = sub(f.to.arr(), f.from.arr());
+    let e = sub(foe, f.from.arr());
+    let le = sqrt(dot(e, e));
+    if le <= 0.0 {
+        return 0.0;
+    }
+    cross(d, e).abs() / le
+}
+
+/// Weighted least-squares FOE: minimises `Σ (d_i × (F − p_i))² / |F₀ − p_i|²`
+/// over the kept flows (the misalignments at the current estimate `F₀`).
+fn refine(flows: &[Flow], keep: &[bool], f0: [f32; 2]) -> Option<[f32; 2]> {
+    let o = f0;
+    let (mut a11, mut a12, mut a22, mut b1, mut b2, mut n) =
+        (0.0f32, 0.0f32, 0.0f32, 0.0f32, 0.0f32, 0usize);
+    for (f, &k) in flows.iter().zip(keep) {
+        if !k {
+            continue;
+        }
+        let d = sub(f.to.arr(), f.from.arr());
+        let e = sub(o, f.from.arr());
+        let w2 = dot(e, e);
+        if w2 <= 0.0 || dot(d, d) <= 0.0 {
+            continue;
+        }
+        // Residual cross(d, F − p) = nrm · (F − o) + cross(d, o − p), nrm = (−d_y, d_x).
+        let w = 1.0 / w2;
+        let nrm = [-d[1], d[0]];
+        let r0 = cross(d, e);
+        a11 += w * nrm[0] * nrm[0];
+        a12 += w * nrm[0] * nrm[1];
+        a22 += w * nrm[1] * nrm[1];
+        b1 -= w * nrm[0] * r0;
+        b2 -= w * nrm[1] * r0;
+        n += 1;
+    }
+    let det = a11 * a22 - a12 * a12;
+    let tr = a11 + a22;
+    if n < 2 || det.is_nan() || det <= 1.0e-7 * tr * tr {
+        return None;
+    }
+    let x = (a22 * b1 - a12 * b2) / det;
+    let y = (a11 * b2 - a12 * b1) / det;
+    let f = [o[0] + x, o[1] + y];
+    (f[0].is_finite() && f[1].is_finite()).then_some(f)
+}
+
+/// Intersection of the lines of flows `a` and `b`, if not near-parallel.
+fn pair(a: &Flow, b: &Flow) -> Option<[f32; 2]> {
+    let (da, db) = (sub(a.to.arr(), a.from.arr()), sub(b.to.arr(), b.from.arr()));
+    let den = cross(da, db);
+    let scale = sqrt(dot(da, da) * dot(db, db));
+    if den.abs() <= 1.0e-3 * scale {
+        return None;
+    }
+    let t = cross(sub(b.from.arr(), a.from.arr()), db) / den;
+    let p = [a.from.u + t * da[0], a.from.v + t * da[1]];
+    (p[0].is_finite() && p[1].is_finite()).then_some(p)
+}
+
+/// The focus of expansion of one pure translation from the flows of its
+/// feature points, robust to wrong matches:
+///
+/// 1. candidates: the intersections of flow `i` with flow `i + n/2` and
+///    `i + n/3`; the candidate with which most flows agree (their end
+///    lies within [`FLOW_TOLERANCE_PX`] of the line from the candidate
+///    through their start) is the start;
+/// 2. up to [`FOE_ROUNDS`] rounds: keep the flows whose misalignment is at
+///    most `max(3 × median, FLOW_TOLERANCE_PX)`, and re-fit by weighted
+///    least squares on the misalignments.
+///
+/// Zero-length flows are ignored. `N` is the capacity. Work `O(n²)` for
+/// `n ≤ N` flows (a calibration, not a per-frame task).
+///
+/// ```
+/// use roadstereo::calibration::{focus_of_expansion, Flow};
+/// use roadstereo::Pixel;
+/// // Points moving away from (300, 200).
+/// let flows: Vec<Flow> = [(100.0, 100.0), (400.0, 50.0), (350.0, 400.0), (50.0, 300.0)]
+///     .iter()
+///     .map(|&(u, v)| Flow {
+///         from: Pixel::new(u, v),
+///         to: Pixel::new(300.0 + 1.2 * (u - 300.0), 200.0 + 1.2 * (v - 200.0)),
+///     })
+///     .collect();
+/// let fit = focus_of_expansion::<64>(&flows).unwrap();
+/// assert!((fit.foe.u - 300.0).abs() < 0.01 && (fit.foe.v - 200.0).abs() < 0.01);
+/// ```
+pub fn focus_of_expansion<const N: usize>(flows: &[Flow]) -> Result<FoeFit, CalibrationError> {
+    if flows.len() > N {
+        return Err(CalibrationError::TooManyFlows);
+    }
+    if flows.iter().any(|f| {
+        !(f.from.u.is_finite() && f.from.v.is_finite() && f.to.u.is_finite() && f.to.v.is_finite())
+    }) {
+        return Err(CalibrationError::NotFinite);
+    }
+    let mut keep = [false; N];
+    let mut usable = 0;
+    for (k, f) in keep.iter_mut().zip(flows) {
+        *k = f.from != f.to;
+        usable += usize::from(*k);
+    }
+    if usable < 2 {
+        return Err(CalibrationError::TooFewFlows);
+    }
+    let usable_mask = keep;
+    // 1. The best-supported pairwise intersection.
+    let n = flows.len();
+    let mut best: Option<([f32; 2], usize)> = None;
+    for step in [n / 2, n / 3] {
+        for (i, a) in flows.iter().enumerate() {
+            let Some(b) = flows.get((i + step.max(1)) % n) else {
+                continue;
+            };
+            if a.from == a.to || b.from == b.to {
+                continue;
+            }
+            let Some(p) = pair(a, b) else {
+                continue;
+            };
+            let support = flows
+                .iter()
+                .zip(usable_mask.iter())
+                .filter(|(f, &k)| k && misalignment(f, p) <= FLOW_TOLERANCE_PX)
+                .count();
+            if best.is_none_or(|(_, s)| support > s) {
+                best = Some((p, support));
+            }
+        }
+    }
+    let Some((mut foe, _)) = best else {
+        return Err(CalibrationError::Parallel);
+    };
+    // 2. Reject and re-fit.
+    let mut dist = [0.0f32; N];
+    for _ in 0..FOE_ROUNDS {
+        let mut m = 0usize;
+        for (((d, k), f), &u) in dist
+            .iter_mut()
+            .zip(keep.iter_mut())
+            .zip(flows)
+            .zip(usable_mask.iter())
+        {
+            *k = u;
+            if u {
+                *d = misalignment(f, foe);
+                m += 1;
+            }
+        }
+        // The median over the agreeing flows sets the scale of the noise.
+        let mut agree = [false; N];
+        for ((a, &d), &u) in agree.iter_mut().zip(dist.iter()).zip(usable_mask.iter()) {
+            *a = u && d <= 3.0 * FLOW_TOLERANCE_PX;
+        }
+        let ma = agree.iter().filter(|&&a| a).count();
+        let median = if ma > 0 {
+            median_of_kept(&dist, &agree, ma)
+        } else {
+            median_of_kept(&dist, &keep, m)
+        };
+        let limit = fmax(3.0 * median, FLOW_TOLERANCE_PX);
+        for (k, &d) in keep.iter_mut().zip(dist.iter()) {
+            if *k && d > limit {
+                *k = false;
+            }
+        }
+        let Some(next) = refine(flows, &keep, foe) else {
+            return Err(CalibrationError::Parallel);
+        };
+        let moved = fmax((next[0] - foe[0]).abs(), (next[1] - foe[1]).abs());
+        foe = next;
+        if moved < 1.0e-3 {
+            break;
+        }
+    }
+    let mut ss = 0.0f32;
+    let mut inliers = 0usize;
+    for (f, &k) in flows.iter().zip(keep.iter()) {
+        if k {
+            let d = distance(f, foe);
+            ss += d * d;
+            inliers += 1;
+        }
+    }
+    if inliers < 2 {
+        return Err(CalibrationError::TooFewFlows);
+    }
+    Ok(FoeFit {
+        foe: Pixel::new(foe[0], foe[1]),
+        rms: sqrt(ss / inliers as f32),
+        inliers,
+        outliers: usable - inliers,
+    })
+}
+
+/// Distance of `p` from the line of flow `f`, pixels.
+fn distance(f: &Flow, p: [f32; 2]) -> f32 {
+    let d = sub(f.to.arr(), f.from.arr());
+    let l2 = dot(d, d);
+    if l2 <= 0.0 {
+        return f32::INFINITY;
+    }
+    cross(d, sub(p, f.from.arr())).abs() / sqrt(l2)
+}
+
+/// The median of the kept entries (the lower one for an even count), by
+/// counting: `O(n²)` for the `n ≤ N` flows of one calibration motion.
+fn median_of_kept(v: &[f32], keep: &[bool], m: usize) -> f32 {
+    let want = m.saturating_sub(1) / 2;
+    for (x, &k) in v.iter().zip(keep) {
+        if !k {
+            continue;
+        }
+        let (mut below, mut equal) = (0usize, 0usize);
+        for (y, &ky) in v.iter().zip(keep) {
+            if ky {
+                if y < x {
+                    below += 1;
+                } else if y == x {
+                    equal += 1;
+                }
+            }
+        }
+        if below <= want && want < below + equal {
+            return *x;
+        }
+    }
+    0.0
+}
+
+/// Intrinsic parameters recovered by a calibration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Intrinsics {
+    /// Image origin (principal point), pixels.
+    pub cx: f32,
+    /// Image origin row, pixels.
+    pub cy: f32,
+    /// Roll of the camera axes about the optical axis relative to the robot
+    /// axes, radians (`+` clockwise seen from behind).
+    pub roll: f32,
+    /// Horizontal focal length, pixels.
+    pub fx: f32,
+    /// Vertical focal length, pixels.
+    pub fy: f32,
+}
+
+impl Intrinsics {
+    /// Aspect ratio `r = f_x / f_y`.
+    pub fn aspect(&self) -> f32 {
+        if self.fy > 0.0 {
+            self.fx / self.fy
+        } else {
+            0.0
+        }
+    }
+
+    /// The FOE this camera predicts for robot translation `t` (`t_z > 0`).
+    pub fn predicted_foe(&self, t: [f32; 3]) -> Option<Pixel> {
+        let (s, c) = sin_cos(self.roll);
+        // R_z(γ)ᵀ (x, y): rotate the robot translation into camera axes.
+        let (x, y) = (c * t[0] + s * t[1], -s * t[0] + c * t[1]);
+        (t[2] > 0.0).then(|| Pixel::new(self.cx + self.fx * x / t[2], self.cy + self.fy * y / t[2]))
+    }
+
+    /// The camera model of the pipeline for an image of `width × height`.
+    pub fn camera(&self, width: u16, height: u16) -> Result<Camera, CalibrationError> {
+        Camera::new(self.fx, self.fy, self.cx, self.cy, width, height)
+            .map_err(CalibrationError::Camera)
+    }
+
+    /// A robot-frame motion (translation and rotation in the robot's axes,
+    /// the conventions of [`crate::motion`]) expressed in the rolled camera
+    /// axes, as the pipeline wants it: `T_c = R_zᵀ T`, `R_c = R_zᵀ R R_z`.
+    pub fn camera_motion(&self, robot: &Motion) -> Result<Motion, MotionError> {
+        let (s, c) = sin_cos(self.roll);
+        let rz = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+        let rzt = crate::math::mat3_transpose(&rz);
+        let t = crate::math::mat3_vec(&rzt, robot.translation());
+        let r = crate::math::mat3_mul(&rzt, &crate::math::mat3_mul(&robot.rotation_matrix(), &rz));
+        // Angles of R = R_y(β) R_x(α) R_z(γ): α = asin(−r12), β = atan2(r02, r22),
+        // γ = atan2(r10, r11).
+        let [[_, _, r02], [r10, r11, r12], [_, _, r22]] = r;
+        let alpha = libm_free::asin(-r12);
+        let beta = libm_free::atan2(r02, r22);
+        let gamma = libm_free::atan2(r10, r11);
+        Motion::new(t, [alpha, beta, gamma])
+    }
+}
+
+/// Small `asin`/`atan2` for the per-calibration conversion (not a hot path).
+mod libm_free {
+    /// `atan(x)` for `|x| ≤ 1`: odd minimax-free series with range halving.
+    fn atan_unit(x: f32) -> f32 {
+        // atan(x) = 2 atan(x / (1 + sqrt(1 + x²))): brings |x| ≤ 0.42.
+        let y = x / (1.0 + crate::math::sqrt(1.0 + x * x));
+        let y2 = y * y;
+        let mut term = y;
+        let mut sum = y;
+        let mut k = 1.0f32;
+        for _ in 0..12 {
+            term *= -y2;
+            k += 2.0;
+            sum += term / k;
+        }
+        2.0 * sum
+    }
+
+    pub(super) fn atan2(y: f32, x: f32) -> f32 {
+        use core::f32::consts::{FRAC_PI_2, PI};
+        if x == 0.0 && y == 0.0 {
+            return 0.0;
+        }
+        if x.abs() >= y.abs() {
+            let a = atan_unit(y / x);
+            if x > 0.0 {
+                a
+            } else if y >= 0.0 {
+                a + PI
+            } else {
+                a - PI
+            }
+        } else {
+            let a = atan_unit(x / y);
+            if y > 0.0 {
+                FRAC_PI_2 - a
+            } else {
+                -FRAC_PI_2 - a
+            }
+        }
+    }
+
+    pub(super) fn asin(x: f32) -> f32 {
+        let x = x.clamp(-1.0, 1.0);
+        atan2(x, crate::math::sqrt(1.0 - x * x))
+    }
+}
+
+/// The paper's step-by-step procedure (Appendix II B (a), (b)).
+///
+/// `straight`: FOE of the translation `(0, 0, t)`; `diagonal`: FOEs of the
+/// translations `(+t, +t, t)`, `(−t, +t, t)`, `(−t, −t, t)`, `(+t, −t, t)`
+/// (in that order: round the image, so neighbours are adjacent).
+pub fn calibrate_stepwise(
+    straight: Pixel,
+    diagonal: [Pixel; 4],
+) -> Result<Intrinsics, CalibrationError> {
+    let c = straight.arr();
+    if !(c[0].is_finite() && c[1].is_finite())
+        || diagonal
+            .iter()
+            .any(|p| !(p.u.is_finite() && p.v.is_finite()))
+    {
+        return Err(CalibrationError::NotFinite);
+    }
+    let d = diagonal.map(|p| sub(p.arr(), c));
+    // r² from the four adjacent pairs: a + r² b = 0 in least squares.
+    let (mut ab, mut bb) = (0.0f32, 0.0f32);
+    for k in 0..4 {
+        let (p, q) = (
+            d.get(k).copied().unwrap_or_default(),
+            d.get((k + 1) % 4).copied().unwrap_or_default(),
+        );
+        let (a, b) = (p[0] * q[0], p[1] * q[1]);
+        ab += a * b;
+        bb += b * b;
+    }
+    if bb.is_nan() || bb <= 0.0 {
+        return Err(CalibrationError::Degenerate);
+    }
+    let r2 = -ab / bb;
+    if !r2.is_finite() || r2 <= 0.0 {
+        return Err(CalibrationError::Degenerate);
+    }
+    let r = sqrt(r2);
+    let signs = [[1.0f32, 1.0], [-1.0, 1.0], [-1.0, -1.0], [1.0, -1.0]];
+    // Roll: e_k = (d_x, r d_y) ∝ R_zᵀ s_k, i.e. e_k is s_k turned by −γ.
+    let (mut sin_sum, mut cos_sum, mut fy_sum) = (0.0f32, 0.0f32, 0.0f32);
+    for (dk, s) in d.iter().zip(signs.iter()) {
+        let e = [dk[0], r * dk[1]];
+        // angle(e) − angle(s) = −γ: accumulate the unit rotation s → e.
+        let le = sqrt(dot(e, e));
+        if le.is_nan() || le <= 0.0 {
+            return Err(CalibrationError::Degenerate);
+        }
+        let ls = core::f32::consts::SQRT_2;
+        cos_sum += dot(*s, e) / (le * ls);
+        sin_sum += cross(*s, e) / (le * ls);
+        // |D⁻¹ d| = √2 with D = f_y diag(r, 1): f_y = |(d_x / r, d_y)| / √2.
+        fy_sum += sqrt(dk[0] * dk[0] / r2 + dk[1] * dk[1]) / ls;
+    }
+    let roll = -libm_free::atan2(sin_sum, cos_sum);
+    let fy = fy_sum / 4.0;
+    Ok(Intrinsics {
+        cx: c[0],
+        cy: c[1],
+        roll,
+        fx: r * fy,
+        fy,
+    })
+}
+
+/// The flows of one calibration motion and its robot translation.
+#[derive(Debug, Clone, Copy)]
+pub struct MotionFlows<'a> {
+    /// Robot translation `(t_x, t_y, t_z)`, `t_z > 0`.
+    pub translation: [f32; 3],
+    /// The flows observed for it.
+    pub flows: &'a [Flow],
+}
+
+/// Quality figures of a joint calibration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct JointFit {
+    /// The parameters.
+    pub intrinsics: Intrinsics,
+    /// RMS misalignment of the inlier flows, pixels.
+    pub rms: f32,
+    /// Standard deviations of `c_x, c_y` (px), `γ` (rad), `f_x, f_y` (px).
+    pub sigma: [f32; 5],
+    /// Flows used (inliers of the per-motion FOE fits).
+    pub flows: usize,
+    /// Gauss–Newton iterations run.
+    pub iterations: usize,
+}
+
+/// Gauss–Newton iterations of [`calibrate_jointly`] at most.
+pub const JOINT_ITERATIONS: usize = 10;
+
+/// Joint calibration from every flow of every motion (see the module docs),
+/// started from `start`: minimises the misalignments of all flows (the
+/// distance of each flow's end from the line from its motion's predicted
+/// FOE through its start). A flow is used when its misalignment is at most
+/// `max(3 × median, FLOW_TOLERANCE_PX)` (the rule of
+/// [`focus_of_expansion`]), re-decided at each iteration. `N`: capacity per
+/// motion.
+pub fn calibrate_jointly<const N: usize>(
+    motions: &[MotionFlows<'_>],
+    start: &Intrinsics,
+) -> Result<JointFit, CalibrationError> {
+    if motions.iter().any(|m| {
+        m.translation[2].is_nan()
+            || m.translation[2] <= 0.0
+            || m.translation.iter().any(|x| !x.is_finite())
+    }) {
+        return Err(CalibrationError::BadTranslation);
+    }
+    if motions.iter().any(|m| m.flows.len() > N) {
+        return Err(CalibrationError::TooManyFlows);
+    }
+    // Parameters scaled to similar sizes: c (px), roll (mrad), f (px).
+    let mut p = [start.cx, start.cy, start.roll * 1000.0, start.fx, start.fy];
+    let model = |p: &[f32; 5]| Intrinsics {
+        cx: p[0],
+        cy: p[1],
+        roll: p[2] * 0.001,
+        fx: p[3],
+        fy: p[4],
+    };
+    // Inlier masks from the start model, per motion.
+    let keep_for = |m: &MotionFlows<'_>, k: &Intrinsics, keep: &mut [bool; N]| -> usize {
+        let Some(foe) = k.predicted_foe(m.translation) else {
+            return 0;
+        };
+        let mut dist = [0.0f32; N];
+        let mut n = 0;
+        for ((d, kk), f) in dist.iter_mut().zip(keep.iter_mut()).zip(m.flows) {
+            *kk = f.from != f.to && f.from.u.is_finite() && f.to.u.is_finite();
+            if *kk {
+                *d = misalignment(f, foe.arr());
+                n += 1;
+            }
+        }
+        let med = median_of_kept(&dist, keep, n);
+        let limit = fmax(3.0 * med, FLOW_TOLERANCE_PX);
+        let mut left = 0;
+        for (kk, &d) in keep.iter_mut().zip(dist.iter()) {
+            if *kk && d > limit {
+                *kk = false;
+            }
+            left += usize::from(*kk);
+        }
+        left
+    };
+    let mut iterations = 0;
+    let mut rms = 0.0f32;
+    let mut normal = [[0.0f32; 5]; 5];
+    let mut used = 0usize;
+    let mut converged = false;
+    for it in 0..=JOINT_ITERATIONS {
+        let k = model(&p);
+        let (s, c) = sin_cos(k.roll);
+        let mut jtj = [[0.0f32; 5]; 5];
+        let mut jtr = [0.0f32; 5];
+        let (mut ss, mut n) = (0.0f32, 0usize);
+        for m in motions {
+            let mut keep = [false; N];
+            if keep_for(m, &start_or(&k, start, it), &mut keep) < 2 {
+                continue;
+            }
+            let t = m.translation;
+            let (x, y) = ((c * t[0] + s * t[1]) / t[2], (-s * t[0] + c * t[1]) / t[2]);
+            // d/dγ of R_zᵀ (t_x, t_y) / t_z.
+            let (dx, dy) = ((-s * t[0] + c * t[1]) / t[2], (-c * t[0] - s * t[1]) / t[2]);
+            let foe = [k.cx + k.fx * x, k.cy + k.fy * y];
+            // dF/dp for p = (cx, cy, roll_mrad, fx, fy).
+            let dfdp = [
+                [1.0, 0.0],
+                [0.0, 1.0],
+                [k.fx * dx * 0.001, k.fy * dy * 0.001],
+                [x, 0.0],
+                [0.0, y],
+            ];
+            for (f, &kk) in m.flows.iter().zip(keep.iter()) {
+                if !kk {
+                    continue;
+                }
+                // Misalignment of the flow end from the line FOE → start:
+                // res = (d × e) / |e| with e = FOE − start.
+                let d = sub(f.to.arr(), f.from.arr());
+                let e = sub(foe, f.from.arr());
+                let le2 = dot(e, e);
+                if le2.is_nan() || le2 <= 0.0 {
+                    continue;
+                }
+                let le = sqrt(le2);
+                let cr = cross(d, e);
+                let res = cr / le;
+                // ∂res/∂F = n/|e| − (d × e) e/|e|³, n = (−d_y, d_x).
+                let g = [
+                    -d[1] / le - cr * e[0] / (le2 * le),
+                    d[0] / le - cr * e[1] / (le2 * le),
+                ];
+                let j = dfdp.map(|h| dot(g, h));
+                for (row, &ja) in jtj.iter_mut().zip(j.iter()) {
+                    for (cell, &jb) in row.iter_mut().zip(j.iter()) {
+                        *cell += ja * jb;
+                    }
+                }
+                for (g, &ja) in jtr.iter_mut().zip(j.iter()) {
+                    *g += ja * res;
+                }
+                ss += res * res;
+                n += 1;
+            }
+        }
+        if n < 6 {
+            return Err(CalibrationError::TooFewFlows);
+        }
+        rms = sqrt(ss / n as f32);
+        normal = jtj;
+        used = n;
+        if it == JOINT_ITERATIONS || converged {
+            break;
+        }
+        let Some(step) = solve5(jtj, jtr) else {
+            return Err(CalibrationError::Degenerate);
+        };
+        let mut big = false;
+        for (pi, si) in p.iter_mut().zip(step.iter()) {
+            *pi -= si;
+            big |= si.abs() > 1.0e-4 * fmax(pi.abs(), 1.0);
+        }
+        iterations = it + 1;
+        if p.iter().any(|x| !x.is_finite()) {
+            return Err(CalibrationError::Degenerate);
+        }
+        // Converged: one more pass computes the residuals at the result.
+        converged = !big;
+    }
+    let dof = used.saturating_sub(5).max(1) as f32;
+    let var = rms * rms * used as f32 / dof;
+    let inv_diag = inverse_diagonal5(normal).unwrap_or([f32::INFINITY; 5]);
+    let scale = [1.0, 1.0, 0.001, 1.0, 1.0];
+    let mut sigma = [0.0f32; 5];
+    for ((sg, id), sc) in sigma.iter_mut().zip(inv_diag.iter()).zip(scale.iter()) {
+        *sg = sqrt(fmax(id * var, 0.0)) * sc;
+    }
+    Ok(JointFit {
+        intrinsics: model(&p),
+        rms,
+        sigma,
+        flows: used,
+        iterations,
+    })
+}
+
+/// The inlier masks come from the start model on the first iteration and
+/// from the current one afterwards.
+fn start_or(current: &Intrinsics, start: &Intrinsics, iteration: usize) -> Intrinsics {
+    if iteration == 0 {
+        *start
+    } else {
+        *current
+    }
+}
+
+/// Solve the 5×5 symmetric positive definite system `a x = b` (Cholesky).
+fn solve5(a: [[f32; 5]; 5], b: [f32; 5]) -> Option<[f32; 5]> {
+    let l = cholesky5(a)?;
+    // Forward: L y = b.
+    let mut y = [0.0f32; 5];
+    for i in 0..5 {
+        let row = l.get(i)?;
+        let mut s = *b.get(i)?;
+        for (k, yk) in y.iter().enumerate().take(i) {
+            s -= row.get(k)? * yk;
+        }
+        *y.get_mut(i)? = s / row.get(i)?;
+    }
+    // Backward: Lᵀ x = y.
+    let mut x = [0.0f32; 5];
+    for i in (0..5).rev() {
+        let mut s = *y.get(i)?;
+        for k in i + 1..5 {
+            s -= l.get(k)?.get(i)? * x.get(k)?;
+        }
+        *x.get_mut(i)? = s / l.get(i)?.get(i)?;
+    }
+    Some(x)
+}
+
+fn cholesky5(a: [[f32; 5]; 5]) -> Option<[[f32; 5]; 5]> {
+    let mut l = [[0.0f32; 5]; 5];
+    for i in 0..5 {
+        for j in 0..=i {
+            let mut s = *a.get(i)?.get(j)?;
+            for k in 0..j {
+                s -= l.get(i)?.get(k)? * l.get(j)?.get(k)?;
+            }
+            if i == j {
+                if s.is_nan() || s <= 0.0 {
+                    return None;
+                }
+                *l.get_mut(i)?.get_mut(j)? = sqrt(s);
+            } else {
+                let d = *l.get(j)?.get(j)?;
+                *l.get_mut(i)?.get_mut(j)? = s / d;
+            }
+        }
+    }
+    Some(l)
+}
+
+/// Diagonal of the inverse of a 5×5 SPD matrix (for standard deviations).
+fn inverse_diagonal5(a: [[f32; 5]; 5]) -> Option<[f32; 5]> {
+    let mut out = [0.0f32; 5];
+    for (i, o) in out.iter_mut().enumerate() {
+        let mut e = [0.0f32; 5];
+        *e.get_mut(i)? = 1.0;
+        *o = *solve5(a, e)?.get(i)?;
+    }
+    Some(out)
+}

@@ -276,3 +276,78 @@ fn calibration_converts_into_the_pipeline_camera() {
         );
     }
 }
+
+/// End to end: a camera with the paper's roll and aspect ratio watches a
+/// curved ground line while the robot drives forward; the pipeline, fed
+/// with the *calibrated* camera and the robot motion converted to camera
+/// axes, recovers the depths.
+#[test]
+fn calibrated_camera_feeds_the_pipeline() {
+    use roadstereo::{Config, Frame, Motion, Processor, Status, Step};
+    let cam = TrueCamera::default();
+    let (_, k) = run(&cam, &paper_motions(), 50, 0.0, 3).expect("calibrates");
+    let camera = k.camera(512, 480).expect("camera");
+    // A ground line curving right, 1 unit below the camera, robot frame.
+    let curve: Vec<[f64; 3]> = (0..4000)
+        .map(|i| {
+            let s = i as f64 * 0.005;
+            [-0.8 + 0.02 * s * s, 1.0, 2.0 + s]
+        })
+        .collect();
+    let robot_t = [-0.1, 0.0, 0.5];
+    // One point per image row, sub-pixel, with the true 3-D point's depth.
+    let detect = |shift: [f64; 3]| -> Vec<(Pixel, f64)> {
+        let proj: Vec<Option<[f64; 2]>> = curve
+            .iter()
+            .map(|p| cam.project([p[0] - shift[0], p[1] - shift[1], p[2] - shift[2]]))
+            .collect();
+        let mut out: Vec<(Pixel, f64)> = Vec::new();
+        for (i, w) in proj.windows(2).enumerate() {
+            let (Some(a), Some(b)) = (w[0], w[1]) else {
+                continue;
+            };
+            let mut r = a[1].floor();
+            while r > b[1] {
+                let t = (a[1] - r) / (a[1] - b[1]);
+                let u = a[0] + t * (b[0] - a[0]);
+                let z = curve[i][2] + t * (curve[i + 1][2] - curve[i][2]) - shift[2];
+                if out.last().is_none_or(|(p, _)| f64::from(p.v) > r) {
+                    out.push((Pixel::new(u as f32, r as f32), z));
+                }
+                r -= 1.0;
+            }
+        }
+        out
+    };
+    let (b1, b2) = (detect([0.0; 3]), detect(robot_t));
+    assert!(b1.len() > 100 && b2.len() > 100);
+    let mut f1 = Frame::<512, 2>::new(camera);
+    f1.push_boundary(&b1.iter().map(|x| x.0).collect::<Vec<_>>())
+        .unwrap();
+    let mut f2 = Frame::<512, 2>::new(camera);
+    f2.push_boundary(&b2.iter().map(|x| x.0).collect::<Vec<_>>())
+        .unwrap();
+    let robot = Motion::new(robot_t.map(|x| x as f32), [0.0; 3]).unwrap();
+    let motion = k.camera_motion(&robot).unwrap();
+    let mut p = Box::new(Processor::<512, 2>::new(Config::default()));
+    assert!(matches!(p.process(&f1, None), Ok(Step::First)));
+    let Ok(Step::Structure(s)) = p.process(&f2, Some(&motion)) else {
+        panic!("no structure")
+    };
+    let mut n = 0;
+    let mut worst: f64 = 0.0;
+    for (r, (_, z)) in s.boundaries()[0].points().iter().zip(&b1) {
+        if r.status() == Status::Ok {
+            let e = (f64::from(r.depth().unwrap()) / z - 1.0).abs();
+            worst = worst.max(e);
+            n += 1;
+        }
+    }
+    println!(
+        "calibrated pipeline: {n} depths, worst relative error {:.3} %, statuses {:?}",
+        worst * 100.0,
+        s.status_counts()
+    );
+    assert!(n >= 100, "{n} depths");
+    assert!(worst < 0.02, "worst relative depth error {worst}");
+}

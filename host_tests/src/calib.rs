@@ -4,8 +4,50 @@
 //! pixel grid, optional wrong matches.
 
 use crate::synth::Rng;
-use roadstereo::calibration::Flow;
+use roadstereo::calibration::{
+    calibrate_jointly, calibrate_stepwise, focus_of_expansion, CalibrationError, Flow, Intrinsics,
+    JointFit, MotionFlows,
+};
 use roadstereo::Pixel;
+
+/// Capacity (flows per motion) of the calibration runs.
+pub const CAP: usize = 512;
+
+/// One synthetic calibration run: the flows of each motion (the first five
+/// must be the paper's straight and diagonal ones), the step-by-step
+/// result, and the joint fit started from it.
+pub fn calibrate_run(
+    cam: &TrueCamera,
+    motions: &[[f64; 3]],
+    n: usize,
+    outliers: f64,
+    seed: u64,
+) -> Result<(Vec<Vec<Flow>>, Intrinsics, JointFit), CalibrationError> {
+    let mut rng = Rng(seed);
+    let sets: Vec<Vec<Flow>> = motions
+        .iter()
+        .map(|&t| flows(cam, t, n, outliers, &mut rng))
+        .collect();
+    let foes: Vec<Pixel> = sets
+        .iter()
+        .take(5)
+        .map(|f| focus_of_expansion::<CAP>(f).map(|x| x.foe))
+        .collect::<Result<_, _>>()?;
+    let [straight, p, q, r, s] = foes[..] else {
+        return Err(CalibrationError::TooFewFlows);
+    };
+    let stepwise = calibrate_stepwise(straight, [p, q, r, s])?;
+    let mf: Vec<MotionFlows<'_>> = motions
+        .iter()
+        .zip(&sets)
+        .map(|(t, f)| MotionFlows {
+            translation: t.map(|x| x as f32),
+            flows: f,
+        })
+        .collect();
+    let joint = calibrate_jointly::<CAP>(&mf, &stepwise)?;
+    Ok((sets, stepwise, joint))
+}
 
 /// The true camera (the paper's values: c = (273.59, 233.96), r = 0.787,
 /// γ = −1.26°, f_x = 614.5, f_y = 780.7, 512 × 480).

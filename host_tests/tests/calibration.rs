@@ -1,15 +1,12 @@
 //! Intrinsic calibration from foci of expansion (Appendix II B) against a
 //! synthetic camera with the paper's calibrated values.
 
-use host_tests::calib::{flows, paper_motions, TrueCamera};
-use host_tests::synth::Rng;
+use host_tests::calib::{calibrate_run, paper_motions, TrueCamera};
 use roadstereo::calibration::{
     calibrate_jointly, calibrate_stepwise, focus_of_expansion, CalibrationError, Flow, Intrinsics,
     MotionFlows,
 };
 use roadstereo::Pixel;
-
-const CAP: usize = 512;
 
 struct Errors {
     c: f64,
@@ -51,27 +48,7 @@ fn run(
     outliers: f64,
     seed: u64,
 ) -> Result<(Intrinsics, Intrinsics), CalibrationError> {
-    let mut rng = Rng(seed);
-    let sets: Vec<Vec<Flow>> = motions
-        .iter()
-        .map(|&t| flows(cam, t, n, outliers, &mut rng))
-        .collect();
-    let foes: Vec<Pixel> = sets
-        .iter()
-        .take(5)
-        .map(|f| focus_of_expansion::<CAP>(f).map(|x| x.foe))
-        .collect::<Result<_, _>>()?;
-    let stepwise = calibrate_stepwise(foes[0], [foes[1], foes[2], foes[3], foes[4]])?;
-    let mf: Vec<MotionFlows<'_>> = motions
-        .iter()
-        .zip(&sets)
-        .map(|(t, f)| MotionFlows {
-            translation: t.map(|x| x as f32),
-            flows: f,
-        })
-        .collect();
-    let joint = calibrate_jointly::<CAP>(&mf, &stepwise)?;
-    Ok((stepwise, joint.intrinsics))
+    calibrate_run(cam, motions, n, outliers, seed).map(|(_, s, j)| (s, j.intrinsics))
 }
 
 #[test]

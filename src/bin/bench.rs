@@ -11,7 +11,7 @@ mod fw;
 
 use core::hint::black_box;
 
-use cortex_m_rt::{entry, exception, ExceptionFrame};
+use cortex_m_rt::entry;
 use defmt_semihosting as _;
 use roadstereo::{
     epipolar::IndexedSearch, Config, CrossingSearch, Crossings, Frame, PairGeometry, Processor,
@@ -193,15 +193,4 @@ fn stages(f1: &Frame<CAP, 2>, f2: &Frame<CAP, 2>, m: &roadstereo::Motion) {
         search / pts,
         found
     );
-}
-
-#[exception]
-unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
-    fw::exit(false)
-}
-
-#[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
-    defmt::error!("panic");
-    fw::exit(false)
 }

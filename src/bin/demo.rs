@@ -12,7 +12,7 @@
 
 mod fw;
 
-use cortex_m_rt::{entry, exception, ExceptionFrame};
+use cortex_m_rt::entry;
 use defmt_semihosting as _;
 use roadstereo::{Config, Frame, Processor, Status};
 
@@ -117,15 +117,4 @@ fn main() -> ! {
         worst
     );
     fw::exit(true)
-}
-
-#[exception]
-unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
-    fw::exit(false)
-}
-
-#[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
-    defmt::error!("panic");
-    fw::exit(false)
 }

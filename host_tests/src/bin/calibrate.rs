@@ -4,15 +4,9 @@
 //! analogue of the paper's Fig. A-5/A-6 (flow lines and their FOEs) as SVG:
 //! `calibrate [OUT_DIR]` (default `../docs`).
 
-use host_tests::calib::{flows, paper_motions, TrueCamera};
-use host_tests::synth::Rng;
+use host_tests::calib::{calibrate_run, paper_motions, TrueCamera, CAP};
 use plotters::prelude::*;
-use roadstereo::calibration::{
-    calibrate_jointly, calibrate_stepwise, focus_of_expansion, Flow, Intrinsics, JointFit,
-    MotionFlows,
-};
-
-const CAP: usize = 512;
+use roadstereo::calibration::{focus_of_expansion, Flow, Intrinsics, JointFit};
 
 fn calibrate(
     cam: &TrueCamera,
@@ -21,27 +15,7 @@ fn calibrate(
     outliers: f64,
     seed: u64,
 ) -> (Vec<Vec<Flow>>, Intrinsics, JointFit) {
-    let mut rng = Rng(seed);
-    let sets: Vec<Vec<Flow>> = motions
-        .iter()
-        .map(|&t| flows(cam, t, n, outliers, &mut rng))
-        .collect();
-    let foes: Vec<_> = sets
-        .iter()
-        .take(5)
-        .map(|f| focus_of_expansion::<CAP>(f).expect("FOE").foe)
-        .collect();
-    let s = calibrate_stepwise(foes[0], [foes[1], foes[2], foes[3], foes[4]]).expect("stepwise");
-    let mf: Vec<MotionFlows<'_>> = motions
-        .iter()
-        .zip(&sets)
-        .map(|(t, f)| MotionFlows {
-            translation: t.map(|x| x as f32),
-            flows: f,
-        })
-        .collect();
-    let j = calibrate_jointly::<CAP>(&mf, &s).expect("joint");
-    (sets, s, j)
+    calibrate_run(cam, motions, n, outliers, seed).expect("the synthetic run calibrates")
 }
 
 fn errors(k: &Intrinsics, t: &TrueCamera) -> [f64; 5] {

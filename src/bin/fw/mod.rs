@@ -11,7 +11,7 @@
 use core::sync::atomic::{AtomicU32, Ordering};
 
 use cortex_m::peripheral::{syst::SystClkSource, SYST};
-use cortex_m_rt::exception;
+use cortex_m_rt::{exception, ExceptionFrame};
 use cortex_m_semihosting::debug;
 use roadstereo::{Camera, Frame, Motion, Pixel};
 
@@ -156,4 +156,17 @@ impl Drive {
         }
         Ok(motion)
     }
+}
+
+/// A HardFault ends the run with failure (QEMU's exit code says so).
+#[exception]
+unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
+    exit(false)
+}
+
+/// So does a panic (none can happen in the library: see the `nopanic` proof).
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo) -> ! {
+    defmt::error!("panic");
+    exit(false)
 }

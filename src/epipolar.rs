@@ -30,12 +30,13 @@
 //! outside the image, where it crosses a fixed reference line. A segment of
 //! the frame-2 boundary can only cross the line if the line's key lies
 //! between the keys of the segment's end points. [`IndexedSearch`] keeps the
-//! key range of every subtree of segments in an implicit binary tree built in
-//! one linear pass per boundary, and descends only into subtrees whose range
-//! holds the key. The key test is only a filter (widened by a margin that
-//! covers rounding); the decision whether a segment crosses is always the
-//! exact side test of [`EpipolarLine::crossing`], so any search that offers
-//! every crossing segment gives identical results.
+//! running maximum and minimum of the keys along the boundary, built in one
+//! linear pass, so the segments that can hold a key form one run, found by
+//! probing from the previous point's run (a sweep along the boundary). The
+//! key test is only a filter (widened by a margin that covers rounding); the
+//! decision whether a segment crosses is always the exact side test of
+//! [`EpipolarLine::crossing`], so any search that offers every crossing
+//! segment gives identical results.
 
 use crate::camera::{Camera, Pixel};
 use crate::math::{

@@ -505,7 +505,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
 
 /// The two uses of search scratch in one frame, one after the other: the
 /// fold test over frame 1, then the crossing search over frame 2. With the
-/// built-in index both share one tree (no extra memory).
+/// built-in index both share one index (no extra memory).
 trait Searches<const N: usize> {
     type Crossing: CrossingSearch;
     fn index(&mut self) -> &mut IndexedSearch<N>;

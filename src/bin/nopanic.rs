@@ -1,5 +1,6 @@
-//! Link-time proof that the per-frame code has no panic path: this binary
-//! calls every public per-frame entry point with inputs the optimiser
+//! Link-time proof that the per-frame code (and the calibration) has no
+//! panic path: this binary calls every public per-frame entry point and the
+//! calibration functions with inputs the optimiser
 //! cannot see (`black_box`), and uses `panic-never`, whose panic handler
 //! does not link. `cargo build --release --features firmware --bin nopanic`
 //! succeeds only if no panicking branch survives in that code.
@@ -11,6 +12,9 @@ use core::hint::black_box;
 
 use cortex_m_rt::entry;
 use panic_never as _;
+use roadstereo::calibration::{
+    calibrate_jointly, calibrate_stepwise, focus_of_expansion, Flow, MotionFlows,
+};
 use roadstereo::{Camera, Config, Frame, Motion, Pixel, Processor, Step};
 
 const N: usize = 256;
@@ -64,6 +68,27 @@ fn main() -> ! {
         }
         if black_box(false) {
             processor.reset();
+        }
+        // The calibration entry points too.
+        let flows = black_box(
+            [Flow {
+                from: black_box(Pixel::new(1.0, 2.0)),
+                to: black_box(Pixel::new(3.0, 4.0)),
+            }; 64],
+        );
+        let fit = focus_of_expansion::<64>(black_box(&flows));
+        let p = fit.map(|f| f.foe).unwrap_or_default();
+        if let Ok(k) = calibrate_stepwise(black_box(p), black_box([p; 4])) {
+            let m = [MotionFlows {
+                translation: black_box([0.0, 0.0, 1.0]),
+                flows: &flows,
+            }];
+            black_box(calibrate_jointly::<64>(black_box(&m), &k).ok());
+            black_box(k.camera(black_box(512), black_box(480)).ok());
+            if let Some(m) = motion.as_ref() {
+                black_box(k.camera_motion(m).ok());
+            }
+            black_box(k.predicted_foe(black_box([0.0, 0.0, 1.0])));
         }
     }
 }

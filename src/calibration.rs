@@ -396,58 +396,10 @@ impl Intrinsics {
         // Angles of R = R_y(β) R_x(α) R_z(γ): α = asin(−r12), β = atan2(r02, r22),
         // γ = atan2(r10, r11).
         let [[_, _, r02], [r10, r11, r12], [_, _, r22]] = r;
-        let alpha = libm_free::asin(-r12);
-        let beta = libm_free::atan2(r02, r22);
-        let gamma = libm_free::atan2(r10, r11);
+        let alpha = crate::math::asin(-r12);
+        let beta = crate::math::atan2(r02, r22);
+        let gamma = crate::math::atan2(r10, r11);
         Motion::new(t, [alpha, beta, gamma])
-    }
-}
-
-/// Small `asin`/`atan2` for the per-calibration conversion (not a hot path).
-mod libm_free {
-    /// `atan(x)` for `|x| ≤ 1`: odd minimax-free series with range halving.
-    fn atan_unit(x: f32) -> f32 {
-        // atan(x) = 2 atan(x / (1 + sqrt(1 + x²))): brings |x| ≤ 0.42.
-        let y = x / (1.0 + crate::math::sqrt(1.0 + x * x));
-        let y2 = y * y;
-        let mut term = y;
-        let mut sum = y;
-        let mut k = 1.0f32;
-        for _ in 0..12 {
-            term *= -y2;
-            k += 2.0;
-            sum += term / k;
-        }
-        2.0 * sum
-    }
-
-    pub(super) fn atan2(y: f32, x: f32) -> f32 {
-        use core::f32::consts::{FRAC_PI_2, PI};
-        if x == 0.0 && y == 0.0 {
-            return 0.0;
-        }
-        if x.abs() >= y.abs() {
-            let a = atan_unit(y / x);
-            if x > 0.0 {
-                a
-            } else if y >= 0.0 {
-                a + PI
-            } else {
-                a - PI
-            }
-        } else {
-            let a = atan_unit(x / y);
-            if y > 0.0 {
-                FRAC_PI_2 - a
-            } else {
-                -FRAC_PI_2 - a
-            }
-        }
-    }
-
-    pub(super) fn asin(x: f32) -> f32 {
-        let x = x.clamp(-1.0, 1.0);
-        atan2(x, crate::math::sqrt(1.0 - x * x))
     }
 }
 
@@ -504,7 +456,7 @@ pub fn calibrate_stepwise(
         // |D⁻¹ d| = √2 with D = f_y diag(r, 1): f_y = |(d_x / r, d_y)| / √2.
         fy_sum += sqrt(dk[0] * dk[0] / r2 + dk[1] * dk[1]) / ls;
     }
-    let roll = -libm_free::atan2(sin_sum, cos_sum);
+    let roll = -crate::math::atan2(sin_sum, cos_sum);
     let fy = fy_sum / 4.0;
     Ok(Intrinsics {
         cx: c[0],

@@ -13,7 +13,9 @@
 //! [`epipolar`] (rotation compensation, FOE, epipolar search, Sec. 2),
 //! [`depth`] (triangulation, eq. 2.3, and the stick, Sec. 4.1), and
 //! [`processor`] (the per-frame driver and its output), and
-//! [`calibration`] (intrinsics from foci of expansion, Appendix II B).
+//! [`calibration`] (intrinsics from foci of expansion, Appendix II B), and
+//! [`analysis`] (the disparity analysis of Sec. 3, the tilt transform of
+//! Appendix I).
 //!
 //! See the README for the coordinate conventions and a worked example.
 #![no_std]
@@ -27,6 +29,7 @@
 )]
 #![cfg_attr(test, allow(clippy::unwrap_used, clippy::indexing_slicing))]
 
+pub mod analysis;
 pub mod boundary;
 pub mod calibration;
 pub mod camera;

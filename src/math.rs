@@ -55,6 +55,66 @@ pub(crate) fn sin_cos(x: f32) -> (f32, f32) {
     (s, c)
 }
 
+/// `atan(x)` in single precision (no `libm`: its `f32` functions reduce in
+/// `f64`): range reduction `atan(x) = 2 atan(x / (1 + √(1 + x²)))` to
+/// `|x| ≤ 0.42`, then 13 terms of the series. The test `atan_matches_libm`
+/// pins the error at 5e-7.
+pub(crate) fn atan(x: f32) -> f32 {
+    use core::f32::consts::FRAC_PI_2;
+    if x.abs() > 1.0 {
+        let a = atan_unit(1.0 / x);
+        return if x > 0.0 {
+            FRAC_PI_2 - a
+        } else {
+            -FRAC_PI_2 - a
+        };
+    }
+    atan_unit(x)
+}
+
+fn atan_unit(x: f32) -> f32 {
+    let y = x / (1.0 + sqrt(1.0 + x * x));
+    let y2 = y * y;
+    let (mut term, mut sum, mut k) = (y, y, 1.0f32);
+    for _ in 0..12 {
+        term *= -y2;
+        k += 2.0;
+        sum += term / k;
+    }
+    2.0 * sum
+}
+
+/// `atan2(y, x)` in single precision (0 for the origin).
+pub(crate) fn atan2(y: f32, x: f32) -> f32 {
+    use core::f32::consts::{FRAC_PI_2, PI};
+    if x == 0.0 && y == 0.0 {
+        return 0.0;
+    }
+    if x.abs() >= y.abs() {
+        let a = atan_unit(y / x);
+        if x > 0.0 {
+            a
+        } else if y >= 0.0 {
+            a + PI
+        } else {
+            a - PI
+        }
+    } else {
+        let a = atan_unit(x / y);
+        if y > 0.0 {
+            FRAC_PI_2 - a
+        } else {
+            -FRAC_PI_2 - a
+        }
+    }
+}
+
+/// `asin(x)`, `x` clamped to `[−1, 1]`.
+pub(crate) fn asin(x: f32) -> f32 {
+    let x = x.clamp(-1.0, 1.0);
+    atan2(x, sqrt(1.0 - x * x))
+}
+
 /// `max` by comparison. `f32::max` is a call to `fmaxf` on the Cortex-M4F
 /// (no `VMAXNM` before Armv8); inputs here are never NaN.
 #[inline(always)]
@@ -215,6 +275,24 @@ mod tests {
             let (s, c) = sin_cos(x);
             assert!((s - libm::sinf(x)).abs() <= 3.0e-7, "sin({x})");
             assert!((c - libm::cosf(x)).abs() <= 3.0e-7, "cos({x})");
+        }
+    }
+
+    #[test]
+    fn atan_matches_libm() {
+        for i in -2000..=2000 {
+            let x = i as f32 * 0.01;
+            assert!((atan(x) - libm::atanf(x)).abs() <= 5.0e-7, "atan({x})");
+            for j in [-3.0f32, -0.5, 0.0, 0.7, 2.0] {
+                assert!(
+                    (atan2(x, j) - libm::atan2f(x, j)).abs() <= 1.0e-6,
+                    "atan2({x}, {j})"
+                );
+            }
+        }
+        for i in -100..=100 {
+            let x = i as f32 * 0.01;
+            assert!((asin(x) - libm::asinf(x)).abs() <= 1.0e-6, "asin({x})");
         }
     }
 

@@ -1,0 +1,141 @@
+//! Section 3 analysis and the Appendix I tilt transform, against
+//! independent calculations.
+
+use roadstereo::analysis::{
+    camera_to_vehicle, common_columns_stereo, common_rows_motion, disparity_flat, disparity_tilted,
+    ground_interval, motion_factor, vehicle_to_camera,
+};
+
+/// Eq. 3.2 follows from eq. 2.2 through the tilt transform: for a grid of
+/// tilts, distances and motions, the disparity of a ground point computed
+/// with eq. 2.2 in the camera frame (translation and point transformed by
+/// the library's Appendix I transform) equals eq. 3.2.
+#[test]
+fn eq_3_2_follows_from_eq_2_2_through_the_tilt_transform() {
+    let (f, h) = (800.0f64, 1.0f64);
+    for tilt_deg in [0.0f64, 10.0, 23.0, 35.0] {
+        let tilt = tilt_deg.to_radians() as f32;
+        // The transform agrees with an independent rotation about x.
+        let (s, c) = (tilt_deg.to_radians().sin(), tilt_deg.to_radians().cos());
+        let v = [0.3f32, -0.2, 1.7];
+        let got = vehicle_to_camera(v, tilt);
+        let want = [0.3, c * -0.2 - s * 1.7, s * -0.2 + c * 1.7];
+        for k in 0..3 {
+            assert!((f64::from(got[k]) - want[k]).abs() < 1e-6);
+        }
+        let back = camera_to_vehicle(got, tilt);
+        for k in 0..3 {
+            assert!((back[k] - v[k]).abs() < 1e-6);
+        }
+        for z in [1.5f64, 3.0, 6.0, 12.0] {
+            for w in [0.1f64, 0.2, 0.4] {
+                let p = vehicle_to_camera([0.0, h as f32, z as f32], tilt).map(f64::from);
+                let t = vehicle_to_camera([0.0, 0.0, w as f32], tilt).map(f64::from);
+                // Eq. 2.2, y component, in the camera frame.
+                let dy = -f * t[1] / (p[2] - t[2]) + f * p[1] * t[2] / (p[2] * (p[2] - t[2]));
+                let lib = f64::from(disparity_tilted(
+                    f as f32, h as f32, w as f32, z as f32, tilt,
+                ));
+                assert!(
+                    (dy - lib).abs() <= 1e-4 * dy.abs() + 1e-5,
+                    "θ {tilt_deg}°, Z {z}, W {w}: eq. 2.2 {dy}, eq. 3.2 {lib}"
+                );
+                if tilt_deg == 0.0 {
+                    let flat = f64::from(disparity_flat(f as f32, h as f32, w as f32, z as f32));
+                    assert!((flat - lib).abs() <= 1e-4 * flat);
+                }
+            }
+        }
+    }
+}
+
+/// Eq. 3.4: F → n when w ≪ Z'.
+#[test]
+fn motion_factor_tends_to_n_for_small_motion() {
+    let tilt = 23f32.to_radians();
+    for n in [1.0f32, 2.0, 3.0, 5.0] {
+        let f_small = motion_factor(n, 0.001, 5.0, tilt);
+        assert!((f_small - n).abs() < 1e-2 * n, "F({n}) = {f_small}");
+        // And it is the ratio of disparities (eq. 3.2) it claims to be.
+        let (h, z) = (1.0f32, 4.0f32);
+        let zp = h * tilt.sin() + z * tilt.cos();
+        let ratio =
+            disparity_tilted(800.0, h, n * 0.1, z, tilt) / disparity_tilted(800.0, h, 0.1, z, tilt);
+        assert!((motion_factor(n, 0.1, zp, tilt) - ratio).abs() < 1e-4 * ratio);
+    }
+}
+
+/// Section 3 (b): motion stereo keeps most of its common field as the
+/// motion doubles, ordinary stereo loses much of it as the baseline
+/// doubles. The figures, with the paper's, are printed.
+#[test]
+fn common_field_motion_stereo_vs_ordinary_stereo() {
+    let (h, tilt, f, rows, cols) = (1.0f32, 23f32.to_radians(), 800.0f32, 480.0f32, 512.0f32);
+    let half_fov = (rows / 2.0 / f).atan();
+    let (near, far) = ground_interval(h, tilt, half_fov).expect("ground in view");
+    println!("ground in view: {near:.2} to {far:.2} (paper: 1.4 to 8.7)");
+    // Independent: the lowest ray is tilt + half field below the horizon.
+    assert!((f64::from(near) - 1.0 / (f64::from(tilt + half_fov)).tan()).abs() < 1e-4);
+    let m1 = common_rows_motion(h, tilt, f, rows, 0.1).expect("m1");
+    let m2 = common_rows_motion(h, tilt, f, rows, 0.2).expect("m2");
+    // Ordinary stereo at the depth where a 0.1 baseline keeps 70 %.
+    let z70 = f * 0.1 / (0.3 * cols);
+    let s1 = common_columns_stereo(f, cols, 0.1, z70);
+    let s2 = common_columns_stereo(f, cols, 0.2, z70);
+    println!(
+        "motion stereo, W 0.1 → 0.2: {:.1} % → {:.1} % (paper 95 % → 84 %); \
+         ordinary stereo, U 0.1 → 0.2 at Z = {z70:.2}: {:.1} % → {:.1} % (paper 70 % → 30 %)",
+        m1 * 100.0,
+        m2 * 100.0,
+        s1 * 100.0,
+        s2 * 100.0
+    );
+    // The paper's qualitative finding.
+    assert!(m1 - m2 < 0.10, "motion stereo loses little");
+    assert!(s1 - s2 > 0.25, "ordinary stereo loses much");
+    // Independent check of the motion-stereo rows: the rows lost are those
+    // of the ground strip [near, near + W].
+    let row = |d: f64| 800.0 * ((1.0 / d).atan() - 23f64.to_radians()).tan();
+    let lost = 240.0 - row(f64::from(near) + 0.1);
+    assert!((f64::from(m1) - (1.0 - lost / 480.0)).abs() < 1e-3);
+}
+
+/// Reconstructed points in the vehicle frame: the Fig. 6 scenario's points,
+/// turned from camera to vehicle axes with the known tilt, land on the true
+/// boundary points (relative to the camera), to 0.5 % of their distance.
+#[test]
+fn reconstructed_points_in_the_vehicle_frame() {
+    use host_tests::{point_stats, reconstruct, scenarios};
+    let s = scenarios::named().remove(0);
+    let k = s.intrinsics;
+    let r = s.render();
+    let p = reconstruct(&r, &k, false, roadstereo::Config::default());
+    let st = p.structure();
+    let stats = point_stats(&r, &k, &p);
+    let mut n = 0;
+    for (b, bs) in st.boundaries().iter().enumerate() {
+        for (i, pr) in bs.points().iter().enumerate() {
+            let Some(pc) = st.point(pr) else { continue };
+            if pr.status() != roadstereo::Status::Ok {
+                continue;
+            }
+            let v = camera_to_vehicle(pc, s.tilt as f32);
+            // Truth: the camera-frame truth, rotated by the test's own f64 tilt.
+            let t = r.frame1[b][i].camera;
+            let (sn, cs) = s.tilt.sin_cos();
+            let want = [t[0], cs * t[1] + sn * t[2], -sn * t[1] + cs * t[2]];
+            let dist = want.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let err = (0..3)
+                .map(|a| (f64::from(v[a]) - want[a]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            assert!(err <= 0.005 * dist, "b{b} i{i}: {v:?} vs {want:?}");
+            // On flat ground the vehicle-frame height is the camera height.
+            if want[2] < 4.0 {
+                assert!((f64::from(v[1]) - s.height).abs() < 0.01 * dist);
+            }
+            n += 1;
+        }
+    }
+    assert!(n > 300 && stats.len() > 300);
+}

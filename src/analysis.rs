@@ -1,0 +1,151 @@
+//! Disparity analysis of Section 3 and the tilt transform of Appendix I.
+//!
+//! Conventions as everywhere in the crate (`x` right, `y` **down**, `z`
+//! forward). The *vehicle frame* has its origin at the camera centre, `x`
+//! right, `y` down (perpendicular to the ground plane the vehicle stands
+//! on), `z` forward along the ground; the camera is pitched **down** by the
+//! tilt `θ` about `x`. The paper's Appendix I writes `y` up; with `y` down
+//! its relations read
+//!
+//! `U_c = U_v`,  `V_c = V_v cos θ − W_v sin θ`,  `W_c = V_v sin θ + W_v cos θ`
+//!
+//! (the paper's `V_c = W sin θ + V cos θ`, `W_c = W cos θ − V sin θ` with
+//! its `V` and `V_c` pointing up). A ground point at horizontal distance `Z`
+//! and depth `h` below the camera has camera depth `Z_c = Z cos θ + h sin θ`
+//! and `Y_c = h cos θ − Z sin θ` (the paper's `h_c`, sign for `y` down).
+//!
+//! Substituting these into eq. 2.2 gives eq. 3.2 (see [`disparity_tilted`]);
+//! the host tests check it numerically over a grid of `θ`, `Z`, `W`.
+
+use crate::math::{atan, fmax, sin_cos};
+
+/// Vehicle-frame translation `(U, V, W)` → camera frame, camera pitched
+/// down by `tilt` radians (Appendix I).
+///
+/// ```
+/// use roadstereo::analysis::vehicle_to_camera;
+/// // Driving 1 unit straight ahead with the camera tilted 30° down: in the
+/// // camera's axes the motion goes forward and up (negative y).
+/// let [u, v, w] = vehicle_to_camera([0.0, 0.0, 1.0], 30f32.to_radians());
+/// assert!(u == 0.0 && (v + 0.5).abs() < 1e-6 && (w - 0.866_025_4).abs() < 1e-6);
+/// ```
+pub fn vehicle_to_camera(t: [f32; 3], tilt: f32) -> [f32; 3] {
+    let (s, c) = sin_cos(tilt);
+    [t[0], c * t[1] - s * t[2], s * t[1] + c * t[2]]
+}
+
+/// Camera-frame vector → vehicle frame (inverse of [`vehicle_to_camera`]);
+/// also turns reconstructed points (camera coordinates, e.g.
+/// [`crate::Structure::point`]) into the vehicle frame.
+pub fn camera_to_vehicle(p: [f32; 3], tilt: f32) -> [f32; 3] {
+    let (s, c) = sin_cos(tilt);
+    [p[0], c * p[1] + s * p[2], -s * p[1] + c * p[2]]
+}
+
+/// Eq. 3.1: vertical disparity (pixels) of a ground point at distance `z`
+/// for an untilted camera at height `h` moving forward by `w`
+/// (`U = V = 0`): `d_y = f h w / (z (z − w))`. Infinite when `z ≤ w`.
+pub fn disparity_flat(f: f32, h: f32, w: f32, z: f32) -> f32 {
+    let den = z * (z - w);
+    if den > 0.0 {
+        f * h * w / den
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// Eq. 3.2: vertical disparity (pixels) of a ground point at horizontal
+/// distance `z` for a camera at height `h`, tilted down by `tilt`, the
+/// vehicle moving forward by `w` on flat ground:
+/// `d_y = f h w / (Z' (Z' − w cos θ))` with `Z' = h sin θ + z cos θ`.
+/// Infinite when the point is not in front of both cameras.
+pub fn disparity_tilted(f: f32, h: f32, w: f32, z: f32, tilt: f32) -> f32 {
+    let (s, c) = sin_cos(tilt);
+    let zp = h * s + z * c;
+    let den = zp * (zp - w * c);
+    if zp > 0.0 && den > 0.0 {
+        f * h * w / den
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// The stretch of flat ground in the vertical field of view: the nearest
+/// and farthest horizontal distances seen by a camera at height `h`, tilted
+/// down by `tilt`, with half vertical field of view `half_fov` (radians;
+/// `atan(rows / 2 / f_y)`). The far end is infinite when the upper edge of
+/// the view is at or above the horizon. `None` if the ground is not seen.
+pub fn ground_interval(h: f32, tilt: f32, half_fov: f32) -> Option<(f32, f32)> {
+    let lower = tilt + half_fov; // steepest ray below the horizon
+    let upper = tilt - half_fov;
+    if lower <= 0.0 || lower >= core::f32::consts::FRAC_PI_2 {
+        return None;
+    }
+    let near = h / tan(lower);
+    let far = if upper > 0.0 {
+        h / tan(upper)
+    } else {
+        f32::INFINITY
+    };
+    Some((near, far))
+}
+
+fn tan(x: f32) -> f32 {
+    let (s, c) = sin_cos(x);
+    if c.abs() > 0.0 {
+        s / c
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// Eq. 3.4: the ratio `F` of the disparity for motion `n w` to that for
+/// `w`, at `Z' = h sin θ + Z cos θ`: `F = n + n (n − 1) w cos θ / (Z' − n w cos θ)`.
+/// `F → n` when `w ≪ Z'`.
+pub fn motion_factor(n: f32, w: f32, z_prime: f32, tilt: f32) -> f32 {
+    let (_, c) = sin_cos(tilt);
+    let den = z_prime - n * w * c;
+    if den > 0.0 {
+        n + n * (n - 1.0) * w * c / den
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// Motion stereo: the fraction of the image rows that see the ground in
+/// frame 1 whose ground point is still in view after the vehicle moves
+/// forward by `w` (flat ground, camera at height `h`, tilted by `tilt`,
+/// `rows` image rows, focal length `f_y`, principal point at the centre).
+/// The rows lost are those of the strip the vehicle drives past.
+pub fn common_rows_motion(h: f32, tilt: f32, f_y: f32, rows: f32, w: f32) -> Option<f32> {
+    let half = rows * 0.5;
+    let half_fov = atan(half / f_y);
+    let (near, far) = ground_interval(h, tilt, half_fov)?;
+    // Row (from the centre, down positive) of the ground at distance d.
+    let row = |d: f32| f_y * tan(atan(h / d) - tilt);
+    // Rows that see the ground at all: from the bottom up to the horizon or
+    // the top edge.
+    let top = if far.is_finite() {
+        -half
+    } else {
+        fmax(-half, -f_y * tan(tilt))
+    };
+    let seen = half - top;
+    let lost = half - row(near + w);
+    if seen > 0.0 {
+        Some(fmax(1.0 - lost / seen, 0.0))
+    } else {
+        None
+    }
+}
+
+/// Ordinary stereo: the fraction of the image columns common to two
+/// cameras with parallel axes a baseline `u` apart, for points at depth
+/// `z` (`columns` wide, focal length `f_x`): `1 − f_x u / (z · columns)`.
+pub fn common_columns_stereo(f_x: f32, columns: f32, u: f32, z: f32) -> f32 {
+    if z > 0.0 && columns > 0.0 {
+        fmax(1.0 - f_x * u / (z * columns), 0.0)
+    } else {
+        0.0
+    }
+}

@@ -98,6 +98,13 @@ fn common_field_motion_stereo_vs_ordinary_stereo() {
     let row = |d: f64| 800.0 * ((1.0 / d).atan() - 23f64.to_radians()).tan();
     let lost = 240.0 - row(f64::from(near) + 0.1);
     assert!((f64::from(m1) - (1.0 - lost / 480.0)).abs() < 1e-3);
+    // The same count over the paper's stated field (1.4 to 8.7).
+    let paper = |w: f64| 1.0 - (row(1.4) - row(1.4 + w)) / (row(1.4) - row(8.7));
+    println!(
+        "over the paper's field 1.4 to 8.7: {:.1} % → {:.1} %",
+        paper(0.1) * 100.0,
+        paper(0.2) * 100.0
+    );
 }
 
 /// Reconstructed points in the vehicle frame: the Fig. 6 scenario's points,

@@ -200,6 +200,10 @@ pub struct EpipolarLine {
     pub ray_min: f32,
     /// See `ray_min`.
     pub ray_max: f32,
+    /// The line's key if the caller already knows it (any value congruent
+    /// modulo the key's period will do), else infinity: the search then
+    /// computes it. Only the search's speed depends on it.
+    pub key: f32,
 }
 
 impl EpipolarLine {
@@ -353,6 +357,7 @@ impl PairGeometry {
             } else {
                 f32::INFINITY
             },
+            key: NO_KEY,
         }
     }
 }
@@ -763,7 +768,11 @@ impl<const N: usize> CrossingSearch for IndexedSearch<N> {
             }
             return;
         }
-        let q = self.key.line(line);
+        let q = if line.key.is_finite() {
+            line.key
+        } else {
+            self.key.line(line)
+        };
         self.sweep(q, |j| {
             if let (Some(v0), Some(v1)) = (boundary.get(j), boundary.get(j + 1)) {
                 if let Some(c) = line.crossing(j, *v0, *v1) {

@@ -637,6 +637,7 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
                 &geom,
                 r.pixel1,
                 &c,
+                r.z_far,
                 r.status == Status::Folded,
                 b2,
                 search,
@@ -657,16 +658,20 @@ fn flagged(pixel1: Pixel, status: Status) -> PointResult {
 
 /// The whole per-point pipeline: compensate, draw the line, intersect,
 /// triangulate, bound.
+#[allow(clippy::too_many_arguments)]
 fn evaluate<S: CrossingSearch>(
     config: &Config,
     geom: &PairGeometry,
     p1: Pixel,
     c: &Compensated,
+    key: f32,
     folded: bool,
     b2: Option<&[Pixel]>,
     search: &mut S,
 ) -> PointResult {
-    let line: EpipolarLine = geom.line(c);
+    let mut line: EpipolarLine = geom.line(c);
+    // The key of p₁' (computed in pass 1) is the key of its epipolar line.
+    line.key = key;
     let w = geom.w();
     let r1 = config.e1 * c.stretch;
     // |a| = |W'| ρ₁ (distance to the FOE): the error disc holds the FOE.

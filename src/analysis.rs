@@ -149,3 +149,72 @@ pub fn common_columns_stereo(f_x: f32, columns: f32, u: f32, z: f32) -> f32 {
         0.0
     }
 }
+
+/// Appendix II A: where a point seen at row `y_true` (pixels from the
+/// principal point, `y` down) by the true camera axis appears for an
+/// estimated axis turned by `angle` (radians) about `x`:
+/// `y_e = y_t f / (f cos θ − y_t sin θ)`. Infinite at the horizon of the
+/// turned axis.
+pub fn misaligned_row(y_true: f32, f: f32, angle: f32) -> f32 {
+    let (s, c) = sin_cos(angle);
+    let den = f * c - y_true * s;
+    if den.abs() > 0.0 {
+        y_true * f / den
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// Appendix II A: the disparity `y_Q − y_P` as seen with the misaligned
+/// axis, from the true rows `y_p` (frame 1) and `y_q` (frame 2):
+/// `dy_e = dy_t f² cos θ / ((f cos θ − y_P sin θ)(f cos θ − y_Q sin θ))`.
+pub fn misaligned_disparity(y_p: f32, y_q: f32, f: f32, angle: f32) -> f32 {
+    let (s, c) = sin_cos(angle);
+    let den = (f * c - y_p * s) * (f * c - y_q * s);
+    if den.abs() > 0.0 {
+        (y_q - y_p) * f * f * c / den
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// Appendix II A, Fig. A-2: the relative depth error caused by an error
+/// `angle` in the camera axis, for a ground point at horizontal distance
+/// `z`, camera height `h`, tilt `tilt`, forward motion `w` (vehicle frame),
+/// focal length `f`: the depth of Sec. 4.1.1, `Z = (−f V + W y₂)/d_y`
+/// (camera-frame motion), computed from the true and from the misaligned
+/// rows. `None` if the point is not seen in both frames.
+pub fn misalignment_depth_error(
+    f: f32,
+    h: f32,
+    tilt: f32,
+    w: f32,
+    z: f32,
+    angle: f32,
+) -> Option<f32> {
+    let t = vehicle_to_camera([0.0, 0.0, w], tilt);
+    let p1 = vehicle_to_camera([0.0, h, z], tilt);
+    let p2 = [p1[0] - t[0], p1[1] - t[1], p1[2] - t[2]];
+    if p1[2] <= 0.0 || p2[2] <= 0.0 {
+        return None;
+    }
+    let (y1, y2) = (f * p1[1] / p1[2], f * p2[1] / p2[2]);
+    let depth = |y2: f32, dy: f32| (-f * t[1] + t[2] * y2) / dy;
+    let z_true = depth(y2, y2 - y1);
+    let z_est = depth(
+        misaligned_row(y2, f, angle),
+        misaligned_disparity(y1, y2, f, angle),
+    );
+    (z_true.is_finite() && z_est.is_finite() && z_true != 0.0).then(|| (z_est / z_true - 1.0).abs())
+}
+
+/// The relative depth error of Sec. 4.1.1 from a disparity error `e`
+/// (pixels) at disparity `d`: `e d / (d² − e²)`; infinite when `d ≤ e`.
+pub fn quantisation_depth_error(d: f32, e: f32) -> f32 {
+    let den = d * d - e * e;
+    if d > e && den > 0.0 {
+        e * d / den
+    } else {
+        f32::INFINITY
+    }
+}

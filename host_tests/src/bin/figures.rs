@@ -189,10 +189,174 @@ fn example(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
+/// Fig. 3: disparity vs distance for several tilts (W = 0.1, h = 1,
+/// f = 800), with the ground in view of each tilt as a bar below.
+fn fig3(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
+    use roadstereo::analysis::{disparity_tilted, ground_interval};
+    let path = dir.join("fig3_disparity_tilt.svg");
+    let root = SVGBackend::new(&path, (720, 480)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "Fig. 3: disparity d_y vs distance, W = 0.1, h = 1",
+            ("sans-serif", 18),
+        )
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(50)
+        .build_cartesian_2d(0.0f64..12.0, -8.0f64..60.0)?;
+    chart
+        .configure_mesh()
+        .x_desc("distance along the ground (camera heights)")
+        .y_desc("d_y (pixels)")
+        .draw()?;
+    let half_fov = (240.0f32 / 800.0).atan();
+    for (k, (deg, col)) in [(0.0f32, BLACK), (10.0, BLUE), (23.0, RED), (35.0, GREEN)]
+        .into_iter()
+        .enumerate()
+    {
+        let t = deg.to_radians();
+        chart
+            .draw_series(LineSeries::new(
+                (5..120).map(|i| {
+                    let z = i as f32 * 0.1;
+                    (
+                        f64::from(z),
+                        f64::from(disparity_tilted(800.0, 1.0, 0.1, z, t)),
+                    )
+                }),
+                col.stroke_width(2),
+            ))?
+            .label(format!("tilt {deg}°"))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col));
+        if let Some((near, far)) = ground_interval(1.0, t, half_fov) {
+            let y = -1.5 - 1.5 * k as f64;
+            chart.draw_series(std::iter::once(PathElement::new(
+                vec![(f64::from(near), y), (f64::from(far.min(12.0)), y)],
+                col.stroke_width(5),
+            )))?;
+        }
+    }
+    chart.configure_series_labels().border_style(BLACK).draw()?;
+    root.present()?;
+    println!("wrote {}", path.display());
+    Ok(())
+}
+
+/// Fig. 4: the motion factor F vs n (w = 0.1, tilt 23°) for several Z'.
+fn fig4(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
+    use roadstereo::analysis::motion_factor;
+    let path = dir.join("fig4_motion_factor.svg");
+    let root = SVGBackend::new(&path, (720, 480)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "Fig. 4: F (disparity ratio for motion n·w) vs n, w = 0.1",
+            ("sans-serif", 18),
+        )
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(50)
+        .build_cartesian_2d(1.0f64..10.0, 0.0f64..25.0)?;
+    chart.configure_mesh().x_desc("n").y_desc("F").draw()?;
+    let t = 23f32.to_radians();
+    for (zp, col) in [(1.5f32, RED), (3.0, BLUE), (6.0, GREEN), (12.0, BLACK)] {
+        chart
+            .draw_series(LineSeries::new(
+                (10..=100).map(|i| {
+                    let n = i as f32 * 0.1;
+                    (
+                        f64::from(n),
+                        f64::from(motion_factor(n, 0.1, zp, t).min(25.0)),
+                    )
+                }),
+                col.stroke_width(2),
+            ))?
+            .label(format!("Z' = {zp}"))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col));
+    }
+    chart
+        .draw_series(LineSeries::new(
+            (1..=10).map(|n| (n as f64, n as f64)),
+            BLACK.mix(0.3),
+        ))?
+        .label("F = n")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.3)));
+    chart.configure_series_labels().border_style(BLACK).draw()?;
+    root.present()?;
+    println!("wrote {}", path.display());
+    Ok(())
+}
+
+/// Fig. A-2: relative depth error from a camera-axis error (1°, 2°, 3°)
+/// vs distance, W = 0.25 and 0.5, with the quantisation error (e = 1 px).
+fn fig_a2(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
+    use roadstereo::analysis::{
+        disparity_tilted, misalignment_depth_error, quantisation_depth_error,
+    };
+    let path = dir.join("fig_a2_axis_error.svg");
+    let root = SVGBackend::new(&path, (1000, 420)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let panels = root.split_evenly((1, 2));
+    let t = 23f32.to_radians();
+    for (area, w) in panels.iter().zip([0.25f32, 0.5]) {
+        let mut chart = ChartBuilder::on(area)
+            .caption(
+                format!("Fig. A-2: relative depth error, W = {w}"),
+                ("sans-serif", 16),
+            )
+            .margin(10)
+            .x_label_area_size(35)
+            .y_label_area_size(50)
+            .build_cartesian_2d(1.0f64..9.0, 0.0f64..0.12)?;
+        chart
+            .configure_mesh()
+            .x_desc("distance along the ground")
+            .y_desc("|ΔZ / Z|")
+            .draw()?;
+        let zs: Vec<f32> = (0..=80)
+            .map(|i| 1.2 + w + i as f32 * 0.1)
+            .filter(|z| *z <= 9.0)
+            .collect();
+        chart
+            .draw_series(AreaSeries::new(
+                zs.iter().map(|&z| {
+                    let q = quantisation_depth_error(disparity_tilted(800.0, 1.0, w, z, t), 1.0);
+                    (f64::from(z), f64::from(q.min(0.12)))
+                }),
+                0.0,
+                BLACK.mix(0.15),
+            ))?
+            .label("quantisation, e = 1 px")
+            .legend(|(x, y)| {
+                Rectangle::new([(x, y - 4), (x + 20, y + 4)], BLACK.mix(0.15).filled())
+            });
+        for (deg, col) in [(1.0f32, BLUE), (2.0, RED), (3.0, GREEN)] {
+            chart
+                .draw_series(LineSeries::new(
+                    zs.iter().filter_map(|&z| {
+                        misalignment_depth_error(800.0, 1.0, t, w, z, deg.to_radians())
+                            .map(|e| (f64::from(z), f64::from(e.min(0.12))))
+                    }),
+                    col.stroke_width(2),
+                ))?
+                .label(format!("axis error {deg}°"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col));
+        }
+        chart.configure_series_labels().border_style(BLACK).draw()?;
+    }
+    root.present()?;
+    println!("wrote {}", path.display());
+    Ok(())
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dir = std::path::PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| "../docs".into()));
     std::fs::create_dir_all(&dir)?;
     fig7(&dir)?;
+    fig3(&dir)?;
+    fig4(&dir)?;
+    fig_a2(&dir)?;
     example(&dir)?;
     Ok(())
 }

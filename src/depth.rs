@@ -130,3 +130,54 @@ pub(crate) fn stick(
     let z_near = fmax(s_near / depth_scale, 0.0);
     (z_far.is_finite() && z_far >= z_near).then_some(DepthInterval { z_near, z_far })
 }
+
+/// The stick when, in addition, each component of the translation used may
+/// be off by up to `delta` (see [`crate::Config::with_translation_error`]).
+///
+/// With the true translation anywhere in that box, `|a|` may differ from
+/// ours by `spread_a` and `W'` by `spread_w`
+/// ([`crate::motion_error`]); the true epipolar line is turned from ours by
+/// an angle with `sin Δθ ≤ spread_a / |a|`, which at the intersection
+/// displaces it sideways by up to `D_true sin Δθ`. With
+/// `h = h₁ + (D + ε) sin Δθ` the along-line error is
+/// `ε = r₁ + (e₂ + h |cos φ|)/sin φ`, solved for `ε` in closed form, and
+///
+/// `s_far = W'₊ + (|a| + |W'|₊ r₁ + spread_a) / (D − ε)`,
+/// `s_near = W'₋ + (|a| − |W'|₊ r₁ − spread_a) / (D + ε + h²/2(D − ε))`
+///
+/// (the last term: a sideways offset lengthens the true disparity at most by
+/// that much). `None` when the far end is unbounded.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn stick_with_translation_error(
+    w: f32,
+    tau: f32,
+    a_len: f32,
+    r1: f32,
+    e2: f32,
+    sin_low: f32,
+    cos: f32,
+    depth_scale: f32,
+    spread_a: f32,
+    spread_w: f32,
+) -> Option<DepthInterval> {
+    let d = tau * a_len;
+    let turn = spread_a / a_len; // ≥ sin of the angle between the lines
+    if turn.is_nan() || turn >= 1.0 || turn * cos >= sin_low {
+        return None;
+    }
+    let h1 = r1 * fmax(1.0 + (w + spread_w) * tau, 1.0 + (w - spread_w) * tau);
+    let h1 = fmax(h1, 0.0);
+    let eps = (r1 + (e2 + (h1 + d * turn) * cos) / sin_low) / (1.0 - turn * cos / sin_low);
+    if d - eps <= 0.0 {
+        return None;
+    }
+    let h = h1 + (d + eps) * turn;
+    let w_abs = w.abs() + spread_w;
+    let a_hi = a_len + w_abs * r1 + spread_a;
+    let a_lo = fmax(a_len - w_abs * r1 - spread_a, 0.0);
+    let s_far = (w + spread_w) + a_hi / (d - eps);
+    let s_near = (w - spread_w) + a_lo / (d + eps + h * h / (2.0 * (d - eps)));
+    let z_far = s_far / depth_scale;
+    let z_near = fmax(s_near / depth_scale, 0.0);
+    (z_far.is_finite() && z_far >= z_near).then_some(DepthInterval { z_near, z_far })
+}

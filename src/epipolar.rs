@@ -161,6 +161,8 @@ impl PencilKey {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PairGeometry {
     h: crate::math::Mat3,
+    r: crate::math::Mat3,
+    k2: (f32, f32, f32, f32),
     w: f32,
     g: [f32; 2],
     c2: [f32; 2],
@@ -282,7 +284,25 @@ impl PairGeometry {
                 sign_w: if w > 0.0 { 1.0 } else { -1.0 },
             }
         };
-        Self { h, w, g, c2, key }
+        Self {
+            h,
+            r: motion.rotation_matrix(),
+            k2: (cam2.fx(), cam2.fy(), cam2.cx(), cam2.cy()),
+            w,
+            g,
+            c2,
+            key,
+        }
+    }
+
+    /// The rotation `R` of the motion.
+    pub(crate) fn rotation(&self) -> &crate::math::Mat3 {
+        &self.r
+    }
+
+    /// Frame-2 intrinsics `(f_x, f_y, c_x, c_y)`.
+    pub(crate) fn camera2_intrinsics(&self) -> (f32, f32, f32, f32) {
+        self.k2
     }
 
     /// `W'`, the forward component of the rotation-compensated translation.

@@ -37,6 +37,7 @@ pub mod depth;
 pub mod epipolar;
 mod math;
 pub mod motion;
+pub mod motion_error;
 pub mod processor;
 
 pub use boundary::{Boundary, BoundaryError, Frame};

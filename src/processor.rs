@@ -11,7 +11,9 @@ use core::fmt;
 
 use crate::boundary::Frame;
 use crate::camera::{Camera, Pixel};
-use crate::depth::{chord, crossing_angle, stick, DepthInterval, CHORD_HALF_WINDOW};
+use crate::depth::{
+    chord, crossing_angle, stick, stick_with_translation_error, DepthInterval, CHORD_HALF_WINDOW,
+};
 use crate::epipolar::{
     Compensated, CrossingSearch, Crossings, EpipolarLine, IndexedSearch, PairGeometry,
     MAX_CROSSINGS,
@@ -27,6 +29,7 @@ pub struct Config {
     e2: f32,
     sin_min_angle: f32,
     max_depth: f32,
+    translation_error: f32,
 }
 
 /// Why a configuration was rejected.
@@ -39,6 +42,8 @@ pub enum ConfigError {
     MinAngle,
     /// The maximum depth is not finite and positive.
     MaxDepth,
+    /// The translation error bound is negative, NaN or too large.
+    TranslationError,
 }
 
 impl fmt::Display for ConfigError {
@@ -47,6 +52,7 @@ impl fmt::Display for ConfigError {
             Self::LocalisationError => "localisation error must be in [0, 100] px",
             Self::MinAngle => "minimum crossing angle must be in [0.1, 89] degrees",
             Self::MaxDepth => "maximum depth must be finite and positive",
+            Self::TranslationError => "translation error bound must be in [0, 1e6]",
         })
     }
 }
@@ -60,6 +66,7 @@ impl Default for Config {
             e2: 0.5,
             sin_min_angle: 0.173_648_18,
             max_depth: 1000.0,
+            translation_error: 0.0,
         }
     }
 }
@@ -95,7 +102,35 @@ impl Config {
             e2,
             sin_min_angle: crate::math::sin_cos(min_angle_deg.to_radians()).0,
             max_depth,
+            translation_error: 0.0,
         })
+    }
+
+    /// The same configuration with sticks that also hold when each
+    /// component `(U, V, W)` of the translation given to
+    /// [`Processor::process`] may be off by up to `delta` (length units,
+    /// frame-1 camera axes): the combined interval of quantisation and
+    /// translation error (Sec. 4.2), guaranteed for every translation in that
+    /// box. See [`crate::depth`] for the bound.
+    ///
+    /// ```
+    /// use roadstereo::Config;
+    /// let c = Config::default().with_translation_error(0.02)?;
+    /// assert_eq!(c.translation_error(), 0.02);
+    /// assert!(Config::default().with_translation_error(-1.0).is_err());
+    /// # Ok::<(), roadstereo::ConfigError>(())
+    /// ```
+    pub fn with_translation_error(mut self, delta: f32) -> Result<Self, ConfigError> {
+        if !(0.0..=crate::math::MAX_TRANSLATION).contains(&delta) {
+            return Err(ConfigError::TranslationError);
+        }
+        self.translation_error = delta;
+        Ok(self)
+    }
+
+    /// Bound on each translation component's error, length units.
+    pub fn translation_error(&self) -> f32 {
+        self.translation_error
     }
 
     /// `e = e₁ + e₂`, pixels.
@@ -731,16 +766,38 @@ fn evaluate<S: CrossingSearch>(
         r.status = Status::BeyondMaxDepth;
         return r;
     }
-    match stick(
-        w,
-        best.tau,
-        a_len,
-        r1,
-        config.e2,
-        sin_low,
-        cos,
-        c.depth_scale,
-    ) {
+    let interval = if config.translation_error > 0.0 {
+        let (spread_a, spread_w) = crate::motion_error::spread(
+            geom.rotation(),
+            geom.camera2_intrinsics(),
+            c.pixel,
+            config.translation_error,
+        );
+        stick_with_translation_error(
+            w,
+            best.tau,
+            a_len,
+            r1,
+            config.e2,
+            sin_low,
+            cos,
+            c.depth_scale,
+            spread_a,
+            spread_w,
+        )
+    } else {
+        stick(
+            w,
+            best.tau,
+            a_len,
+            r1,
+            config.e2,
+            sin_low,
+            cos,
+            c.depth_scale,
+        )
+    };
+    match interval {
         Some(i) => {
             r.z = z;
             r.z_near = crate::math::fmin(i.z_near, z);

@@ -1,0 +1,120 @@
+//! Effect of translation errors on the reconstruction (paper, Sec. 4.2).
+//!
+//! An error in the translation moves every point at once (it is "global to
+//! the scene"). For one correspondence `(p₁, p₂)` the depth along the
+//! disparity (eq. 2.3 in the least-squares form of [`crate::depth`]) is
+//!
+//! `s(T) = W' + (a·a)/(a·d)`, `a = W'(p₁' − c₂) − (f_x U', f_y V')`,
+//! `d = p₂ − p₁'`, `T' = Rᵀ T`, `Z = s / q_z`,
+//!
+//! so its derivatives with respect to `T` are in closed form
+//! ([`depth_sensitivity`]): with `a` linear in `T'`,
+//! `ds = dW' + [2 (a·da)(a·d) − (a·a)(da·d)] / (a·d)²`, and
+//! `∂s/∂T = R ∂s/∂T'`.
+//!
+//! The guaranteed stick with a bounded translation error is part of the
+//! per-point pipeline: [`crate::Config::with_translation_error`].
+
+use crate::camera::{Camera, Pixel};
+use crate::epipolar::PairGeometry;
+use crate::math::{dot, mat3_transpose, mat3_vec};
+use crate::motion::Motion;
+
+/// Depth `Z` (frame-1 camera coordinates) of the correspondence
+/// `p1 → p2` under `motion`, by eq. 2.3 in least squares along the
+/// disparity: the "brute-force re-triangulation" with a given motion.
+/// `None` when the geometry is degenerate (point at the FOE, no disparity,
+/// behind the camera).
+///
+/// ```
+/// use roadstereo::{motion_error::depth_of_correspondence, Camera, Motion, Pixel};
+/// let cam = Camera::new(800.0, 800.0, 256.0, 240.0, 512, 480).unwrap();
+/// // A point at depth 5 straight below the axis, camera moving forward 0.5.
+/// let m = Motion::new([0.0, 0.0, 0.5], [0.0; 3]).unwrap();
+/// let (p1, p2) = (Pixel::new(256.0, 240.0 + 800.0 / 5.0), Pixel::new(256.0, 240.0 + 800.0 / 4.5));
+/// let z = depth_of_correspondence(&cam, &cam, &m, p1, p2).unwrap();
+/// assert!((z - 5.0).abs() < 1e-4);
+/// ```
+pub fn depth_of_correspondence(
+    cam1: &Camera,
+    cam2: &Camera,
+    motion: &Motion,
+    p1: Pixel,
+    p2: Pixel,
+) -> Option<f32> {
+    let g = PairGeometry::new(cam1, cam2, motion);
+    let c = g.compensate(p1)?;
+    let line = g.line(&c);
+    let d = [p2.u - c.pixel[0], p2.v - c.pixel[1]];
+    let ad = dot(line.a, d);
+    if ad.is_nan() || ad <= 0.0 || line.a2 <= 0.0 {
+        return None;
+    }
+    let s = g.w() + line.a2 / ad;
+    let z = s / c.depth_scale;
+    z.is_finite().then_some(z)
+}
+
+/// The closed-form derivatives `∂Z/∂(U, V, W)` of the depth of the
+/// correspondence `p1 → p2` with respect to the translation (frame-1
+/// camera coordinates), the rotation held fixed. `None` as for
+/// [`depth_of_correspondence`].
+pub fn depth_sensitivity(
+    cam1: &Camera,
+    cam2: &Camera,
+    motion: &Motion,
+    p1: Pixel,
+    p2: Pixel,
+) -> Option<[f32; 3]> {
+    let g = PairGeometry::new(cam1, cam2, motion);
+    let c = g.compensate(p1)?;
+    let line = g.line(&c);
+    let a = line.a;
+    let d = [p2.u - c.pixel[0], p2.v - c.pixel[1]];
+    let (aa, ad) = (line.a2, dot(a, d));
+    if ad.is_nan() || ad <= 0.0 || aa <= 0.0 {
+        return None;
+    }
+    // da/dT' for T' = (U', V', W'): (−f_x, 0), (0, −f_y), (p₁' − c₂).
+    let rel = [c.pixel[0] - cam2.cx(), c.pixel[1] - cam2.cy()];
+    let da = [[-cam2.fx(), 0.0], [0.0, -cam2.fy()], rel];
+    let dw = [0.0, 0.0, 1.0];
+    let mut grad_tp = [0.0f32; 3];
+    for ((gk, dak), dwk) in grad_tp.iter_mut().zip(da.iter()).zip(dw.iter()) {
+        *gk = dwk + (2.0 * dot(a, *dak) * ad - aa * dot(*dak, d)) / (ad * ad);
+    }
+    // ∂s/∂T = R ∂s/∂T' (T' = Rᵀ T), then Z = s / q_z.
+    let r = motion.rotation_matrix();
+    let grad = mat3_vec(&r, grad_tp);
+    let inv = 1.0 / c.depth_scale;
+    let out = grad.map(|x| x * inv);
+    out.iter().all(|x| x.is_finite()).then_some(out)
+}
+
+/// How far a box of translation errors (`±delta` on each frame-1 camera
+/// component) can move the vector `a` of a compensated point and the
+/// forward component `W'`: `(Σᵢ |∂a/∂Tᵢ| δ, Σᵢ |∂W'/∂Tᵢ| δ)`.
+pub(crate) fn spread(
+    rotation: &[[f32; 3]; 3],
+    cam2: (f32, f32, f32, f32),
+    p1c: [f32; 2],
+    delta: f32,
+) -> (f32, f32) {
+    let (fx, fy, cx, cy) = cam2;
+    let rt = mat3_transpose(rotation);
+    let rel = [p1c[0] - cx, p1c[1] - cy];
+    let [r0, r1, r2] = rt;
+    let (mut sa, mut sw) = (0.0f32, 0.0f32);
+    for i in 0..3 {
+        let (a0, a1, a2) = (
+            r0.get(i).copied().unwrap_or(0.0),
+            r1.get(i).copied().unwrap_or(0.0),
+            r2.get(i).copied().unwrap_or(0.0),
+        );
+        // Column i of (∂a/∂T') Rᵀ.
+        let col = [-fx * a0 + rel[0] * a2, -fy * a1 + rel[1] * a2];
+        sa += crate::math::sqrt(dot(col, col));
+        sw += a2.abs();
+    }
+    (sa * delta, sw * delta)
+}

@@ -163,6 +163,7 @@ pub struct PairGeometry {
     h: crate::math::Mat3,
     r: crate::math::Mat3,
     k2: (f32, f32, f32, f32),
+    t_norm: f32,
     w: f32,
     g: [f32; 2],
     c2: [f32; 2],
@@ -288,6 +289,10 @@ impl PairGeometry {
             h,
             r: motion.rotation_matrix(),
             k2: (cam2.fx(), cam2.fy(), cam2.cx(), cam2.cy()),
+            t_norm: {
+                let [tx, ty, tz] = tp;
+                crate::math::sqrt(tx * tx + ty * ty + tz * tz)
+            },
             w,
             g,
             c2,
@@ -298,6 +303,11 @@ impl PairGeometry {
     /// The rotation `R` of the motion.
     pub(crate) fn rotation(&self) -> &crate::math::Mat3 {
         &self.r
+    }
+
+    /// `|T|`, the length of the translation.
+    pub(crate) fn translation_norm(&self) -> f32 {
+        self.t_norm
     }
 
     /// Frame-2 intrinsics `(f_x, f_y, c_x, c_y)`.

@@ -14,6 +14,21 @@
 //!
 //! The guaranteed stick with a bounded translation error is part of the
 //! per-point pipeline: [`crate::Config::with_translation_error`].
+//!
+//! # Rotation errors (Sec. 5 leaves them open)
+//! An error `ω` in the rotation moves the rotation-compensated point `p₁'`
+//! by the rotational flow at `(x, y)` (normalised frame-2 coordinates):
+//! `δx = f_x (x y ω_x − (1 + x²) ω_y + y ω_z)`,
+//! `δy = f_y ((1 + y²) ω_x − x y ω_y − x ω_z)` to first order. For
+//! `|ω_k| ≤ ε_k` its length is at most
+//! `Σ_k |flow column k| ε_k + f (1 + x² + y²) (Σ ε_k)²` (the last term covers
+//! the second order, generously, for `Σ ε_k ≤ 0.1` rad) —
+//! [`rotation_shift_bound`]. With [`crate::Config::with_rotation_error`] that
+//! shift is added to the frame-1 localisation error of every point, so the
+//! stick holds for any rotation error in the box. At `f = 800` px a 1° error
+//! about `x` or `y` moves points by about 14 px at the image centre, about
+//! `z` by up to `1° × 350 px ≈ 6` px at the image corners (the paper: "10
+//! pixels" and "4 or 5 pixels").
 
 use crate::camera::{Camera, Pixel};
 use crate::epipolar::PairGeometry;
@@ -117,4 +132,29 @@ pub(crate) fn spread(
         sw += a2.abs();
     }
     (sa * delta, sw * delta)
+}
+
+/// Upper bound (pixels) on how far an error of at most `eps` (radians, about
+/// the `x`, `y`, `z` axes) in the rotation moves a rotation-compensated
+/// point at `p` (frame-2 pixels) of a camera with intrinsics
+/// `(f_x, f_y, c_x, c_y)`. See the module docs. Infinite for
+/// `Σ eps > 0.1` rad, where the bound is not claimed.
+pub fn rotation_shift_bound(p: [f32; 2], cam2: (f32, f32, f32, f32), eps: [f32; 3]) -> f32 {
+    let (fx, fy, cx, cy) = cam2;
+    let total = eps[0] + eps[1] + eps[2];
+    if total.is_nan() || total > 0.1 {
+        return f32::INFINITY;
+    }
+    let (x, y) = ((p[0] - cx) / fx, (p[1] - cy) / fy);
+    let cols = [
+        [fx * x * y, fy * (1.0 + y * y)],
+        [fx * (1.0 + x * x), fy * x * y],
+        [fx * y, fy * x],
+    ];
+    let mut b = 0.0f32;
+    for (c, e) in cols.iter().zip(eps.iter()) {
+        b += crate::math::sqrt(dot(*c, *c)) * e.abs();
+    }
+    let f = if fx > fy { fx } else { fy };
+    b + f * (1.0 + x * x + y * y) * total * total
 }

@@ -30,6 +30,7 @@ pub struct Config {
     sin_min_angle: f32,
     max_depth: f32,
     translation_error: f32,
+    rotation_error: [f32; 3],
 }
 
 /// Why a configuration was rejected.
@@ -44,6 +45,8 @@ pub enum ConfigError {
     MaxDepth,
     /// The translation error bound is negative, NaN or too large.
     TranslationError,
+    /// A rotation error bound is negative, NaN, or they sum above 0.1 rad.
+    RotationError,
 }
 
 impl fmt::Display for ConfigError {
@@ -53,6 +56,7 @@ impl fmt::Display for ConfigError {
             Self::MinAngle => "minimum crossing angle must be in [0.1, 89] degrees",
             Self::MaxDepth => "maximum depth must be finite and positive",
             Self::TranslationError => "translation error bound must be in [0, 1e6]",
+            Self::RotationError => "rotation error bounds must be >= 0 and sum to at most 0.1 rad",
         })
     }
 }
@@ -67,6 +71,7 @@ impl Default for Config {
             sin_min_angle: 0.173_648_18,
             max_depth: 1000.0,
             translation_error: 0.0,
+            rotation_error: [0.0; 3],
         }
     }
 }
@@ -103,6 +108,7 @@ impl Config {
             sin_min_angle: crate::math::sin_cos(min_angle_deg.to_radians()).0,
             max_depth,
             translation_error: 0.0,
+            rotation_error: [0.0; 3],
         })
     }
 
@@ -126,6 +132,32 @@ impl Config {
         }
         self.translation_error = delta;
         Ok(self)
+    }
+
+    /// The same configuration with sticks that also hold when the rotation
+    /// given to [`Processor::process`] may be off by up to `eps` radians
+    /// about each axis (`x`, `y`, `z`; at most 0.1 rad in all): every
+    /// point's frame-1 localisation error grows by
+    /// [`crate::motion_error::rotation_shift_bound`].
+    ///
+    /// ```
+    /// use roadstereo::Config;
+    /// let c = Config::default().with_rotation_error([0.01, 0.01, 0.005])?;
+    /// assert!(Config::default().with_rotation_error([0.1, 0.1, 0.0]).is_err());
+    /// # Ok::<(), roadstereo::ConfigError>(())
+    /// ```
+    pub fn with_rotation_error(mut self, eps: [f32; 3]) -> Result<Self, ConfigError> {
+        let total = eps[0] + eps[1] + eps[2];
+        if eps.iter().any(|e| !(0.0..=0.1).contains(e)) || total > 0.1 {
+            return Err(ConfigError::RotationError);
+        }
+        self.rotation_error = eps;
+        Ok(self)
+    }
+
+    /// Bound on the rotation error about each axis, radians.
+    pub fn rotation_error(&self) -> [f32; 3] {
+        self.rotation_error
     }
 
     /// Bound on each translation component's error, length units.
@@ -708,7 +740,14 @@ fn evaluate<S: CrossingSearch>(
     // The key of p₁' (computed in pass 1) is the key of its epipolar line.
     line.key = key;
     let w = geom.w();
-    let r1 = config.e1 * c.stretch;
+    let mut r1 = config.e1 * c.stretch;
+    if config.rotation_error != [0.0; 3] {
+        r1 += crate::motion_error::rotation_shift_bound(
+            c.pixel,
+            geom.camera2_intrinsics(),
+            config.rotation_error,
+        );
+    }
     // |a| = |W'| ρ₁ (distance to the FOE): the error disc holds the FOE.
     let foe_guard = w.abs() * crate::math::fmax(r1, 1.0e-3);
     if line.a2 <= foe_guard * foe_guard || line.a2 <= 1.0e-12 {
@@ -766,12 +805,17 @@ fn evaluate<S: CrossingSearch>(
         r.status = Status::BeyondMaxDepth;
         return r;
     }
-    let interval = if config.translation_error > 0.0 {
+    // A rotation error also turns the compensated translation T' = Rᵀ T by
+    // up to Σε: a translation error of at most |T| Σε (5 % added for the
+    // second order) in every component.
+    let [ex, ey, ez] = config.rotation_error;
+    let t_error = config.translation_error + 1.05 * geom.translation_norm() * (ex + ey + ez);
+    let interval = if t_error > 0.0 {
         let (spread_a, spread_w) = crate::motion_error::spread(
             geom.rotation(),
             geom.camera2_intrinsics(),
             c.pixel,
-            config.translation_error,
+            t_error,
         );
         stick_with_translation_error(
             w,

@@ -153,3 +153,74 @@ fn combined_interval_holds_under_translation_error() {
     println!("combined interval: {ok} unflagged sticks, all contain the truth; mean (Z_far − Z_near)/Z = {:.3}", ratio_sum / ok as f64);
     assert!(ok > 20_000);
 }
+
+/// Rotation errors (Sec. 5): the per-point shift bound holds against the
+/// compensation under every corner of the error box, and with the bound
+/// configured the truth lies inside every unflagged stick when the rotation
+/// given to the pipeline is off by up to 0.3° about each axis (random),
+/// over 200 random scenarios.
+#[test]
+fn rotation_error_bound_holds() {
+    use roadstereo::motion_error::rotation_shift_bound;
+    use roadstereo::PairGeometry;
+    let eps = 0.3f32.to_radians();
+    let (mut ok, mut worst_use) = (0usize, 0.0f32);
+    for seed in 0..200u64 {
+        let s = scenarios::random(seed);
+        let r = s.render();
+        let k = s.intrinsics;
+        let cam = k.camera();
+        let m = r.motion();
+        // The bound against brute force: compensate with each corner of the
+        // rotation-error box and measure the shift.
+        let g0 = PairGeometry::new(&cam, &cam, &m);
+        for b in &r.frame1 {
+            for p in b.iter().step_by(17) {
+                let p1 = roadstereo::Pixel::new(p.u as f32, p.v as f32);
+                let Some(c0) = g0.compensate(p1) else {
+                    continue;
+                };
+                let bound = rotation_shift_bound(
+                    c0.pixel,
+                    (cam.fx(), cam.fy(), cam.cx(), cam.cy()),
+                    [eps; 3],
+                );
+                for corner in 0..8 {
+                    let a = m.angles();
+                    let da = [0, 1, 2].map(|i| if corner >> i & 1 == 1 { eps } else { -eps });
+                    let mk =
+                        Motion::new(m.translation(), [a[0] + da[0], a[1] + da[1], a[2] + da[2]])
+                            .unwrap();
+                    let c1 = PairGeometry::new(&cam, &cam, &mk).compensate(p1).unwrap();
+                    let shift = (c1.pixel[0] - c0.pixel[0]).hypot(c1.pixel[1] - c0.pixel[1]);
+                    assert!(shift <= bound, "seed {seed}: shift {shift} > bound {bound}");
+                    worst_use = worst_use.max(shift / bound);
+                }
+            }
+        }
+        // Containment with a wrong rotation.
+        let mut g = synth::Rng(seed ^ 0x5A5A);
+        let a = m.angles();
+        let used = [0, 1, 2].map(|i| a[i] + (g.uniform(-1.0, 1.0) as f32) * eps);
+        let mu = Motion::new(m.translation(), used).unwrap();
+        let config = Config::default().with_rotation_error([eps; 3]).unwrap();
+        let p = run(&r, cam, &mu, config);
+        for st in point_stats(&r, &k, &p) {
+            if st.status != Status::Ok || !st.observed {
+                continue;
+            }
+            assert!(
+                st.contained(),
+                "seed {seed} b{} i{}: true {} outside [{}, {}]",
+                st.boundary,
+                st.index,
+                st.z_true,
+                st.z_near,
+                st.z_far
+            );
+            ok += 1;
+        }
+    }
+    println!("rotation error ±0.3°: {ok} unflagged sticks all contain the truth; the shift bound is at most {:.0} % used", worst_use * 100.0);
+    assert!(ok > 10_000);
+}

@@ -15,7 +15,8 @@
 //! [`processor`] (the per-frame driver and its output), and
 //! [`calibration`] (intrinsics from foci of expansion, Appendix II B), and
 //! [`analysis`] (the disparity analysis of Sec. 3, the tilt transform of
-//! Appendix I).
+//! Appendix I), [`motion_error`] (Sec. 4.2 and 5) and [`geometry`] (camera
+//! height, tilt and road width from the reconstruction, Sec. 4.2.1).
 //!
 //! See the README for the coordinate conventions and a worked example.
 #![no_std]
@@ -35,6 +36,7 @@ pub mod calibration;
 pub mod camera;
 pub mod depth;
 pub mod epipolar;
+pub mod geometry;
 mod math;
 pub mod motion;
 pub mod motion_error;

@@ -50,6 +50,8 @@ pub enum BoundaryError {
     },
 }
 
+impl core::error::Error for BoundaryError {}
+
 impl fmt::Display for BoundaryError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {

@@ -70,6 +70,8 @@ pub enum CalibrationError {
     Camera(CameraError),
 }
 
+impl core::error::Error for CalibrationError {}
+
 impl fmt::Display for CalibrationError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {

@@ -58,6 +58,8 @@ pub enum CameraError {
     ImageSize,
 }
 
+impl core::error::Error for CameraError {}
+
 impl fmt::Display for CameraError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {

@@ -79,6 +79,8 @@ pub enum GeometryError {
     Inconsistent,
 }
 
+impl core::error::Error for GeometryError {}
+
 impl fmt::Display for GeometryError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
@@ -136,7 +138,10 @@ fn heights<const N: usize>(points: &[Sample], s: f32, c: f32, m: usize) -> Optio
             j += 1;
         }
     }
-    (first.is_finite() && last.is_finite() && first <= last).then_some(Range { lo: first, hi: last })
+    (first.is_finite() && last.is_finite() && first <= last).then_some(Range {
+        lo: first,
+        hi: last,
+    })
 }
 
 /// Ground-plane position (lateral, forward) of a sample at tilt `(s, c)`
@@ -220,9 +225,18 @@ pub fn road_geometry<const N: usize>(
     }
     let pts = both.get(..n).ok_or(GeometryError::TooFewPoints)?;
     let (mut tilt, mut height, mut width) = (
-        Range { lo: f32::INFINITY, hi: f32::NEG_INFINITY },
-        Range { lo: f32::INFINITY, hi: f32::NEG_INFINITY },
-        Range { lo: f32::INFINITY, hi: f32::NEG_INFINITY },
+        Range {
+            lo: f32::INFINITY,
+            hi: f32::NEG_INFINITY,
+        },
+        Range {
+            lo: f32::INFINITY,
+            hi: f32::NEG_INFINITY,
+        },
+        Range {
+            lo: f32::INFINITY,
+            hi: f32::NEG_INFINITY,
+        },
     );
     let mut t = 0.0f32;
     while t <= TILT_MAX {

@@ -46,6 +46,8 @@ pub enum MotionError {
     RotationTooLarge,
 }
 
+impl core::error::Error for MotionError {}
+
 impl fmt::Display for MotionError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {

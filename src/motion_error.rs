@@ -158,3 +158,63 @@ pub fn rotation_shift_bound(p: [f32; 2], cam2: (f32, f32, f32, f32), eps: [f32; 
     let f = if fx > fy { fx } else { fy };
     b + f * (1.0 + x * x + y * y) * total * total
 }
+
+/// Depth of the frame-1 pixel `p1` when its match is re-found, under
+/// `motion`, on the frame-2 boundary taken as the straight line through
+/// `p2` with direction `dir`: `τ = (p₂ − p₁') × b / (a × b)`,
+/// `s = W' + 1/τ`, `Z = s/q_z` — the closed-form response of the whole
+/// pipeline (epipolar line, intersection, triangulation) to a motion change
+/// where the boundary is locally straight. `None` if the line misses (or
+/// runs along) the boundary, or the depth is not positive.
+pub fn depth_on_boundary(
+    cam1: &Camera,
+    cam2: &Camera,
+    motion: &Motion,
+    p1: Pixel,
+    p2: Pixel,
+    dir: [f32; 2],
+) -> Option<f32> {
+    let g = PairGeometry::new(cam1, cam2, motion);
+    let c = g.compensate(p1)?;
+    let line = g.line(&c);
+    let den = crate::math::cross(line.a, dir);
+    if den == 0.0 || den.is_nan() {
+        return None;
+    }
+    let tau = crate::math::cross([p2.u - c.pixel[0], p2.v - c.pixel[1]], dir) / den;
+    if tau.is_nan() || tau <= 0.0 {
+        return None;
+    }
+    let z = (g.w() + 1.0 / tau) / c.depth_scale;
+    (z.is_finite() && z > 0.0).then_some(z)
+}
+
+/// The over- and under-estimated depths of the point matched at `p2` on a
+/// boundary with local direction `dir` when each translation component `k`
+/// alone is off by `±delta[k]` (Sec. 4.2, Fig. 10), in closed form
+/// ([`depth_on_boundary`]): `[(low, high); 3]`. `None` as for that function.
+pub fn translation_error_effect(
+    cam1: &Camera,
+    cam2: &Camera,
+    motion: &Motion,
+    p1: Pixel,
+    p2: Pixel,
+    dir: [f32; 2],
+    delta: [f32; 3],
+) -> Option<[(f32, f32); 3]> {
+    let t = motion.translation();
+    let mut out = [(0.0f32, 0.0f32); 3];
+    for (k, (o, dk)) in out.iter_mut().zip(delta.iter()).enumerate() {
+        let at = |sign: f32| {
+            let mut tt = t;
+            if let Some(c) = tt.get_mut(k) {
+                *c += sign * dk;
+            }
+            let m = Motion::new(tt, motion.angles()).ok()?;
+            depth_on_boundary(cam1, cam2, &m, p1, p2, dir)
+        };
+        let (a, b) = (at(-1.0)?, at(1.0)?);
+        *o = if a <= b { (a, b) } else { (b, a) };
+    }
+    Some(out)
+}

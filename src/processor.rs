@@ -49,6 +49,8 @@ pub enum ConfigError {
     RotationError,
 }
 
+impl core::error::Error for ConfigError {}
+
 impl fmt::Display for ConfigError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
@@ -427,6 +429,8 @@ pub enum ProcessError {
     /// A previous frame exists but no motion was given.
     MissingMotion,
 }
+
+impl core::error::Error for ProcessError {}
 
 impl fmt::Display for ProcessError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

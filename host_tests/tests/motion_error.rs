@@ -3,7 +3,7 @@
 //! forward-looking tilted camera, and the guaranteed combined interval.
 
 use host_tests::{frame, point_stats, scenarios, synth, B, N};
-use roadstereo::motion_error::{depth_of_correspondence, depth_sensitivity};
+use roadstereo::motion_error::{depth_of_correspondence, depth_on_boundary, depth_sensitivity};
 use roadstereo::{Config, Motion, Processor, Status, Step};
 
 fn run(
@@ -223,4 +223,93 @@ fn rotation_error_bound_holds() {
     }
     println!("rotation error ±0.3°: {ok} unflagged sticks all contain the truth; the shift bound is at most {:.0} % used", worst_use * 100.0);
     assert!(ok > 10_000);
+}
+
+/// The over- and under-estimated depths for ±5 % of the travel in each
+/// component, in closed form (the match re-found on the boundary's local
+/// line), against the brute force: the whole pipeline re-run with the
+/// perturbed motion (new epipolar lines, new intersections on the
+/// quantised polyline). Median difference within 10 % of the change.
+#[test]
+fn over_and_under_estimates_match_retriangulation() {
+    use roadstereo::motion_error::translation_error_effect;
+    let s = scenarios::named().remove(0);
+    let r = s.render();
+    let k = s.intrinsics;
+    let cam = k.camera();
+    let m = r.motion();
+    let base = run(&r, cam, &m, Config::default());
+    let stats = point_stats(&r, &k, &base);
+    let t = m.translation();
+    let d = 0.05 * t.iter().map(|x| x * x).sum::<f32>().sqrt();
+    let mut rel = vec![Vec::new(); 3];
+    for comp in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let mut tt = t;
+            tt[comp] += sign * d;
+            let p = run(
+                &r,
+                cam,
+                &Motion::new(tt, m.angles()).unwrap(),
+                Config::default(),
+            );
+            let bs = base
+                .structure()
+                .boundaries()
+                .iter()
+                .zip(p.structure().boundaries());
+            let mut idx = 0;
+            for (b0, b1) in bs {
+                for (q0, q1) in b0.points().iter().zip(b1.points()) {
+                    let st = &stats[idx];
+                    idx += 1;
+                    if q0.status() != Status::Ok || q1.status() != Status::Ok || st.angle_deg < 30.0
+                    {
+                        continue;
+                    }
+                    let (p1, p2) = (q0.pixel1(), q0.pixel2().unwrap());
+                    // The boundary's local direction: the true frame-2
+                    // boundary near the match (the test's own data).
+                    let b2 = &r.frame2[st.boundary];
+                    let kk = b2
+                        .iter()
+                        .position(|q| q.v <= f64::from(p2.v))
+                        .unwrap_or(0)
+                        .clamp(4, b2.len() - 5);
+                    let dir = [
+                        (b2[kk + 4].u - b2[kk - 4].u) as f32,
+                        (b2[kk + 4].v - b2[kk - 4].v) as f32,
+                    ];
+                    let Some(eff) = translation_error_effect(&cam, &cam, &m, p1, p2, dir, [d; 3])
+                    else {
+                        continue;
+                    };
+                    let z0 = q0.depth().unwrap();
+                    let (lo, hi) = eff[comp];
+                    let mut tt = t;
+                    tt[comp] += sign * d;
+                    let mk = Motion::new(tt, m.angles()).unwrap();
+                    let Some(exact) = depth_on_boundary(&cam, &cam, &mk, p1, p2, dir) else {
+                        continue;
+                    };
+                    let closed = if (exact - lo).abs() < (exact - hi).abs() {
+                        lo
+                    } else {
+                        hi
+                    };
+                    let brute = q1.depth().unwrap();
+                    let change = (brute - z0).abs();
+                    if change > 1e-4 * z0 {
+                        rel[comp].push(f64::from(((closed - brute) / (brute - z0)).abs()));
+                    }
+                }
+            }
+        }
+    }
+    for (comp, r) in rel.iter_mut().enumerate() {
+        let n = r.len();
+        let med = host_tests::median(r);
+        println!("component {comp}: closed form vs pipeline re-run, median relative difference of the change {med:.3} over {n}");
+        assert!(n > 100 && med < 0.10, "component {comp}: {med}");
+    }
 }

@@ -625,6 +625,7 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
         return Err(ProcessError::MissingMotion);
     };
     let geom = PairGeometry::new(previous.camera(), frame.camera(), motion);
+    let errors = MotionErrors::new(config, &geom);
     out.camera1 = *previous.camera();
     out.boundaries.clear();
     for (k, b1) in previous.boundaries().iter().enumerate() {
@@ -709,6 +710,7 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
                 r.pixel1,
                 &c,
                 r.z_far,
+                &errors,
                 r.status == Status::Folded,
                 b2,
                 search,
@@ -717,6 +719,27 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
     }
     previous.assign(frame);
     Ok(false)
+}
+
+/// The motion-error model of one frame, worked out once per frame.
+struct MotionErrors {
+    /// Translation error bound per component, including the turn of the
+    /// compensated translation by a rotation error: `|T| Σε` (5 % added for
+    /// the second order).
+    translation: f32,
+    /// Whether a rotation error is configured (points then get the shift
+    /// bound added to their frame-1 error).
+    rotation: bool,
+}
+
+impl MotionErrors {
+    fn new(config: &Config, geom: &PairGeometry) -> Self {
+        let [ex, ey, ez] = config.rotation_error;
+        Self {
+            translation: config.translation_error + 1.05 * geom.translation_norm() * (ex + ey + ez),
+            rotation: ex + ey + ez > 0.0,
+        }
+    }
 }
 
 fn flagged(pixel1: Pixel, status: Status) -> PointResult {
@@ -736,6 +759,7 @@ fn evaluate<S: CrossingSearch>(
     p1: Pixel,
     c: &Compensated,
     key: f32,
+    errors: &MotionErrors,
     folded: bool,
     b2: Option<&[Pixel]>,
     search: &mut S,
@@ -745,7 +769,7 @@ fn evaluate<S: CrossingSearch>(
     line.key = key;
     let w = geom.w();
     let mut r1 = config.e1 * c.stretch;
-    if config.rotation_error != [0.0; 3] {
+    if errors.rotation {
         r1 += crate::motion_error::rotation_shift_bound(
             c.pixel,
             geom.camera2_intrinsics(),
@@ -809,11 +833,7 @@ fn evaluate<S: CrossingSearch>(
         r.status = Status::BeyondMaxDepth;
         return r;
     }
-    // A rotation error also turns the compensated translation T' = Rᵀ T by
-    // up to Σε: a translation error of at most |T| Σε (5 % added for the
-    // second order) in every component.
-    let [ex, ey, ez] = config.rotation_error;
-    let t_error = config.translation_error + 1.05 * geom.translation_norm() * (ex + ey + ez);
+    let t_error = errors.translation;
     let interval = if t_error > 0.0 {
         let (spread_a, spread_w) = crate::motion_error::spread(
             geom.rotation(),

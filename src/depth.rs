@@ -48,8 +48,10 @@
 //! `s_far = W' + (1 + |W'| r₁/|a|) / (τ − ε/|a|)`,
 //! `s_near = W' + (1 − |W'| r₁/|a|) / (τ + ε/|a|)`.
 //!
-//! When `τ ≤ ε/|a|` the disparity is not larger than its error and the far
-//! end is unbounded ([`crate::Status::Unbounded`]). The boundary direction
+//! A sideways offset `h` of the true line also lengthens the true disparity,
+//! by at most `h²/2(D − ε)`, which the near end allows for. When
+//! `τ ≤ ε/|a|` the disparity is not larger than its error and the far end is
+//! unbounded ([`crate::Status::Unbounded`]). The boundary direction
 //! is measured over a chord of up to `2·CHORD_HALF_WINDOW + 1` points; the
 //! error of that chord's direction (at most `2 e₂ / L` for a chord of length
 //! `L`) is taken off `sin φ` before it is used, so the stick stays a bound;
@@ -102,37 +104,10 @@ pub(crate) fn crossing_angle(a: [f32; 2], a_len: f32, chord: [f32; 2], e2: f32) 
     (sin - 2.0 * e2 / l, fmin(cos, 1.0))
 }
 
-/// The stick for a match at `tau` (see the module docs).
-/// Returns `None` when the far end is unbounded.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn stick(
-    w: f32,
-    tau: f32,
-    a_len: f32,
-    r1: f32,
-    e2: f32,
-    sin_low: f32,
-    cos: f32,
-    depth_scale: f32,
-) -> Option<DepthInterval> {
-    // Callers guarantee a_len > 0, sin_low > 0 and depth_scale > 0.
-    let h1 = r1 * fmax(1.0 + w * tau, 0.0);
-    let delta2 = (e2 + h1 * cos) / sin_low;
-    let eps_tau = (r1 + delta2) / a_len;
-    let rel = w.abs() * r1 / a_len;
-    let tau_far = tau - eps_tau;
-    if tau_far <= 0.0 {
-        return None;
-    }
-    let s_far = w + (1.0 + rel) / tau_far;
-    let s_near = w + fmax(1.0 - rel, 0.0) / (tau + eps_tau);
-    let z_far = s_far / depth_scale;
-    let z_near = fmax(s_near / depth_scale, 0.0);
-    (z_far.is_finite() && z_far >= z_near).then_some(DepthInterval { z_near, z_far })
-}
-
-/// The stick when, in addition, each component of the translation used may
-/// be off by up to `delta` (see [`crate::Config::with_translation_error`]).
+/// The stick for a match at `tau` (see the module docs), also when each
+/// component of the translation used may be off by up to `delta` (see
+/// [`crate::Config::with_translation_error`]; `spread_a = spread_w = 0`
+/// without translation error).
 ///
 /// With the true translation anywhere in that box, `|a|` may differ from
 /// ours by `spread_a` and `W'` by `spread_w`
@@ -148,7 +123,7 @@ pub(crate) fn stick(
 /// (the last term: a sideways offset lengthens the true disparity at most by
 /// that much). `None` when the far end is unbounded.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn stick_with_translation_error(
+pub(crate) fn stick(
     w: f32,
     tau: f32,
     a_len: f32,

@@ -11,9 +11,7 @@ use core::fmt;
 
 use crate::boundary::Frame;
 use crate::camera::{Camera, Pixel};
-use crate::depth::{
-    chord, crossing_angle, stick, stick_with_translation_error, DepthInterval, CHORD_HALF_WINDOW,
-};
+use crate::depth::{chord, crossing_angle, stick, DepthInterval, CHORD_HALF_WINDOW};
 use crate::epipolar::{
     Compensated, CrossingSearch, Crossings, EpipolarLine, IndexedSearch, PairGeometry,
     MAX_CROSSINGS,
@@ -833,38 +831,28 @@ fn evaluate<S: CrossingSearch>(
         r.status = Status::BeyondMaxDepth;
         return r;
     }
-    let t_error = errors.translation;
-    let interval = if t_error > 0.0 {
-        let (spread_a, spread_w) = crate::motion_error::spread(
+    let (spread_a, spread_w) = if errors.translation > 0.0 {
+        crate::motion_error::spread(
             geom.rotation(),
             geom.camera2_intrinsics(),
             c.pixel,
-            t_error,
-        );
-        stick_with_translation_error(
-            w,
-            best.tau,
-            a_len,
-            r1,
-            config.e2,
-            sin_low,
-            cos,
-            c.depth_scale,
-            spread_a,
-            spread_w,
+            errors.translation,
         )
     } else {
-        stick(
-            w,
-            best.tau,
-            a_len,
-            r1,
-            config.e2,
-            sin_low,
-            cos,
-            c.depth_scale,
-        )
+        (0.0, 0.0)
     };
+    let interval = stick(
+        w,
+        best.tau,
+        a_len,
+        r1,
+        config.e2,
+        sin_low,
+        cos,
+        c.depth_scale,
+        spread_a,
+        spread_w,
+    );
     match interval {
         Some(i) => {
             r.z = z;

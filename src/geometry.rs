@@ -195,35 +195,49 @@ fn width_at<const N: usize>(a: &[Sample], b: &[Sample], s: f32, c: f32) -> Optio
     d.get(n / 2).copied()
 }
 
-/// Camera height, tilt and road width from the samples of the left and the
-/// right boundary (each in order along its boundary, at most `N`), allowing
-/// `outliers` points per tilt to disagree with the plane.
+/// Most views (frame pairs) [`road_geometry`] combines.
+pub const MAX_VIEWS: usize = 16;
+
+/// Camera height, tilt and road width from one or more views — the samples
+/// of the left and the right boundary of a reconstruction (each in order
+/// along its boundary) — of the same road from the same camera mounting,
+/// e.g. successive frame pairs. A `(θ, h)` must agree with the points of
+/// all views (all but `outliers` of them, for wrong matches); the width is
+/// the median over the views of each view's median boundary distance. `N`
+/// is the capacity for all points together; more are left out (the
+/// farther points of each view first).
 ///
-/// Work: `O(G · M log M + G · M²)` for `M` points and `G = 1200` tilts — a
-/// check of the reconstruction, not a per-frame task.
+/// Work: `O(G · M log M + G · V · m²)` for `M` points in all, `V` views of
+/// `m` points and `G = 1200` tilts — a check of the reconstruction, not a
+/// per-frame task.
 pub fn road_geometry<const N: usize>(
-    left: &[Sample],
-    right: &[Sample],
+    views: &[(&[Sample], &[Sample])],
     outliers: usize,
 ) -> Result<RoadGeometry, GeometryError> {
-    if left.len() < 10 || right.len() < 10 || left.len() > N || right.len() > N {
+    if views.is_empty()
+        || views.len() > MAX_VIEWS
+        || views
+            .iter()
+            .any(|(l, r)| l.len() < 10 || r.len() < 10 || l.len() > N || r.len() > N)
+    {
         return Err(GeometryError::TooFewPoints);
     }
-    let mut both = [Sample::default(); N];
+    let mut all = [Sample::default(); N];
     let mut n = 0;
-    // The plane fit uses both boundaries (the road is taken as planar over
-    // the points given; pass the near part of a hilly road). N bounds the
-    // total: beyond it, the farther points of each side are left out.
-    for side in [left, right] {
-        let take = side.len().min(N / 2).max(5);
-        for p in side.iter().take(take) {
-            if let Some(slot) = both.get_mut(n) {
-                *slot = *p;
-                n += 1;
+    // The plane fit uses every boundary of every view (the road is taken as
+    // planar over the points given; pass the near part of a hilly road).
+    let share = (N / (2 * views.len())).max(5);
+    for (l, r) in views {
+        for side in [*l, *r] {
+            for p in side.iter().take(share) {
+                if let Some(slot) = all.get_mut(n) {
+                    *slot = *p;
+                    n += 1;
+                }
             }
         }
     }
-    let pts = both.get(..n).ok_or(GeometryError::TooFewPoints)?;
+    let pts = all.get(..n).ok_or(GeometryError::TooFewPoints)?;
     let (mut tilt, mut height, mut width) = (
         Range {
             lo: f32::INFINITY,
@@ -246,9 +260,20 @@ pub fn road_geometry<const N: usize>(
             tilt.hi = fmax(tilt.hi, t);
             height.lo = fmin(height.lo, h.lo);
             height.hi = fmax(height.hi, h.hi);
-            if let Some(w1) = width_at::<N>(left, right, s, c) {
-                width.lo = fmin(width.lo, w1 * h.lo);
-                width.hi = fmax(width.hi, w1 * h.hi);
+            let mut w = [0.0f32; MAX_VIEWS];
+            let mut k = 0;
+            for ((l, r), slot) in views.iter().zip(w.iter_mut()) {
+                if let Some(w1) = width_at::<N>(l, r, s, c) {
+                    *slot = w1;
+                    k += 1;
+                }
+            }
+            if let Some(ws) = w.get_mut(..k) {
+                ws.sort_unstable_by(f32::total_cmp);
+                if let Some(&w1) = ws.get(k / 2) {
+                    width.lo = fmin(width.lo, w1 * h.lo);
+                    width.hi = fmax(width.hi, w1 * h.hi);
+                }
             }
         }
         t += TILT_STEP;

@@ -20,6 +20,33 @@ fn run(
     p
 }
 
+/// Asserts that every unflagged stick whose true correspondent is in frame 2
+/// contains the truth; returns their relative lengths `(Z_far − Z_near)/Z`.
+fn contained_sticks(
+    r: &synth::Rendered,
+    k: &synth::Intrinsics,
+    p: &Processor<N, B>,
+    seed: u64,
+) -> Vec<f64> {
+    let mut out = Vec::new();
+    for st in point_stats(r, k, p) {
+        if st.status != Status::Ok || !st.observed {
+            continue;
+        }
+        assert!(
+            st.contained(),
+            "seed {seed} b{} i{}: true {} outside [{}, {}]",
+            st.boundary,
+            st.index,
+            st.z_true,
+            st.z_near,
+            st.z_far
+        );
+        out.push((st.z_far - st.z_near) / st.z);
+    }
+    out
+}
+
 /// The closed-form derivatives equal the derivatives of the exact
 /// re-triangulation of the same correspondence (central differences), to
 /// 2 % of the largest component.
@@ -133,21 +160,9 @@ fn combined_interval_holds_under_translation_error() {
         };
         let config = Config::default().with_translation_error(delta).unwrap();
         let p = run(&r, cam, &mu, config);
-        for st in point_stats(&r, &k, &p) {
-            if st.status != Status::Ok || !st.observed {
-                continue;
-            }
-            assert!(
-                st.contained(),
-                "seed {seed} b{} i{}: true {} outside [{}, {}]",
-                st.boundary,
-                st.index,
-                st.z_true,
-                st.z_near,
-                st.z_far
-            );
+        for z in contained_sticks(&r, &k, &p, seed) {
             ok += 1;
-            ratios.push((st.z_far - st.z_near) / st.z);
+            ratios.push(z);
         }
     }
     println!(
@@ -208,21 +223,7 @@ fn rotation_error_bound_holds() {
         let mu = Motion::new(m.translation(), used).unwrap();
         let config = Config::default().with_rotation_error([eps; 3]).unwrap();
         let p = run(&r, cam, &mu, config);
-        for st in point_stats(&r, &k, &p) {
-            if st.status != Status::Ok || !st.observed {
-                continue;
-            }
-            assert!(
-                st.contained(),
-                "seed {seed} b{} i{}: true {} outside [{}, {}]",
-                st.boundary,
-                st.index,
-                st.z_true,
-                st.z_near,
-                st.z_far
-            );
-            ok += 1;
-        }
+        ok += contained_sticks(&r, &k, &p, seed).len();
     }
     println!("rotation error ±0.3°: {ok} unflagged sticks all contain the truth; the shift bound is at most {:.0} % used", worst_use * 100.0);
     assert!(ok > 10_000);

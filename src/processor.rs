@@ -426,6 +426,8 @@ pub enum Step<'a, const N: usize, const B: usize> {
 pub enum ProcessError {
     /// A previous frame exists but no motion was given.
     MissingMotion,
+    /// [`Processor::process_against_kept`] was called with no kept frame.
+    NoKeptFrame,
 }
 
 impl core::error::Error for ProcessError {}
@@ -434,6 +436,7 @@ impl fmt::Display for ProcessError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
             Self::MissingMotion => "a motion from the previous frame is required",
+            Self::NoKeptFrame => "there is no kept frame to reconstruct against",
         })
     }
 }
@@ -530,6 +533,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             output,
             frame,
             motion,
+            true,
             &mut OwnIndex(search),
         )?;
         Ok(if first {
@@ -562,8 +566,46 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             output,
             frame,
             motion,
+            true,
             &mut WithSearch(index, search),
         )
+    }
+
+    /// Reconstruct `frame` against the kept frame *without replacing it*,
+    /// which makes the kept frame a key frame; `motion` is from the kept
+    /// frame to `frame`. Pairing one key frame with several later frames
+    /// gives views of the same boundary points with longer baselines: the
+    /// disparity grows with the travel (eq. 2.3; the motion factor `F` of
+    /// eq. 3.4) and the sticks shrink with it, which is how
+    /// [`crate::geometry::road_geometry`] fuses frames. Errors leave the kept
+    /// state unchanged; with no kept frame this is
+    /// [`ProcessError::NoKeptFrame`].
+    pub fn process_against_kept(
+        &mut self,
+        frame: &Frame<N, B>,
+        motion: &Motion,
+    ) -> Result<&Structure<N, B>, ProcessError> {
+        if !self.has_previous {
+            return Err(ProcessError::NoKeptFrame);
+        }
+        let Self {
+            config,
+            previous,
+            has_previous,
+            search,
+            output,
+        } = self;
+        run(
+            config,
+            previous,
+            has_previous,
+            output,
+            frame,
+            Some(motion),
+            false,
+            &mut OwnIndex(search),
+        )?;
+        Ok(&self.output)
     }
 
     /// The output of the last successful reconstruction (empty before one).
@@ -605,6 +647,7 @@ impl<const N: usize, S: CrossingSearch> Searches<N> for WithSearch<'_, N, S> {
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 fn run<const N: usize, const B: usize, S: Searches<N>>(
     config: &Config,
     previous: &mut Frame<N, B>,
@@ -612,6 +655,7 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
     out: &mut Structure<N, B>,
     frame: &Frame<N, B>,
     motion: Option<&Motion>,
+    replace: bool,
     searches: &mut S,
 ) -> Result<bool, ProcessError> {
     if !*has_previous {
@@ -715,7 +759,9 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
             );
         }
     }
-    previous.assign(frame);
+    if replace {
+        previous.assign(frame);
+    }
     Ok(false)
 }
 

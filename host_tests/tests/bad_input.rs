@@ -200,6 +200,27 @@ fn no_previous_frame_is_reported() {
     assert_eq!(p.previous(), Some(&g.f2));
     p.reset();
     assert_eq!(p.previous(), None);
+    // A key-frame reconstruction needs a kept frame.
+    let e = p
+        .process_against_kept(&g.f2, &g.m)
+        .expect_err("no kept frame");
+    assert_eq!(e, ProcessError::NoKeptFrame);
+    assert_eq!(p.previous(), None);
+}
+
+/// A key-frame reconstruction gives the same structure as the ordinary one
+/// and keeps the key frame: the next frame is paired with it again.
+#[test]
+fn key_frame_is_kept() {
+    let g = good();
+    let want = reference(&g);
+    let mut p = Box::new(Processor::<N, B>::new(Config::default()));
+    assert!(matches!(p.process(&g.f1, None), Ok(Step::First)));
+    for _ in 0..2 {
+        let s = p.process_against_kept(&g.f2, &g.m).expect("structure");
+        assert_eq!(s, want.structure());
+        assert_eq!(p.previous(), Some(&g.f1));
+    }
 }
 
 /// A point at the focus of expansion has no disparity: flagged, and the

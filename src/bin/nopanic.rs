@@ -66,6 +66,16 @@ fn main() -> ! {
                 black_box(e);
             }
         }
+        if let Some(m) = motion.as_ref().filter(|_| black_box(true)) {
+            match processor.process_against_kept(black_box(&frame), m) {
+                Ok(s) => {
+                    black_box(s.digest());
+                }
+                Err(e) => {
+                    black_box(e);
+                }
+            }
+        }
         if black_box(false) {
             processor.reset();
         }

@@ -404,6 +404,24 @@ pub trait CrossingSearch {
     fn search(&mut self, line: &EpipolarLine, boundary: &[Pixel], out: &mut Crossings);
 }
 
+/// The running extremes of the keys before a vertex, for
+/// [`IndexedSearch::folded_at`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FoldPrefix {
+    min: f32,
+    max: f32,
+}
+
+impl FoldPrefix {
+    /// Nothing seen yet.
+    pub(crate) fn new() -> Self {
+        Self {
+            min: f32::INFINITY,
+            max: f32::NEG_INFINITY,
+        }
+    }
+}
+
 /// Segments with an unkeyable end (at the FOE) an index keeps aside; with
 /// more, every search scans the whole boundary.
 const MAX_UNKEYED: usize = 4;
@@ -450,6 +468,10 @@ pub struct IndexedSearch<const N: usize> {
     unkeyed: heapless::Vec<usize, MAX_UNKEYED>,
     /// Too many unkeyed segments: every search scans the whole boundary.
     scan: bool,
+    /// Built for the fold test with every segment keyed and the keys
+    /// spanning less than a turn: `hi`/`lo` then hold the suffix maximum
+    /// and minimum of the keys and [`Self::folded_at`] answers in `O(1)`.
+    fold_fast: bool,
     segments: usize,
     /// Range of the unwrapped keys.
     kmin: f32,
@@ -520,6 +542,7 @@ impl<const N: usize> IndexedSearch<N> {
             hint: 0,
             unkeyed: heapless::Vec::new(),
             scan: false,
+            fold_fast: false,
             segments: 0,
             kmin: 0.0,
             kmax: 0.0,
@@ -549,6 +572,7 @@ impl<const N: usize> IndexedSearch<N> {
         self.key = *key;
         self.unkeyed.clear();
         self.scan = false;
+        self.fold_fast = false;
         self.hint = 0;
         self.period = match key {
             PencilKey::Angular { .. } => 4.0,
@@ -559,8 +583,11 @@ impl<const N: usize> IndexedSearch<N> {
         let mut n: usize = 0;
         let mut prev = NO_KEY;
         let mut offset = 0.0f32;
+        // Every vertex keyed and no segment through the FOE.
+        let mut all_keyed = true;
         for (slot, raw) in self.keys.iter_mut().zip(keys) {
             let mut k = raw;
+            all_keyed &= k.is_finite();
             if k.is_finite() {
                 k += offset;
                 if self.period > 0.0 && prev.is_finite() {
@@ -575,6 +602,7 @@ impl<const N: usize> IndexedSearch<N> {
                         offset += 4.0;
                         k += 4.0;
                     }
+                    all_keyed &= self.period <= 0.0 || ((k - prev).abs() - 2.0).abs() >= 1.0e-3;
                 }
                 kmin = fmin(kmin, k);
                 kmax = fmax(kmax, k);
@@ -596,16 +624,43 @@ impl<const N: usize> IndexedSearch<N> {
         };
         let o = if last >= first { 1.0 } else { -1.0 };
         self.orient = o;
-        let s = self.segments;
+        if !unkeyed_meets_all
+            && all_keyed
+            && (self.period <= 0.0 || kmax - kmin < self.period - 0.1)
+        {
+            // The fold test's fast form: suffix extremes of the keys.
+            if let (Some(keys), Some(smax), Some(smin)) = (
+                self.keys.get(..n),
+                self.hi.get_mut(..n),
+                self.lo.get_mut(..n),
+            ) {
+                let (mut mx, mut mn) = (f32::NEG_INFINITY, f32::INFINITY);
+                for ((&k, h), l) in keys.iter().zip(smax.iter_mut()).zip(smin.iter_mut()).rev() {
+                    mx = fmax(mx, k);
+                    mn = fmin(mn, k);
+                    *h = mx;
+                    *l = mn;
+                }
+                self.fold_fast = true;
+                return;
+            }
+        }
+        self.envelopes(unkeyed_meets_all);
+    }
+
+    /// The running envelopes `hi`, `lo` of the oriented keys (and the list
+    /// of unkeyed segments) for the general search.
+    fn envelopes(&mut self, unkeyed_meets_all: bool) {
+        let (s, o, period) = (self.segments, self.orient, self.period);
         let (Some(keys), Some(hi), Some(lo)) = (
-            self.keys.get(..n),
+            self.keys.get(..s + 1),
             self.hi.get_mut(..s),
             self.lo.get_mut(..s),
         ) else {
             self.scan = true;
             return;
         };
-        let keyed = |k0: f32, k1: f32, period: f32| {
+        let keyed = |k0: f32, k1: f32| {
             k0.is_finite()
                 && k1.is_finite()
                 && !(period > 0.0 && ((k1 - k0).abs() - 2.0).abs() < 1.0e-3)
@@ -613,7 +668,7 @@ impl<const N: usize> IndexedSearch<N> {
         let mut run = f32::NEG_INFINITY;
         for (j, (w, h)) in keys.windows(2).zip(hi.iter_mut()).enumerate() {
             if let [k0, k1] = *w {
-                if keyed(k0, k1, self.period) {
+                if keyed(k0, k1) {
                     run = fmax(run, fmax(o * k0, o * k1));
                 } else if unkeyed_meets_all && self.unkeyed.push(j).is_err() {
                     self.scan = true;
@@ -624,7 +679,7 @@ impl<const N: usize> IndexedSearch<N> {
         let mut run = f32::INFINITY;
         for (w, l) in keys.windows(2).rev().zip(lo.iter_mut().rev()) {
             if let [k0, k1] = *w {
-                if keyed(k0, k1, self.period) {
+                if keyed(k0, k1) {
                     run = fmin(run, fmin(o * k0, o * k1));
                 }
             }
@@ -749,6 +804,38 @@ impl<const N: usize> IndexedSearch<N> {
         self.build(key, false, keys);
     }
 
+    /// Whether [`Self::folded_at`] applies (built by [`Self::prepare_keys`]
+    /// with every segment keyed and less than a turn of keys).
+    pub(crate) fn fold_fast(&self) -> bool {
+        self.fold_fast
+    }
+
+    /// The fold test of vertex `i` in `O(1)`, for `i = 0, 1, …` in order
+    /// (`prefix` carries the extremes of the keys of vertices `0..=i−4`
+    /// between calls; start with [`FoldPrefix::new`]): the same answer as
+    /// [`Self::meets_outside`] for the vertex's own key and the segments
+    /// outside `i−4 ..= i+3`. The segments `j ≤ i−5` form a connected
+    /// path over the vertices `0..=i−4`, so the union of their widened key
+    /// ranges is the one interval `[min − ε, max + ε]` of those keys; the
+    /// same holds for the segments `j ≥ i+4` and the vertices from `i+4`.
+    pub(crate) fn folded_at(&self, i: usize, prefix: &mut FoldPrefix) -> bool {
+        let eps = self.eps;
+        let Some(&k) = self.keys.get(i) else {
+            return false;
+        };
+        if let Some(&v) = i.checked_sub(4).and_then(|t| self.keys.get(t)) {
+            prefix.min = fmin(prefix.min, v);
+            prefix.max = fmax(prefix.max, v);
+        }
+        let left = i >= 5 && prefix.min - eps <= k && k <= prefix.max + eps;
+        let right = i + 5 <= self.segments
+            && match (self.lo.get(i + 4), self.hi.get(i + 4)) {
+                (Some(&mn), Some(&mx)) => mn - eps <= k && k <= mx + eps,
+                _ => false,
+            };
+        left || right
+    }
+
     /// Whether the indexed polyline meets the line with key `q` at a segment
     /// outside `skip` (inclusive segment range). Unkeyable lines answer yes.
     pub(crate) fn meets_outside(&mut self, q: f32, skip: (usize, usize)) -> bool {
@@ -811,5 +898,75 @@ impl<const N: usize> CrossingSearch for IndexedSearch<N> {
             }
             true
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deterministic generator (xorshift), values in `[0, 1)`.
+    struct Rng(u32);
+    impl Rng {
+        fn next(&mut self) -> f32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 17;
+            self.0 ^= self.0 << 5;
+            (self.0 >> 8) as f32 / (1u32 << 24) as f32
+        }
+    }
+
+    /// The `O(1)` fold test answers exactly as the general index query, on
+    /// key sequences that jitter (steps around the key margin), fold back,
+    /// wrap round at 4, for both kinds of key.
+    #[test]
+    fn fast_fold_test_equals_the_general_query() {
+        const M: usize = 64;
+        let mut rng = Rng(0x9e37_79b9);
+        let (mut fast_cases, mut folds) = (0, 0);
+        for case in 0..4000 {
+            let projective = case % 3 == 0;
+            let key = if projective {
+                PencilKey::Projective {
+                    c: [0.0, 0.0],
+                    g_hat: [1.0, 0.0],
+                    g_norm: 1.0,
+                    w: 0.0,
+                }
+            } else {
+                PencilKey::Angular {
+                    foe: [0.0, 0.0],
+                    sign_w: 1.0,
+                }
+            };
+            let n = 2 + (rng.next() * (M - 2) as f32) as usize;
+            let scale = [3.0e-5, 1.0e-4, 1.0e-3, 0.05][case % 4];
+            let drift = (rng.next() - 0.5) * scale;
+            let mut keys = [0.0f32; M];
+            let mut k = rng.next() * 4.0;
+            for slot in keys.iter_mut().take(n) {
+                *slot = if projective { k * 100.0 } else { k.rem_euclid(4.0) };
+                // Drift plus jitter; now and then a turn back.
+                let back = if rng.next() < 0.03 { -30.0 * drift } else { 0.0 };
+                k += drift + (rng.next() - 0.5) * scale + back;
+            }
+            let mut fast = IndexedSearch::<M>::new();
+            fast.prepare_keys(&key, keys.iter().take(n).copied());
+            if !fast.fold_fast() {
+                continue;
+            }
+            fast_cases += 1;
+            let mut slow = fast.clone();
+            slow.fold_fast = false;
+            slow.envelopes(false);
+            let mut prefix = FoldPrefix::new();
+            for i in 0..n {
+                let want = slow.meets_outside(fast.keys[i], (i.saturating_sub(4), i + 3));
+                let got = fast.folded_at(i, &mut prefix);
+                assert_eq!(got, want, "case {case}, vertex {i} of {n}");
+                folds += usize::from(got);
+            }
+        }
+        assert!(fast_cases > 3000 && folds > 1000, "{fast_cases} {folds}");
     }
 }

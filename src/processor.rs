@@ -13,7 +13,7 @@ use crate::boundary::Frame;
 use crate::camera::{Camera, Pixel};
 use crate::depth::{chord, crossing_angle, stick, DepthInterval, CHORD_HALF_WINDOW};
 use crate::epipolar::{
-    Compensated, CrossingSearch, Crossings, EpipolarLine, IndexedSearch, PairGeometry,
+    Compensated, CrossingSearch, Crossings, EpipolarLine, FoldPrefix, IndexedSearch, PairGeometry,
     MAX_CROSSINGS,
 };
 use crate::math::sqrt;
@@ -718,8 +718,13 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
                 }
             }),
         );
+        let mut prefix = FoldPrefix::new();
         for (i, r) in bs.points.iter_mut().enumerate() {
-            if r.status != Status::BehindCamera
+            if index.fold_fast() {
+                if index.folded_at(i, &mut prefix) {
+                    r.status = Status::Folded;
+                }
+            } else if r.status != Status::BehindCamera
                 && index.meets_outside(
                     r.z_far,
                     (

@@ -945,9 +945,17 @@ mod tests {
             let mut keys = [0.0f32; M];
             let mut k = rng.next() * 4.0;
             for slot in keys.iter_mut().take(n) {
-                *slot = if projective { k * 100.0 } else { k.rem_euclid(4.0) };
+                *slot = if projective {
+                    k * 100.0
+                } else {
+                    k.rem_euclid(4.0)
+                };
                 // Drift plus jitter; now and then a turn back.
-                let back = if rng.next() < 0.03 { -30.0 * drift } else { 0.0 };
+                let back = if rng.next() < 0.03 {
+                    -30.0 * drift
+                } else {
+                    0.0
+                };
                 k += drift + (rng.next() - 0.5) * scale + back;
             }
             let mut fast = IndexedSearch::<M>::new();

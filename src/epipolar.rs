@@ -398,10 +398,34 @@ impl PairGeometry {
 pub trait CrossingSearch {
     /// Called once for each frame-2 boundary before its lines are searched.
     fn prepare(&mut self, boundary: &[Pixel], key: &PencilKey);
-    /// Push the crossings of `line`'s ray with `boundary` (the one last
-    /// prepared) into `out`, each found by [`EpipolarLine::crossing`],
-    /// stopping when `out` is full. The order does not matter.
-    fn search(&mut self, line: &EpipolarLine, boundary: &[Pixel], out: &mut Crossings);
+    /// Call `visit` with every crossing of `line`'s ray with `boundary`
+    /// (the one last prepared), each found by [`EpipolarLine::crossing`],
+    /// until `visit` returns `false`. The order does not matter.
+    fn search<F: FnMut(Crossing) -> bool>(
+        &mut self,
+        line: &EpipolarLine,
+        boundary: &[Pixel],
+        visit: F,
+    );
+
+    /// [`CrossingSearch::search`] into `out`, stopping when it is full.
+    fn collect(&mut self, line: &EpipolarLine, boundary: &[Pixel], out: &mut Crossings) {
+        self.search(line, boundary, |c| out.push(c).is_ok());
+    }
+}
+
+/// Every crossing of `line` with `boundary`, segment by segment, until
+/// `visit` returns `false`.
+fn scan_all<F: FnMut(Crossing) -> bool>(line: &EpipolarLine, boundary: &[Pixel], mut visit: F) {
+    for (j, w) in boundary.windows(2).enumerate() {
+        if let [v0, v1] = w {
+            if let Some(c) = line.crossing(j, *v0, *v1) {
+                if !visit(c) {
+                    return;
+                }
+            }
+        }
+    }
 }
 
 /// The running extremes of the keys before a vertex, for
@@ -767,37 +791,6 @@ impl<const N: usize> IndexedSearch<N> {
         true
     }
 
-    /// Visit every segment whose key range (widened) holds the key `q`,
-    /// until `visit` returns `false`. Unkeyed segments are always visited.
-    fn sweep(&mut self, q: f32, mut visit: impl FnMut(usize) -> bool) {
-        let turns = if self.scan || !q.is_finite() {
-            None
-        } else {
-            self.turns(q)
-        };
-        let Some((first, count)) = turns else {
-            for j in 0..self.segments {
-                if !visit(j) {
-                    return;
-                }
-            }
-            return;
-        };
-        for &j in self.unkeyed.iter() {
-            if !visit(j) {
-                return;
-            }
-        }
-        let mut qq = first;
-        for _ in 0..count {
-            let (a, b) = self.run_for(qq);
-            if a < b && !self.candidates(a, b, qq, &mut visit) {
-                return;
-            }
-            qq += self.period;
-        }
-    }
-
     /// Index the rotation-compensated frame-1 boundary (for the fold test)
     /// from the keys of its compensated points.
     pub(crate) fn prepare_keys(&mut self, key: &PencilKey, keys: impl Iterator<Item = f32>) {
@@ -871,33 +864,74 @@ impl<const N: usize> CrossingSearch for IndexedSearch<N> {
         self.build(key, true, boundary.iter().map(|p| key.vertex(p.arr())));
     }
 
-    fn search(&mut self, line: &EpipolarLine, boundary: &[Pixel], out: &mut Crossings) {
-        if boundary.len() != self.segments + 1 {
-            // Not the boundary this index was prepared for: scan it.
-            for (j, w) in boundary.windows(2).enumerate() {
-                if let [v0, v1] = w {
-                    if let Some(c) = line.crossing(j, *v0, *v1) {
-                        if out.push(c).is_err() {
-                            return;
-                        }
-                    }
-                }
-            }
-            return;
-        }
+    /// The sweep of [`IndexedSearch`] written out for the crossing search:
+    /// the run start from the hint (probes, then bisection), then the
+    /// candidates while the suffix minimum `lo` allows, each confirmed by
+    /// the exact side test.
+    fn search<F: FnMut(Crossing) -> bool>(
+        &mut self,
+        line: &EpipolarLine,
+        boundary: &[Pixel],
+        mut visit: F,
+    ) {
+        let s = self.segments;
         let q = if line.key.is_finite() {
             line.key
         } else {
             self.key.line(line)
         };
-        self.sweep(q, |j| {
+        let turns = if boundary.len() != s + 1 || self.scan || !q.is_finite() {
+            // Not the boundary this index was prepared for, or no key.
+            None
+        } else {
+            self.turns(q)
+        };
+        let Some((first, count)) = turns else {
+            scan_all(line, boundary, visit);
+            return;
+        };
+        for &j in self.unkeyed.iter() {
             if let (Some(v0), Some(v1)) = (boundary.get(j), boundary.get(j + 1)) {
                 if let Some(c) = line.crossing(j, *v0, *v1) {
-                    return out.push(c).is_ok();
+                    if !visit(c) {
+                        return;
+                    }
                 }
             }
-            true
-        });
+        }
+        let (Some(keys), Some(hi), Some(lo)) =
+            (self.keys.get(..s + 1), self.hi.get(..s), self.lo.get(..s))
+        else {
+            return;
+        };
+        let (o, eps, period) = (self.orient, self.eps, self.period);
+        let mut qq = first;
+        for _ in 0..count {
+            let oq = o * qq;
+            let a = first_at_least(hi, oq - eps, self.hint);
+            self.hint = a;
+            let t_hi = oq + eps;
+            let (Some(lo), Some(keys), Some(pts)) = (lo.get(a..), keys.get(a..), boundary.get(a..))
+            else {
+                break;
+            };
+            for (j, ((&l, k), v)) in (a..).zip(lo.iter().zip(keys.windows(2)).zip(pts.windows(2))) {
+                if l > t_hi {
+                    break;
+                }
+                if let (&[k0, k1], [v0, v1]) = (k, v) {
+                    let (mn, mx) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
+                    if mn - eps <= qq && qq <= mx + eps && self.keyed(k0, k1) {
+                        if let Some(c) = line.crossing(j, *v0, *v1) {
+                            if !visit(c) {
+                                return;
+                            }
+                        }
+                    }
+                }
+            }
+            qq += period;
+        }
     }
 }
 

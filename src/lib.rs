@@ -46,7 +46,8 @@ pub use boundary::{Boundary, BoundaryError, Frame};
 pub use camera::{Camera, CameraError, Pixel, IMAGE_MARGIN_PX};
 pub use depth::DepthInterval;
 pub use epipolar::{
-    CrossingSearch, Crossings, EpipolarLine, PairGeometry, MAX_CROSSINGS, MAX_RAY_CROSSINGS,
+    Crossing, CrossingSearch, Crossings, EpipolarLine, PairGeometry, MAX_CROSSINGS,
+    MAX_RAY_CROSSINGS,
 };
 pub use motion::{Motion, MotionError};
 pub use processor::{

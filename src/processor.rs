@@ -13,8 +13,8 @@ use crate::boundary::Frame;
 use crate::camera::{Camera, Pixel};
 use crate::depth::{chord, crossing_angle, stick, DepthInterval, CHORD_HALF_WINDOW};
 use crate::epipolar::{
-    Compensated, CrossingSearch, Crossings, EpipolarLine, FoldPrefix, IndexedSearch, PairGeometry,
-    MAX_CROSSINGS,
+    Compensated, CrossingSearch, EpipolarLine, FoldPrefix, IndexedSearch, PairGeometry,
+    MAX_CROSSINGS, MAX_RAY_CROSSINGS,
 };
 use crate::math::sqrt;
 use crate::motion::Motion;
@@ -833,20 +833,28 @@ fn evaluate<S: CrossingSearch>(
     let Some(b2) = b2 else {
         return flagged(p1, Status::NoIntersection);
     };
-    let mut crossings = Crossings::new();
-    search.search(&line, b2, &mut crossings);
-    if crossings.is_full() {
-        // More than MAX_RAY_CROSSINGS: the boundary runs along the ray.
-        return flagged(p1, Status::Tangled);
-    }
+    // Every crossing of the ray, up to one more than can be told apart;
+    // those in the search range are counted and the one nearest p₁' kept.
+    let mut on_ray = 0usize;
     let mut best: Option<crate::epipolar::Crossing> = None;
     let mut valid = 0;
-    for x in crossings.iter().filter(|x| line.in_search_range(x)) {
-        valid += 1;
-        best = match best {
-            Some(b) if (b.tau, b.segment) <= (x.tau, x.segment) => Some(b),
-            _ => Some(*x),
-        };
+    search.search(&line, b2, |x| {
+        on_ray += 1;
+        if on_ray > MAX_RAY_CROSSINGS {
+            return false;
+        }
+        if line.in_search_range(&x) {
+            valid += 1;
+            best = match best {
+                Some(b) if (b.tau, b.segment) <= (x.tau, x.segment) => Some(b),
+                _ => Some(x),
+            };
+        }
+        true
+    });
+    if on_ray > MAX_RAY_CROSSINGS {
+        // More than MAX_RAY_CROSSINGS: the boundary runs along the ray.
+        return flagged(p1, Status::Tangled);
     }
     if valid > MAX_CROSSINGS {
         return flagged(p1, Status::Tangled);

@@ -8,7 +8,7 @@ pub mod jsonl;
 pub mod scenarios;
 pub mod synth;
 
-use roadstereo::{CrossingSearch, Crossings, EpipolarLine, Frame, Pixel, Processor};
+use roadstereo::{Crossing, CrossingSearch, EpipolarLine, Frame, Pixel, Processor};
 
 /// Capacity used by the host tests: one point per row of a 480-row image fits.
 pub const N: usize = 512;
@@ -21,10 +21,15 @@ pub struct BruteForce;
 
 impl CrossingSearch for BruteForce {
     fn prepare(&mut self, _boundary: &[Pixel], _key: &roadstereo::epipolar::PencilKey) {}
-    fn search(&mut self, line: &EpipolarLine, boundary: &[Pixel], out: &mut Crossings) {
+    fn search<F: FnMut(Crossing) -> bool>(
+        &mut self,
+        line: &EpipolarLine,
+        boundary: &[Pixel],
+        mut visit: F,
+    ) {
         for j in 0..boundary.len().saturating_sub(1) {
             if let Some(c) = line.crossing(j, boundary[j], boundary[j + 1]) {
-                if out.push(c).is_err() {
+                if !visit(c) {
                     return;
                 }
             }

@@ -179,7 +179,7 @@ fn stages(f1: &Frame<CAP, 2>, f2: &Frame<CAP, 2>, m: &roadstereo::Motion) {
                     let line = geom.line(&c);
                     if line.a2 > 0.0 {
                         let mut out = Crossings::new();
-                        index.search(black_box(&line), b2.points(), &mut out);
+                        index.collect(black_box(&line), b2.points(), &mut out);
                         found += out.len() as u32;
                     }
                 }

@@ -689,7 +689,7 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
         // epipolar line in `z_far` (no extra memory).
         let key = *geom.key();
         for &p1 in b1.points() {
-            let r = match geom.compensate(p1) {
+            let r = match geom.compensate_in_frame(p1) {
                 Some(c) => PointResult {
                     pixel1: p1,
                     pixel2: Pixel::new(c.pixel[0], c.pixel[1]),

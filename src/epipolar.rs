@@ -443,7 +443,7 @@ fn stretch_bound(h: &crate::math::Mat3, cam: &Camera) -> f32 {
     );
     for (u, v) in [(-m, -m), (u1, -m), (-m, v1), (u1, v1)] {
         let [x, y, z] = mat3_vec(h, [u, v, 1.0]);
-        if !(z > 1.0e-3) {
+        if z.is_nan() || z <= 1.0e-3 {
             return f32::INFINITY;
         }
         let (px, py) = (x / z, y / z);

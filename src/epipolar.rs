@@ -680,8 +680,7 @@ impl<const N: usize> IndexedSearch<N> {
             PencilKey::Angular { .. } => 4.0,
             PencilKey::Projective { .. } => 0.0,
         };
-        let (mut kmin, mut kmax) = (f32::INFINITY, f32::NEG_INFINITY);
-        let (mut first, mut last) = (NO_KEY, NO_KEY);
+        let period = self.period;
         let mut n: usize = 0;
         let mut prev = NO_KEY;
         let mut offset = 0.0f32;
@@ -689,10 +688,9 @@ impl<const N: usize> IndexedSearch<N> {
         let mut all_keyed = true;
         for (slot, raw) in self.keys.iter_mut().zip(keys) {
             let mut k = raw;
-            all_keyed &= k.is_finite();
             if k.is_finite() {
                 k += offset;
-                if self.period > 0.0 && prev.is_finite() {
+                if period > 0.0 && prev.is_finite() {
                     // Unwrap: raw keys are in [0, 4) and consecutive keys
                     // differ by less than half a turn, so one correction of
                     // the running offset (a multiple of 4) suffices.
@@ -704,38 +702,36 @@ impl<const N: usize> IndexedSearch<N> {
                         offset += 4.0;
                         k += 4.0;
                     }
-                    all_keyed &= self.period <= 0.0 || ((k - prev).abs() - 2.0).abs() >= 1.0e-3;
+                    all_keyed &= ((k - prev).abs() - 2.0).abs() >= 1.0e-3;
                 }
-                kmin = fmin(kmin, k);
-                kmax = fmax(kmax, k);
-                if !first.is_finite() {
-                    first = k;
-                }
-                last = k;
+            } else {
+                all_keyed = false;
             }
             *slot = k;
             prev = k;
             n += 1;
         }
         self.segments = n.saturating_sub(1);
-        self.kmin = kmin;
-        self.kmax = kmax;
-        self.eps = match key {
-            PencilKey::Angular { .. } => ANGULAR_EPS,
-            PencilKey::Projective { .. } => PROJECTIVE_EPS + 1.0e-5 * fmax(kmin.abs(), kmax.abs()),
+        let keys = self.keys.get(..n).unwrap_or(&[]);
+        // Orientation from the first and the last usable key.
+        let (first, last) = if all_keyed {
+            (keys.first(), keys.last())
+        } else {
+            (
+                keys.iter().find(|k| k.is_finite()),
+                keys.iter().rev().find(|k| k.is_finite()),
+            )
         };
+        let (first, last) = (
+            first.copied().unwrap_or(NO_KEY),
+            last.copied().unwrap_or(NO_KEY),
+        );
         let o = if last >= first { 1.0 } else { -1.0 };
         self.orient = o;
-        if !unkeyed_meets_all
-            && all_keyed
-            && (self.period <= 0.0 || kmax - kmin < self.period - 0.1)
-        {
-            // The fold test's fast form: suffix extremes of the keys.
-            if let (Some(keys), Some(smax), Some(smin)) = (
-                self.keys.get(..n),
-                self.hi.get_mut(..n),
-                self.lo.get_mut(..n),
-            ) {
+        if !unkeyed_meets_all && all_keyed {
+            // The fold test's fast form: suffix extremes of the keys
+            // (whose first entries are the extremes of all keys).
+            if let (Some(smax), Some(smin)) = (self.hi.get_mut(..n), self.lo.get_mut(..n)) {
                 let (mut mx, mut mn) = (f32::NEG_INFINITY, f32::INFINITY);
                 for ((&k, h), l) in keys.iter().zip(smax.iter_mut()).zip(smin.iter_mut()).rev() {
                     mx = fmax(mx, k);
@@ -743,11 +739,49 @@ impl<const N: usize> IndexedSearch<N> {
                     *h = mx;
                     *l = mn;
                 }
-                self.fold_fast = true;
-                return;
+                if period <= 0.0 || mx - mn < period - 0.1 {
+                    self.set_range(mn, mx);
+                    self.fold_fast = true;
+                    return;
+                }
             }
         }
         self.envelopes(unkeyed_meets_all);
+        let s = self.segments;
+        let ends = (self.hi.get(s.wrapping_sub(1)), self.lo.first());
+        match ends {
+            (Some(&top), Some(&bottom))
+                if unkeyed_meets_all && self.unkeyed.is_empty() && !self.scan =>
+            {
+                // Every vertex is on a keyed segment: the envelopes' ends
+                // are the extremes of the (oriented) keys.
+                if o > 0.0 {
+                    self.set_range(bottom, top);
+                } else {
+                    self.set_range(-top, -bottom);
+                }
+            }
+            _ => {
+                let (mut mn, mut mx) = (f32::INFINITY, f32::NEG_INFINITY);
+                for &k in self.keys.get(..n).unwrap_or(&[]) {
+                    if k.is_finite() {
+                        mn = fmin(mn, k);
+                        mx = fmax(mx, k);
+                    }
+                }
+                self.set_range(mn, mx);
+            }
+        }
+    }
+
+    /// The range of the unwrapped keys and the key margin that follows.
+    fn set_range(&mut self, kmin: f32, kmax: f32) {
+        self.kmin = kmin;
+        self.kmax = kmax;
+        self.eps = match self.key {
+            PencilKey::Angular { .. } => ANGULAR_EPS,
+            PencilKey::Projective { .. } => PROJECTIVE_EPS + 1.0e-5 * fmax(kmin.abs(), kmax.abs()),
+        };
     }
 
     /// The running envelopes `hi`, `lo` of the oriented keys (and the list
@@ -767,22 +801,39 @@ impl<const N: usize> IndexedSearch<N> {
                 && k1.is_finite()
                 && !(period > 0.0 && ((k1 - k0).abs() - 2.0).abs() < 1.0e-3)
         };
+        // Running maximum over the vertices of keyed segments: a segment's
+        // first vertex is already in when the one before was keyed.
         let mut run = f32::NEG_INFINITY;
+        let mut joined = false;
         for (j, (w, h)) in keys.windows(2).zip(hi.iter_mut()).enumerate() {
             if let [k0, k1] = *w {
                 if keyed(k0, k1) {
-                    run = fmax(run, fmax(o * k0, o * k1));
-                } else if unkeyed_meets_all && self.unkeyed.push(j).is_err() {
-                    self.scan = true;
+                    if !joined {
+                        run = fmax(run, o * k0);
+                    }
+                    run = fmax(run, o * k1);
+                    joined = true;
+                } else {
+                    joined = false;
+                    if unkeyed_meets_all && self.unkeyed.push(j).is_err() {
+                        self.scan = true;
+                    }
                 }
             }
             *h = run;
         }
         let mut run = f32::INFINITY;
+        let mut joined = false;
         for (w, l) in keys.windows(2).rev().zip(lo.iter_mut().rev()) {
             if let [k0, k1] = *w {
                 if keyed(k0, k1) {
-                    run = fmin(run, fmin(o * k0, o * k1));
+                    if !joined {
+                        run = fmin(run, o * k1);
+                    }
+                    run = fmin(run, o * k0);
+                    joined = true;
+                } else {
+                    joined = false;
                 }
             }
             *l = run;

@@ -574,6 +574,8 @@ pub struct IndexedSearch<const N: usize> {
     /// spanning less than a turn: `hi`/`lo` then hold the suffix maximum
     /// and minimum of the keys and [`Self::folded_at`] answers in `O(1)`.
     fold_fast: bool,
+    /// Every vertex has a key and no segment passes through the FOE.
+    all_keyed: bool,
     segments: usize,
     /// Range of the unwrapped keys.
     kmin: f32,
@@ -645,6 +647,7 @@ impl<const N: usize> IndexedSearch<N> {
             unkeyed: heapless::Vec::new(),
             scan: false,
             fold_fast: false,
+            all_keyed: false,
             segments: 0,
             kmin: 0.0,
             kmax: 0.0,
@@ -712,6 +715,7 @@ impl<const N: usize> IndexedSearch<N> {
             n += 1;
         }
         self.segments = n.saturating_sub(1);
+        self.all_keyed = all_keyed;
         let keys = self.keys.get(..n).unwrap_or(&[]);
         // Orientation from the first and the last usable key.
         let (first, last) = if all_keyed {
@@ -796,6 +800,21 @@ impl<const N: usize> IndexedSearch<N> {
             self.scan = true;
             return;
         };
+        if self.all_keyed {
+            // Every segment counts: prefix maximum and suffix minimum of
+            // the oriented vertex keys.
+            let mut run = keys.first().map_or(f32::NEG_INFINITY, |&k| o * k);
+            for (&k, h) in keys.iter().skip(1).zip(hi.iter_mut()) {
+                run = fmax(run, o * k);
+                *h = run;
+            }
+            let mut run = keys.last().map_or(f32::INFINITY, |&k| o * k);
+            for (&k, l) in keys.iter().zip(lo.iter_mut()).rev() {
+                run = fmin(run, o * k);
+                *l = run;
+            }
+            return;
+        }
         let keyed = |k0: f32, k1: f32| {
             k0.is_finite()
                 && k1.is_finite()
@@ -1050,7 +1069,7 @@ impl<const N: usize> CrossingSearch for IndexedSearch<N> {
                 }
                 if let (&[k0, k1], [v0, v1]) = (k, v) {
                     let (mn, mx) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
-                    if mn - eps <= qq && qq <= mx + eps && self.keyed(k0, k1) {
+                    if mn - eps <= qq && qq <= mx + eps && (self.all_keyed || self.keyed(k0, k1)) {
                         if let Some(c) = line.crossing(j, *v0, *v1) {
                             if !visit(c) {
                                 return;

@@ -62,7 +62,7 @@
 //! `|ΔZ/Z| ≈ e/d` (Sec. 4.1.1).
 
 use crate::camera::Pixel;
-use crate::math::{cross, dot, fmax, fmin, sqrt, sub};
+use crate::math::{cross, dot, fmax, fmin, sqrt_pos, sub};
 
 /// Half-width, in points, of the chord used to measure the boundary direction.
 pub const CHORD_HALF_WINDOW: usize = 4;
@@ -94,10 +94,10 @@ pub(crate) fn chord(boundary: &[Pixel], j: usize) -> [f32; 2] {
 /// is the smallest angle consistent with the chord's own error.
 pub(crate) fn crossing_angle(a: [f32; 2], a_len: f32, chord: [f32; 2], e2: f32) -> (f32, f32) {
     let l2 = dot(chord, chord);
-    if l2 <= 0.0 || a_len <= 0.0 {
+    if !l2.is_finite() || l2 <= 0.0 || a_len <= 0.0 {
         return (0.0, 1.0);
     }
-    let l = sqrt(l2);
+    let l = sqrt_pos(l2);
     let inv = 1.0 / (a_len * l);
     let sin = cross(a, chord).abs() * inv;
     let cos = dot(a, chord).abs() * inv;
@@ -136,6 +136,19 @@ pub(crate) fn stick(
     spread_w: f32,
 ) -> Option<DepthInterval> {
     let d = tau * a_len;
+    if spread_a == 0.0 && spread_w == 0.0 {
+        // No translation error: the same formulas with the spreads at zero
+        // (the same bits), without the terms that vanish.
+        let h1 = fmax(r1 * (1.0 + w * tau), 0.0);
+        let eps = r1 + (e2 + h1 * cos) / sin_low;
+        if d - eps <= 0.0 {
+            return None;
+        }
+        let wr = w.abs() * r1;
+        let s_far = w + (a_len + wr) / (d - eps);
+        let s_near = w + fmax(a_len - wr, 0.0) / (d + eps + h1 * h1 / (2.0 * (d - eps)));
+        return interval(s_near, s_far, depth_scale);
+    }
     let turn = spread_a / a_len; // ≥ sin of the angle between the lines
     if turn.is_nan() || turn >= 1.0 || turn * cos >= sin_low {
         return None;
@@ -152,6 +165,12 @@ pub(crate) fn stick(
     let a_lo = fmax(a_len - w_abs * r1 - spread_a, 0.0);
     let s_far = (w + spread_w) + a_hi / (d - eps);
     let s_near = (w - spread_w) + a_lo / (d + eps + h * h / (2.0 * (d - eps)));
+    interval(s_near, s_far, depth_scale)
+}
+
+/// The stick from the ends in the compensated frame (`Z = s / q_z`).
+#[inline]
+fn interval(s_near: f32, s_far: f32, depth_scale: f32) -> Option<DepthInterval> {
     let z_far = s_far / depth_scale;
     let z_near = fmax(s_near / depth_scale, 0.0);
     (z_far.is_finite() && z_far >= z_near).then_some(DepthInterval { z_near, z_far })

@@ -28,6 +28,17 @@ pub(crate) fn sqrt(x: f32) -> f32 {
     0.5 * (y + x / y)
 }
 
+/// [`sqrt`] for an input the caller knows to be positive and finite (the
+/// hot path's squared lengths): the same Newton steps without the checks,
+/// so the same bits.
+#[inline]
+pub(crate) fn sqrt_pos(x: f32) -> f32 {
+    let mut y = micromath::F32(x).sqrt().0;
+    y = 0.5 * (y + x / y);
+    y = 0.5 * (y + x / y);
+    0.5 * (y + x / y)
+}
+
 /// Sine and cosine of an angle in radians, `|x| ≤ π/2` (callers validate).
 ///
 /// `libm`'s `sinf`/`cosf` reduce their argument in double precision, which

@@ -16,7 +16,6 @@ use crate::epipolar::{
     Compensated, CrossingSearch, EpipolarLine, FoldPrefix, IndexedSearch, PairGeometry,
     MAX_CROSSINGS, MAX_RAY_CROSSINGS,
 };
-use crate::math::sqrt;
 use crate::motion::Motion;
 
 /// Tuning of the reconstruction. All values are validated by [`Config::new`].
@@ -873,7 +872,8 @@ fn evaluate<S: CrossingSearch>(
         status,
         ..PointResult::default()
     };
-    let a_len = sqrt(line.a2);
+    // a2 > 1e-12 and finite (checked above).
+    let a_len = crate::math::sqrt_pos(line.a2);
     let (sin_low, cos) = crossing_angle(line.a, a_len, chord(b2, best.segment), config.e2);
     if sin_low < config.sin_min_angle {
         r.status = Status::Grazing;

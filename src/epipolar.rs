@@ -1059,24 +1059,23 @@ impl<const N: usize> CrossingSearch for IndexedSearch<N> {
             let a = first_at_least(hi, oq - eps, self.hint);
             self.hint = a;
             let t_hi = oq + eps;
-            let (Some(lo), Some(keys), Some(pts)) = (lo.get(a..), keys.get(a..), boundary.get(a..))
-            else {
-                break;
-            };
-            for (j, ((&l, k), v)) in (a..).zip(lo.iter().zip(keys.windows(2)).zip(pts.windows(2))) {
+            // Bounded by the slice `lo` (one entry per segment).
+            let mut j = a;
+            while let (Some(&l), Some(&k0), Some(&k1)) = (lo.get(j), keys.get(j), keys.get(j + 1)) {
                 if l > t_hi {
                     break;
                 }
-                if let (&[k0, k1], [v0, v1]) = (k, v) {
-                    let (mn, mx) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
-                    if mn - eps <= qq && qq <= mx + eps && (self.all_keyed || self.keyed(k0, k1)) {
-                        if let Some(c) = line.crossing(j, *v0, *v1) {
+                let (mn, mx) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
+                if mn - eps <= qq && qq <= mx + eps && (self.all_keyed || self.keyed(k0, k1)) {
+                    if let (Some(&v0), Some(&v1)) = (boundary.get(j), boundary.get(j + 1)) {
+                        if let Some(c) = line.crossing(j, v0, v1) {
                             if !visit(c) {
                                 return;
                             }
                         }
                     }
                 }
+                j += 1;
             }
             qq += period;
         }

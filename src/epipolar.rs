@@ -171,6 +171,9 @@ pub struct PairGeometry {
     /// An upper bound on [`Compensated::stretch`] over the whole frame-1
     /// image with its margin (infinity when none is known).
     stretch_bound: f32,
+    /// [`EpipolarLine::tau_max`], `ray_min`, `ray_max`: the same for every
+    /// line of the pair.
+    tau_range: (f32, f32, f32),
 }
 
 /// A frame-1 pixel after exact rotation compensation.
@@ -301,6 +304,11 @@ impl PairGeometry {
             c2,
             key,
             stretch_bound: stretch_bound(&h, cam1),
+            tau_range: (
+                if w < 0.0 { -1.0 / w } else { f32::INFINITY },
+                if w > 0.0 { -1.0 / w } else { f32::NEG_INFINITY },
+                if w < 0.0 { -1.0 / w } else { f32::INFINITY },
+            ),
         }
     }
 
@@ -391,25 +399,14 @@ impl PairGeometry {
             self.w * (c.pixel[0] - self.c2[0]) - self.g[0],
             self.w * (c.pixel[1] - self.c2[1]) - self.g[1],
         ];
+        let (tau_max, ray_min, ray_max) = self.tau_range;
         EpipolarLine {
             origin: c.pixel,
             a,
             a2: dot(a, a),
-            tau_max: if self.w < 0.0 {
-                -1.0 / self.w
-            } else {
-                f32::INFINITY
-            },
-            ray_min: if self.w > 0.0 {
-                -1.0 / self.w
-            } else {
-                f32::NEG_INFINITY
-            },
-            ray_max: if self.w < 0.0 {
-                -1.0 / self.w
-            } else {
-                f32::INFINITY
-            },
+            tau_max,
+            ray_min,
+            ray_max,
             key: NO_KEY,
         }
     }

@@ -503,24 +503,6 @@ fn scan_all<F: FnMut(Crossing) -> bool>(line: &EpipolarLine, boundary: &[Pixel],
     }
 }
 
-/// The running extremes of the keys before a vertex, for
-/// [`IndexedSearch::folded_at`].
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct FoldPrefix {
-    min: f32,
-    max: f32,
-}
-
-impl FoldPrefix {
-    /// Nothing seen yet.
-    pub(crate) fn new() -> Self {
-        Self {
-            min: f32::INFINITY,
-            max: f32::NEG_INFINITY,
-        }
-    }
-}
-
 /// Segments with an unkeyable end (at the FOE) an index keeps aside; with
 /// more, every search scans the whole boundary.
 const MAX_UNKEYED: usize = 4;
@@ -569,7 +551,7 @@ pub struct IndexedSearch<const N: usize> {
     scan: bool,
     /// Built for the fold test with every segment keyed and the keys
     /// spanning less than a turn: `hi`/`lo` then hold the suffix maximum
-    /// and minimum of the keys and [`Self::folded_at`] answers in `O(1)`.
+    /// and minimum of the keys and [`Self::fold_each`] answers in `O(1)`.
     fold_fast: bool,
     /// Every vertex has a key and no segment passes through the FOE.
     all_keyed: bool,
@@ -942,36 +924,45 @@ impl<const N: usize> IndexedSearch<N> {
         self.build(key, false, keys);
     }
 
-    /// Whether [`Self::folded_at`] applies (built by [`Self::prepare_keys`]
+    /// Whether [`Self::fold_each`] applies (built by [`Self::prepare_keys`]
     /// with every segment keyed and less than a turn of keys).
     pub(crate) fn fold_fast(&self) -> bool {
         self.fold_fast
     }
 
-    /// The fold test of vertex `i` in `O(1)`, for `i = 0, 1, …` in order
-    /// (`prefix` carries the extremes of the keys of vertices `0..=i−4`
-    /// between calls; start with [`FoldPrefix::new`]): the same answer as
-    /// [`Self::meets_outside`] for the vertex's own key and the segments
-    /// outside `i−4 ..= i+3`. The segments `j ≤ i−5` form a connected
+    /// The fold test of every vertex in `O(1)` each (when
+    /// [`Self::fold_fast`]): calls `folded(i)` for each vertex `i` that
+    /// [`Self::meets_outside`] would find met by its own key outside the
+    /// segments `i−4 ..= i+3`. The segments `j ≤ i−5` form a connected
     /// path over the vertices `0..=i−4`, so the union of their widened key
-    /// ranges is the one interval `[min − ε, max + ε]` of those keys; the
-    /// same holds for the segments `j ≥ i+4` and the vertices from `i+4`.
-    pub(crate) fn folded_at(&self, i: usize, prefix: &mut FoldPrefix) -> bool {
-        let eps = self.eps;
-        let Some(&k) = self.keys.get(i) else {
-            return false;
+    /// ranges is the one interval `[min − ε, max + ε]` of those keys (a
+    /// running prefix); the same holds for the segments `j ≥ i+4` and the
+    /// suffix extremes from vertex `i+4`, which the build kept.
+    pub(crate) fn fold_each(&self, mut folded: impl FnMut(usize)) {
+        let n = self.segments + 1;
+        let (Some(keys), Some(smin), Some(smax)) =
+            (self.keys.get(..n), self.lo.get(..n), self.hi.get(..n))
+        else {
+            return;
         };
-        if let Some(&v) = i.checked_sub(4).and_then(|t| self.keys.get(t)) {
-            prefix.min = fmin(prefix.min, v);
-            prefix.max = fmax(prefix.max, v);
+        let eps = self.eps;
+        let (mut pmin, mut pmax) = (f32::INFINITY, f32::NEG_INFINITY);
+        for (i, &k) in keys.iter().enumerate() {
+            let mut met = false;
+            if let Some(&v) = i.checked_sub(4).and_then(|t| keys.get(t)) {
+                pmin = fmin(pmin, v);
+                pmax = fmax(pmax, v);
+                met = i >= 5 && pmin - eps <= k && k <= pmax + eps;
+            }
+            if !met && i + 5 < n {
+                if let (Some(&mn), Some(&mx)) = (smin.get(i + 4), smax.get(i + 4)) {
+                    met = mn - eps <= k && k <= mx + eps;
+                }
+            }
+            if met {
+                folded(i);
+            }
         }
-        let left = i >= 5 && prefix.min - eps <= k && k <= prefix.max + eps;
-        let right = i + 5 <= self.segments
-            && match (self.lo.get(i + 4), self.hi.get(i + 4)) {
-                (Some(&mn), Some(&mx)) => mn - eps <= k && k <= mx + eps,
-                _ => false,
-            };
-        left || right
     }
 
     /// Whether the indexed polyline meets the line with key `q` at a segment
@@ -1145,12 +1136,12 @@ mod tests {
             let mut slow = fast.clone();
             slow.fold_fast = false;
             slow.envelopes(false);
-            let mut prefix = FoldPrefix::new();
+            let mut got = [false; M];
+            fast.fold_each(|i| got[i] = true);
             for i in 0..n {
                 let want = slow.meets_outside(fast.keys[i], (i.saturating_sub(4), i + 3));
-                let got = fast.folded_at(i, &mut prefix);
-                assert_eq!(got, want, "case {case}, vertex {i} of {n}");
-                folds += usize::from(got);
+                assert_eq!(got[i], want, "case {case}, vertex {i} of {n}");
+                folds += usize::from(got[i]);
             }
         }
         assert!(fast_cases > 3000 && folds > 1000, "{fast_cases} {folds}");

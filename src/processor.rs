@@ -13,8 +13,8 @@ use crate::boundary::Frame;
 use crate::camera::{Camera, Pixel};
 use crate::depth::{chord, crossing_angle, stick, DepthInterval, CHORD_HALF_WINDOW};
 use crate::epipolar::{
-    Compensated, CrossingSearch, EpipolarLine, FoldPrefix, IndexedSearch, PairGeometry,
-    MAX_CROSSINGS, MAX_RAY_CROSSINGS,
+    Compensated, CrossingSearch, EpipolarLine, IndexedSearch, PairGeometry, MAX_CROSSINGS,
+    MAX_RAY_CROSSINGS,
 };
 use crate::motion::Motion;
 
@@ -717,22 +717,25 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
                 }
             }),
         );
-        let mut prefix = FoldPrefix::new();
-        for (i, r) in bs.points.iter_mut().enumerate() {
-            if index.fold_fast() {
-                if index.folded_at(i, &mut prefix) {
+        if index.fold_fast() {
+            index.fold_each(|i| {
+                if let Some(r) = bs.points.get_mut(i) {
                     r.status = Status::Folded;
                 }
-            } else if r.status != Status::BehindCamera
-                && index.meets_outside(
-                    r.z_far,
-                    (
-                        i.saturating_sub(CHORD_HALF_WINDOW),
-                        i + CHORD_HALF_WINDOW - 1,
-                    ),
-                )
-            {
-                r.status = Status::Folded;
+            });
+        } else {
+            for (i, r) in bs.points.iter_mut().enumerate() {
+                if r.status != Status::BehindCamera
+                    && index.meets_outside(
+                        r.z_far,
+                        (
+                            i.saturating_sub(CHORD_HALF_WINDOW),
+                            i + CHORD_HALF_WINDOW - 1,
+                        ),
+                    )
+                {
+                    r.status = Status::Folded;
+                }
             }
         }
         // Pass 2: intersect, triangulate, bound.

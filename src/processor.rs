@@ -518,23 +518,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         frame: &Frame<N, B>,
         motion: Option<&Motion>,
     ) -> Result<Step<'_, N, B>, ProcessError> {
-        let Self {
-            config,
-            previous,
-            has_previous,
-            search,
-            output,
-        } = self;
-        let first = run(
-            config,
-            previous,
-            has_previous,
-            output,
-            frame,
-            motion,
-            true,
-            &mut OwnIndex(search),
-        )?;
+        let first = self.run_own(frame, motion, true)?;
         Ok(if first {
             Step::First
         } else {
@@ -587,6 +571,17 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         if !self.has_previous {
             return Err(ProcessError::NoKeptFrame);
         }
+        self.run_own(frame, Some(motion), false)?;
+        Ok(&self.output)
+    }
+
+    /// [`run`] with the built-in index; `replace`: keep `frame` afterwards.
+    fn run_own(
+        &mut self,
+        frame: &Frame<N, B>,
+        motion: Option<&Motion>,
+        replace: bool,
+    ) -> Result<bool, ProcessError> {
         let Self {
             config,
             previous,
@@ -600,11 +595,10 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             has_previous,
             output,
             frame,
-            Some(motion),
-            false,
+            motion,
+            replace,
             &mut OwnIndex(search),
-        )?;
-        Ok(&self.output)
+        )
     }
 
     /// The output of the last successful reconstruction (empty before one).

@@ -869,8 +869,12 @@ fn evaluate<S: CrossingSearch>(
         status,
         ..PointResult::default()
     };
-    // a2 > 1e-12 and finite (checked above).
-    let a_len = crate::math::sqrt_pos(line.a2);
+    // a2 > 1e-12 (checked above); infinite only for absurd motions.
+    let a_len = if line.a2.is_finite() {
+        crate::math::sqrt_pos(line.a2)
+    } else {
+        f32::INFINITY
+    };
     let (sin_low, cos) = crossing_angle(line.a, a_len, chord(b2, best.segment), config.e2);
     if sin_low < config.sin_min_angle {
         r.status = Status::Grazing;

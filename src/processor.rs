@@ -535,23 +535,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         motion: Option<&Motion>,
         search: &mut S,
     ) -> Result<bool, ProcessError> {
-        let Self {
-            config,
-            previous,
-            has_previous,
-            search: index,
-            output,
-        } = self;
-        run(
-            config,
-            previous,
-            has_previous,
-            output,
-            frame,
-            motion,
-            true,
-            &mut WithSearch(index, search),
-        )
+        self.run_using(frame, motion, true, |index| WithSearch(index, search))
     }
 
     /// Reconstruct `frame` against the kept frame *without replacing it*,
@@ -582,6 +566,17 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         motion: Option<&Motion>,
         replace: bool,
     ) -> Result<bool, ProcessError> {
+        self.run_using(frame, motion, replace, OwnIndex)
+    }
+
+    /// [`run`] with the searches `searches` makes of the built-in index.
+    fn run_using<'a, T: Searches<N>>(
+        &'a mut self,
+        frame: &Frame<N, B>,
+        motion: Option<&Motion>,
+        replace: bool,
+        searches: impl FnOnce(&'a mut IndexedSearch<N>) -> T,
+    ) -> Result<bool, ProcessError> {
         let Self {
             config,
             previous,
@@ -597,7 +592,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             frame,
             motion,
             replace,
-            &mut OwnIndex(search),
+            &mut searches(search),
         )
     }
 

@@ -171,9 +171,9 @@ pub struct PairGeometry {
     /// An upper bound on [`Compensated::stretch`] over the whole frame-1
     /// image with its margin (infinity when none is known).
     stretch_bound: f32,
-    /// [`EpipolarLine::tau_max`], `ray_min`, `ray_max`: the same for every
-    /// line of the pair.
-    tau_range: (f32, f32, f32),
+    /// [`EpipolarLine::tau_max`] (also `ray_max`) and `ray_min`: the same
+    /// for every line of the pair.
+    tau_range: (f32, f32),
 }
 
 /// A frame-1 pixel after exact rotation compensation.
@@ -307,7 +307,6 @@ impl PairGeometry {
             tau_range: (
                 if w < 0.0 { -1.0 / w } else { f32::INFINITY },
                 if w > 0.0 { -1.0 / w } else { f32::NEG_INFINITY },
-                if w < 0.0 { -1.0 / w } else { f32::INFINITY },
             ),
         }
     }
@@ -353,43 +352,41 @@ impl PairGeometry {
     /// Exact rotation compensation of a frame-1 pixel; `None` when the ray
     /// points behind the frame-2 camera orientation (`q_z ≤ 1e-6`).
     pub fn compensate(&self, p1: Pixel) -> Option<Compensated> {
-        let [x, y, z] = mat3_vec(&self.h, [p1.u, p1.v, 1.0]);
-        let [[h00, h01, _], [h10, h11, _], [h20, h21, _]] = self.h;
-        if z <= 1.0e-6 {
-            return None;
-        }
-        let iz = 1.0 / z;
-        let (px, py) = (x * iz, y * iz);
-        // Jacobian of (x/z, y/z) with respect to (u, v).
-        let j00 = (h00 - px * h20) * iz;
-        let j01 = (h01 - px * h21) * iz;
-        let j10 = (h10 - py * h20) * iz;
-        let j11 = (h11 - py * h21) * iz;
-        let n1 = fmax(j00.abs() + j10.abs(), j01.abs() + j11.abs());
-        let ninf = fmax(j00.abs() + j01.abs(), j10.abs() + j11.abs());
-        Some(Compensated {
-            pixel: [px, py],
-            depth_scale: z,
-            stretch: fmax(n1, ninf),
-        })
+        self.compensate_with(p1, false)
     }
 
     /// [`Self::compensate`] with the frame-wide stretch bound in place of
     /// the point's own (when there is one): what the processor uses.
     #[inline]
     pub(crate) fn compensate_in_frame(&self, p1: Pixel) -> Option<Compensated> {
-        if !self.stretch_bound.is_finite() {
-            return self.compensate(p1);
-        }
+        self.compensate_with(p1, true)
+    }
+
+    #[inline(always)]
+    fn compensate_with(&self, p1: Pixel, frame_bound: bool) -> Option<Compensated> {
         let [x, y, z] = mat3_vec(&self.h, [p1.u, p1.v, 1.0]);
         if z <= 1.0e-6 {
             return None;
         }
         let iz = 1.0 / z;
+        let (px, py) = (x * iz, y * iz);
+        let stretch = if frame_bound && self.stretch_bound.is_finite() {
+            self.stretch_bound
+        } else {
+            // Jacobian of (x/z, y/z) with respect to (u, v).
+            let [[h00, h01, _], [h10, h11, _], [h20, h21, _]] = self.h;
+            let j00 = (h00 - px * h20) * iz;
+            let j01 = (h01 - px * h21) * iz;
+            let j10 = (h10 - py * h20) * iz;
+            let j11 = (h11 - py * h21) * iz;
+            let n1 = fmax(j00.abs() + j10.abs(), j01.abs() + j11.abs());
+            let ninf = fmax(j00.abs() + j01.abs(), j10.abs() + j11.abs());
+            fmax(n1, ninf)
+        };
         Some(Compensated {
-            pixel: [x * iz, y * iz],
+            pixel: [px, py],
             depth_scale: z,
-            stretch: self.stretch_bound,
+            stretch,
         })
     }
 
@@ -399,14 +396,14 @@ impl PairGeometry {
             self.w * (c.pixel[0] - self.c2[0]) - self.g[0],
             self.w * (c.pixel[1] - self.c2[1]) - self.g[1],
         ];
-        let (tau_max, ray_min, ray_max) = self.tau_range;
+        let (tau_max, ray_min) = self.tau_range;
         EpipolarLine {
             origin: c.pixel,
             a,
             a2: dot(a, a),
             tau_max,
             ray_min,
-            ray_max,
+            ray_max: tau_max,
             key: NO_KEY,
         }
     }

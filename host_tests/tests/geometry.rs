@@ -3,7 +3,7 @@
 //! frames, 512 × 480, f = 800, quantised boundaries.
 
 use host_tests::{frame, reconstruct, synth};
-use roadstereo::geometry::{road_geometry, samples, Sample};
+use roadstereo::geometry::{road_geometry, samples, Range, RoadGeometry, Sample};
 use roadstereo::{Config, Processor, Step};
 
 const N: usize = host_tests::N;
@@ -28,6 +28,19 @@ fn alv(curvature: f64, heading_deg: f64) -> synth::Scenario {
     s.height = 2.0;
     s.tilt = 23f64.to_radians();
     s
+}
+
+/// The three ranges as "lo–hi (width)", tilt in degrees.
+fn cells(g: &RoadGeometry) -> [String; 3] {
+    let cell = |r: &Range, scale: f32, digits: usize| {
+        let (lo, hi) = (r.lo * scale, r.hi * scale);
+        format!("{lo:.digits$}–{hi:.digits$} ({:.digits$})", hi - lo)
+    };
+    [
+        cell(&g.height, 1.0, 2),
+        cell(&g.tilt, 1f32.to_degrees(), 1),
+        cell(&g.width, 1.0, 2),
+    ]
 }
 
 fn boundary_samples(s: &synth::Scenario) -> (Vec<Sample>, Vec<Sample>) {
@@ -58,18 +71,8 @@ fn alv_geometry_ranges_contain_the_truth() {
         println!("  (no outlier allowance: height {:.2}–{:.2}, tilt {:.1}–{:.1}, width {:.2}–{:.2}; {} + {} points)", g0.height.lo, g0.height.hi, g0.tilt.lo.to_degrees(), g0.tilt.hi.to_degrees(), g0.width.lo, g0.width.hi, left.len(), right.len());
         let g = road_geometry::<N>(&[(&left, &right)], 3).expect("geometry");
         let tilt_deg = (g.tilt.lo.to_degrees(), g.tilt.hi.to_degrees());
-        println!(
-            "| {name} | {:.2}–{:.2} ({:.2}) | {:.1}–{:.1} ({:.1}) | {:.2}–{:.2} ({:.2}) |",
-            g.height.lo,
-            g.height.hi,
-            g.height.width(),
-            tilt_deg.0,
-            tilt_deg.1,
-            tilt_deg.1 - tilt_deg.0,
-            g.width.lo,
-            g.width.hi,
-            g.width.width()
-        );
+        let [h, t, w] = cells(&g);
+        println!("| {name} | {h} | {t} | {w} |");
         assert!(g.height.contains(2.0), "{name}: height {:?}", g.height);
         assert!(
             g.tilt.contains(23f32.to_radians()),
@@ -160,18 +163,10 @@ fn key_frames_narrow_the_ranges() {
     for outliers in [0usize, 6] {
         let g = road_geometry::<CAP>(&views, outliers).expect("geometry");
         let tilt = (g.tilt.lo.to_degrees(), g.tilt.hi.to_degrees());
+        let [h, t, w] = cells(&g);
         println!(
-            "{} views (4 key frames × travel 1, 2, 3), {outliers} outliers allowed: height {:.2}–{:.2} ({:.2}), tilt {:.1}–{:.1} ({:.1}°), width {:.2}–{:.2} ({:.2}); paper 0.40, 4°, 0.60",
-            views.len(),
-            g.height.lo,
-            g.height.hi,
-            g.height.width(),
-            tilt.0,
-            tilt.1,
-            tilt.1 - tilt.0,
-            g.width.lo,
-            g.width.hi,
-            g.width.width()
+            "{} views (4 key frames × travel 1, 2, 3), {outliers} outliers allowed: height {h}, tilt (°) {t}, width {w}; paper 0.40, 4°, 0.60",
+            views.len()
         );
         assert!(
             g.height.contains(2.0) && g.tilt.contains(23f32.to_radians()) && g.width.contains(2.6),

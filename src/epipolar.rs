@@ -665,8 +665,26 @@ impl<const N: usize> IndexedSearch<N> {
         let mut offset = 0.0f32;
         // Every vertex keyed and no segment through the FOE.
         let mut all_keyed = true;
+        let mut prev_raw = NO_KEY;
+        // Raw steps below this take the short path (none once the offset
+        // is so large that its rounding could reach 1e-3).
+        let mut short_step = 1.998f32;
         for (slot, raw) in self.keys.iter_mut().zip(keys) {
             let mut k = raw;
+            // The usual step: both keys finite and less than 1.998 apart
+            // (NaN and infinities fail the test), so no unwrapping, and the
+            // unwrapped step (the same up to the rounding of `+ offset`,
+            // below 2e-4 while |offset| < 1024) is not half a turn. The
+            // general code below gives the same bits.
+            if (raw - prev_raw).abs() < short_step {
+                k += offset;
+                *slot = k;
+                prev = k;
+                prev_raw = raw;
+                n += 1;
+                continue;
+            }
+            prev_raw = raw;
             if k.is_finite() {
                 k += offset;
                 if period > 0.0 && prev.is_finite() {
@@ -680,6 +698,9 @@ impl<const N: usize> IndexedSearch<N> {
                     } else if d < -2.0 {
                         offset += 4.0;
                         k += 4.0;
+                    }
+                    if offset.abs() >= 1024.0 {
+                        short_step = -1.0;
                     }
                     all_keyed &= ((k - prev).abs() - 2.0).abs() >= 1.0e-3;
                 }
@@ -943,18 +964,27 @@ impl<const N: usize> IndexedSearch<N> {
             return;
         };
         let eps = self.eps;
+        // Vertex i − 4 (from i = 4 on) and the suffix extremes from vertex
+        // i + 4 (while i + 5 < n), walked along with i: no indexing.
+        let mut lagged = keys.iter();
+        let ahead = n.saturating_sub(1);
+        let mut suffix = smin
+            .get(4..ahead)
+            .unwrap_or(&[])
+            .iter()
+            .zip(smax.get(4..ahead).unwrap_or(&[]));
         let (mut pmin, mut pmax) = (f32::INFINITY, f32::NEG_INFINITY);
         for (i, &k) in keys.iter().enumerate() {
             let mut met = false;
-            if let Some(&v) = i.checked_sub(4).and_then(|t| keys.get(t)) {
-                pmin = fmin(pmin, v);
-                pmax = fmax(pmax, v);
-                met = i >= 5 && pmin - eps <= k && k <= pmax + eps;
-            }
-            if !met && i + 5 < n {
-                if let (Some(&mn), Some(&mx)) = (smin.get(i + 4), smax.get(i + 4)) {
-                    met = mn - eps <= k && k <= mx + eps;
+            if i >= 4 {
+                if let Some(&v) = lagged.next() {
+                    pmin = fmin(pmin, v);
+                    pmax = fmax(pmax, v);
+                    met = i >= 5 && pmin - eps <= k && k <= pmax + eps;
                 }
+            }
+            if let Some((&mn, &mx)) = suffix.next() {
+                met = met || (mn - eps <= k && k <= mx + eps);
             }
             if met {
                 folded(i);
@@ -1044,14 +1074,38 @@ impl<const N: usize> CrossingSearch for IndexedSearch<N> {
             let a = first_at_least(hi, oq - eps, self.hint);
             self.hint = a;
             let t_hi = oq + eps;
+            if self.all_keyed {
+                // Every segment is keyed and the run `[a, b)` holds hardly
+                // any segment besides those whose own keys bracket the
+                // line's (the key test rejects about 1 in 500 on the
+                // bench), so the exact side test is tried on all of it.
+                let (Some(run), Some(pts)) = (lo.get(a..), boundary.get(a..)) else {
+                    return;
+                };
+                for ((&l, w), j) in run.iter().zip(pts.windows(2)).zip(a..) {
+                    if l > t_hi {
+                        break;
+                    }
+                    if let [v0, v1] = *w {
+                        if let Some(c) = line.crossing(j, v0, v1) {
+                            if !visit(c) {
+                                return;
+                            }
+                        }
+                    }
+                }
+                qq += period;
+                continue;
+            }
             // Bounded by the slice `lo` (one entry per segment).
             let mut j = a;
             while let (Some(&l), Some(&k0), Some(&k1)) = (lo.get(j), keys.get(j), keys.get(j + 1)) {
                 if l > t_hi {
                     break;
                 }
+                // Unkeyed segments were examined above.
                 let (mn, mx) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
-                if mn - eps <= qq && qq <= mx + eps && (self.all_keyed || self.keyed(k0, k1)) {
+                if mn - eps <= qq && qq <= mx + eps && self.keyed(k0, k1) {
                     if let (Some(&v0), Some(&v1)) = (boundary.get(j), boundary.get(j + 1)) {
                         if let Some(c) = line.crossing(j, v0, v1) {
                             if !visit(c) {

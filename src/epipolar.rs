@@ -552,6 +552,13 @@ pub struct IndexedSearch<const N: usize> {
     fold_fast: bool,
     /// Every vertex has a key and no segment passes through the FOE.
     all_keyed: bool,
+    /// Built for the crossing search with every segment keyed and the
+    /// widened keys spanning less than a turn: one key in `[0, 4)` has one
+    /// representative to look for, `q + base` or `q + base + 4`
+    /// ([`Self::single_key`]), and the search is one run.
+    single: bool,
+    /// A multiple of 4 with `base ≤ kmin − eps < base + 4`.
+    base: f32,
     segments: usize,
     /// Range of the unwrapped keys.
     kmin: f32,
@@ -571,7 +578,7 @@ impl<const N: usize> Default for IndexedSearch<N> {
 
 /// First index `j` in `[0, v.len())` with `v[j] ≥ t` in a non-decreasing
 /// slice (or `v.len()`): linear probes from `hint`, then bisection.
-#[inline]
+#[inline(always)]
 fn first_at_least(v: &[f32], t: f32, hint: usize) -> usize {
     let n = v.len();
     let at = |j: usize| v.get(j).copied().unwrap_or(f32::INFINITY);
@@ -624,6 +631,8 @@ impl<const N: usize> IndexedSearch<N> {
             scan: false,
             fold_fast: false,
             all_keyed: false,
+            single: false,
+            base: 0.0,
             segments: 0,
             kmin: 0.0,
             kmax: 0.0,
@@ -654,6 +663,7 @@ impl<const N: usize> IndexedSearch<N> {
         self.unkeyed.clear();
         self.scan = false;
         self.fold_fast = false;
+        self.single = false;
         self.hint = 0;
         self.period = match key {
             PencilKey::Angular { .. } => 4.0,
@@ -761,6 +771,7 @@ impl<const N: usize> IndexedSearch<N> {
                 } else {
                     self.set_range(-top, -bottom);
                 }
+                self.single = self.all_keyed && self.single_turn();
             }
             _ => {
                 let (mut mn, mut mx) = (f32::INFINITY, f32::NEG_INFINITY);
@@ -783,6 +794,87 @@ impl<const N: usize> IndexedSearch<N> {
             PencilKey::Angular { .. } => ANGULAR_EPS,
             PencilKey::Projective { .. } => PROJECTIVE_EPS + 1.0e-5 * fmax(kmin.abs(), kmax.abs()),
         };
+    }
+
+    /// Whether the widened key range spans less than a turn (always for
+    /// projective keys), and if so `base` for [`Self::single_key`].
+    fn single_turn(&mut self) -> bool {
+        if self.period <= 0.0 {
+            return true;
+        }
+        let (lo, hi) = (self.kmin - self.eps, self.kmax + self.eps);
+        if !(hi - lo < self.period && lo.abs() < 1.0e6) {
+            return false;
+        }
+        // |lo| < 1e6: the quotient and the multiple of 4 are exact enough
+        // (the comparison in `single_key` decides, not this value).
+        let m = ceil_i32(lo * 0.25) - 1;
+        self.base = 4.0 * m as f32;
+        if self.base > lo || self.base + 4.0 <= lo {
+            // Rounding put lo outside [base, base + 4): no shortcut.
+            return false;
+        }
+        true
+    }
+
+    /// For a [`Self::single`] index: the one unwrapped key equal to `q`
+    /// modulo the period that can lie in the widened key range (the
+    /// smallest one `≥ kmin − eps`), for `q` in `[0, 4)`; `None` otherwise.
+    #[inline(always)]
+    fn single_key(&self, q: f32) -> Option<f32> {
+        if self.period <= 0.0 {
+            return q.is_finite().then_some(q);
+        }
+        if !(0.0..4.0).contains(&q) {
+            return None;
+        }
+        let qq = q + self.base;
+        Some(if qq < self.kmin - self.eps {
+            q + (self.base + 4.0)
+        } else {
+            qq
+        })
+    }
+
+    /// Visit the crossings on the candidate run of the unwrapped key `qq`
+    /// for an index whose segments are all keyed; `false` when `visit`
+    /// stopped the search.
+    ///
+    /// The run `[a, b)` holds hardly any segment besides those whose own
+    /// keys bracket the line's (the key test rejects about 1 in 500 on the
+    /// bench), so the exact side test is tried on all of it.
+    #[inline(always)]
+    fn keyed_run<F: FnMut(Crossing) -> bool>(
+        &mut self,
+        qq: f32,
+        line: &EpipolarLine,
+        boundary: &[Pixel],
+        visit: &mut F,
+    ) -> bool {
+        let s = self.segments;
+        let (Some(hi), Some(lo)) = (self.hi.get(..s), self.lo.get(..s)) else {
+            return true;
+        };
+        let oq = self.orient * qq;
+        let a = first_at_least(hi, oq - self.eps, self.hint);
+        self.hint = a;
+        let t_hi = oq + self.eps;
+        let (Some(run), Some(pts)) = (lo.get(a..), boundary.get(a..)) else {
+            return true;
+        };
+        for ((&l, w), j) in run.iter().zip(pts.windows(2)).zip(a..) {
+            if l > t_hi {
+                break;
+            }
+            if let [v0, v1] = *w {
+                if let Some(c) = line.crossing(j, v0, v1) {
+                    if !visit(c) {
+                        return false;
+                    }
+                }
+            }
+        }
+        true
     }
 
     /// The running envelopes `hi`, `lo` of the oriented keys (and the list
@@ -1038,6 +1130,12 @@ impl<const N: usize> CrossingSearch for IndexedSearch<N> {
         mut visit: F,
     ) {
         let s = self.segments;
+        if self.single && boundary.len() == s + 1 {
+            if let Some(qq) = self.single_key(line.key) {
+                self.keyed_run(qq, line, boundary, &mut visit);
+                return;
+            }
+        }
         let q = if line.key.is_finite() {
             line.key
         } else {
@@ -1062,41 +1160,25 @@ impl<const N: usize> CrossingSearch for IndexedSearch<N> {
                 }
             }
         }
-        let (Some(keys), Some(hi), Some(lo)) =
-            (self.keys.get(..s + 1), self.hi.get(..s), self.lo.get(..s))
-        else {
-            return;
-        };
-        let (o, eps, period) = (self.orient, self.eps, self.period);
         let mut qq = first;
         for _ in 0..count {
+            if self.all_keyed {
+                if !self.keyed_run(qq, line, boundary, &mut visit) {
+                    return;
+                }
+                qq += self.period;
+                continue;
+            }
+            let (o, eps) = (self.orient, self.eps);
+            let (Some(keys), Some(hi), Some(lo)) =
+                (self.keys.get(..s + 1), self.hi.get(..s), self.lo.get(..s))
+            else {
+                return;
+            };
             let oq = o * qq;
             let a = first_at_least(hi, oq - eps, self.hint);
             self.hint = a;
             let t_hi = oq + eps;
-            if self.all_keyed {
-                // Every segment is keyed and the run `[a, b)` holds hardly
-                // any segment besides those whose own keys bracket the
-                // line's (the key test rejects about 1 in 500 on the
-                // bench), so the exact side test is tried on all of it.
-                let (Some(run), Some(pts)) = (lo.get(a..), boundary.get(a..)) else {
-                    return;
-                };
-                for ((&l, w), j) in run.iter().zip(pts.windows(2)).zip(a..) {
-                    if l > t_hi {
-                        break;
-                    }
-                    if let [v0, v1] = *w {
-                        if let Some(c) = line.crossing(j, v0, v1) {
-                            if !visit(c) {
-                                return;
-                            }
-                        }
-                    }
-                }
-                qq += period;
-                continue;
-            }
             // Bounded by the slice `lo` (one entry per segment).
             let mut j = a;
             while let (Some(&l), Some(&k0), Some(&k1)) = (lo.get(j), keys.get(j), keys.get(j + 1)) {
@@ -1116,7 +1198,7 @@ impl<const N: usize> CrossingSearch for IndexedSearch<N> {
                 }
                 j += 1;
             }
-            qq += period;
+            qq += self.period;
         }
     }
 }
@@ -1196,6 +1278,76 @@ mod tests {
             }
         }
         assert!(fast_cases > 3000 && folds > 1000, "{fast_cases} {folds}");
+    }
+
+    /// The index finds exactly the crossings a scan of every segment finds,
+    /// on random polylines about the FOE (arcs that wrap past the cut of
+    /// the pseudo-angle, zigzags, boundaries through the FOE) and for both
+    /// kinds of key and both signs of `W'`; both the one-run path and the
+    /// general path are exercised.
+    #[test]
+    fn index_finds_what_a_scan_finds() {
+        const M: usize = 48;
+        let mut rng = Rng(0x0bad_cafe);
+        let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).expect("camera");
+        let (mut single, mut general, mut found) = (0, 0, 0);
+        for case in 0..3000 {
+            // W' > 0, W' < 0, and a sideways motion (projective keys).
+            let t = match case % 3 {
+                0 => [0.1 * (rng.next() - 0.5), 0.05 * (rng.next() - 0.5), 1.0],
+                1 => [0.1 * (rng.next() - 0.5), 0.05 * (rng.next() - 0.5), -1.0],
+                _ => [1.0, 0.2 * (rng.next() - 0.5), 0.05 * (rng.next() - 0.5)],
+            };
+            let m = Motion::new(t, [0.0; 3]).expect("motion");
+            let g = PairGeometry::new(&cam, &cam, &m);
+            let centre = g
+                .focus_of_expansion()
+                .map_or([255.5, 239.5], |f| [f.u, f.v]);
+            let n = 2 + (rng.next() * (M - 2) as f32) as usize;
+            let r0 = 20.0 + 200.0 * rng.next();
+            let a0 = 6.3 * rng.next();
+            let sweep = (rng.next() - 0.3) * 14.0;
+            let wobble = [0.0, 2.0, 40.0][case % 5 % 3];
+            let mut pts = [Pixel::new(0.0, 0.0); M];
+            for (i, p) in pts.iter_mut().enumerate().take(n) {
+                let a = a0 + sweep * i as f32 / n as f32;
+                let r = r0 + wobble * (rng.next() - 0.5) + 3.0 * i as f32;
+                *p = Pixel::new(
+                    centre[0] + r * libm::cosf(a),
+                    centre[1] + r * libm::sinf(a),
+                );
+            }
+            if case % 17 == 0 {
+                pts[n / 2] = Pixel::new(centre[0], centre[1]);
+            }
+            let boundary = &pts[..n];
+            let mut index = IndexedSearch::<M>::new();
+            index.prepare(boundary, g.key());
+            if index.single {
+                single += 1;
+            } else {
+                general += 1;
+            }
+            for _ in 0..20 {
+                let p = Pixel::new(512.0 * rng.next(), 480.0 * rng.next());
+                let Some(c) = g.compensate(p) else { continue };
+                let mut line = g.line(&c);
+                if line.a2 <= 1.0e-6 {
+                    continue;
+                }
+                if rng.next() < 0.5 {
+                    line.key = g.key().vertex_key(c.pixel);
+                }
+                let mut got = heapless::Vec::<Crossing, M>::new();
+                let mut want = heapless::Vec::<Crossing, M>::new();
+                index.search(&line, boundary, |x| got.push(x).is_ok());
+                scan_all(&line, boundary, |x| want.push(x).is_ok());
+                got.sort_unstable_by_key(|x| x.segment);
+                assert_eq!(got, want, "case {case}");
+                found += got.len();
+            }
+        }
+        assert!(single > 1000 && general > 300 && found > 10_000, "{single} {general} {found}");
     }
 
     /// The frame-wide stretch bound is never below a point's own stretch,

@@ -500,6 +500,86 @@ fn scan_all<F: FnMut(Crossing) -> bool>(line: &EpipolarLine, boundary: &[Pixel],
     }
 }
 
+/// Unwraps a sequence of vertex keys along a boundary: pseudo-angles
+/// (in `[0, 4)`) get the multiple of 4 that keeps consecutive keys less
+/// than half a turn apart; projective keys pass unchanged. Unkeyable
+/// vertices ([`NO_KEY`]) pass unchanged and break the sequence.
+#[derive(Debug, Clone, Copy)]
+struct Unwrap {
+    period: f32,
+    offset: f32,
+    prev: f32,
+    prev_raw: f32,
+    /// Raw steps below this take the short path (none once the offset is
+    /// so large that its rounding could reach 1e-3).
+    short_step: f32,
+    /// Every key so far finite and no step half a turn (a segment through
+    /// the FOE).
+    all_keyed: bool,
+}
+
+impl Unwrap {
+    fn new(key: &PencilKey) -> Self {
+        Self {
+            period: match key {
+                PencilKey::Angular { .. } => 4.0,
+                PencilKey::Projective { .. } => 0.0,
+            },
+            offset: 0.0,
+            prev: NO_KEY,
+            prev_raw: NO_KEY,
+            short_step: 1.998,
+            all_keyed: true,
+        }
+    }
+
+    /// The unwrapped key of the next vertex, whose raw key is `raw`.
+    #[inline(always)]
+    fn next(&mut self, raw: f32) -> f32 {
+        // The usual step: both keys finite and less than 1.998 apart (NaN
+        // and infinities fail the test), so no unwrapping, and the
+        // unwrapped step (the same up to the rounding of `+ offset`, below
+        // 2e-4 while |offset| < 1024) is not half a turn. The general code
+        // below gives the same bits.
+        if (raw - self.prev_raw).abs() < self.short_step {
+            let k = raw + self.offset;
+            self.prev = k;
+            self.prev_raw = raw;
+            return k;
+        }
+        self.step(raw)
+    }
+
+    fn step(&mut self, raw: f32) -> f32 {
+        self.prev_raw = raw;
+        let mut k = raw;
+        if k.is_finite() {
+            k += self.offset;
+            if self.period > 0.0 && self.prev.is_finite() {
+                // Raw keys are in [0, 4) and consecutive keys differ by
+                // less than half a turn, so one correction of the running
+                // offset (a multiple of 4) suffices.
+                let d = k - self.prev;
+                if d > 2.0 {
+                    self.offset -= 4.0;
+                    k -= 4.0;
+                } else if d < -2.0 {
+                    self.offset += 4.0;
+                    k += 4.0;
+                }
+                if self.offset.abs() >= 1024.0 {
+                    self.short_step = -1.0;
+                }
+                self.all_keyed &= ((k - self.prev).abs() - 2.0).abs() >= 1.0e-3;
+            }
+        } else {
+            self.all_keyed = false;
+        }
+        self.prev = k;
+        k
+    }
+}
+
 /// Segments with an unkeyable end (at the FOE) an index keeps aside; with
 /// more, every search scans the whole boundary.
 const MAX_UNKEYED: usize = 4;
@@ -669,58 +749,13 @@ impl<const N: usize> IndexedSearch<N> {
             PencilKey::Angular { .. } => 4.0,
             PencilKey::Projective { .. } => 0.0,
         };
-        let period = self.period;
+        let mut unwrap = Unwrap::new(key);
         let mut n: usize = 0;
-        let mut prev = NO_KEY;
-        let mut offset = 0.0f32;
-        // Every vertex keyed and no segment through the FOE.
-        let mut all_keyed = true;
-        let mut prev_raw = NO_KEY;
-        // Raw steps below this take the short path (none once the offset
-        // is so large that its rounding could reach 1e-3).
-        let mut short_step = 1.998f32;
         for (slot, raw) in self.keys.iter_mut().zip(keys) {
-            let mut k = raw;
-            // The usual step: both keys finite and less than 1.998 apart
-            // (NaN and infinities fail the test), so no unwrapping, and the
-            // unwrapped step (the same up to the rounding of `+ offset`,
-            // below 2e-4 while |offset| < 1024) is not half a turn. The
-            // general code below gives the same bits.
-            if (raw - prev_raw).abs() < short_step {
-                k += offset;
-                *slot = k;
-                prev = k;
-                prev_raw = raw;
-                n += 1;
-                continue;
-            }
-            prev_raw = raw;
-            if k.is_finite() {
-                k += offset;
-                if period > 0.0 && prev.is_finite() {
-                    // Unwrap: raw keys are in [0, 4) and consecutive keys
-                    // differ by less than half a turn, so one correction of
-                    // the running offset (a multiple of 4) suffices.
-                    let d = k - prev;
-                    if d > 2.0 {
-                        offset -= 4.0;
-                        k -= 4.0;
-                    } else if d < -2.0 {
-                        offset += 4.0;
-                        k += 4.0;
-                    }
-                    if offset.abs() >= 1024.0 {
-                        short_step = -1.0;
-                    }
-                    all_keyed &= ((k - prev).abs() - 2.0).abs() >= 1.0e-3;
-                }
-            } else {
-                all_keyed = false;
-            }
-            *slot = k;
-            prev = k;
+            *slot = unwrap.next(raw);
             n += 1;
         }
+        let all_keyed = unwrap.all_keyed;
         self.segments = n.saturating_sub(1);
         self.all_keyed = all_keyed;
         let keys = self.keys.get(..n).unwrap_or(&[]);
@@ -750,7 +785,7 @@ impl<const N: usize> IndexedSearch<N> {
                     *h = mx;
                     *l = mn;
                 }
-                if period <= 0.0 || mx - mn < period - 0.1 {
+                if self.period <= 0.0 || mx - mn < self.period - 0.1 {
                     self.set_range(mn, mx);
                     self.fold_fast = true;
                     return;

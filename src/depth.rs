@@ -94,7 +94,10 @@ pub(crate) fn chord(boundary: &[Pixel], j: usize) -> [f32; 2] {
 /// is the smallest angle consistent with the chord's own error.
 pub(crate) fn crossing_angle(a: [f32; 2], a_len: f32, chord: [f32; 2], e2: f32) -> (f32, f32) {
     let l2 = dot(chord, chord);
-    if !l2.is_finite() || l2 <= 0.0 || a_len <= 0.0 {
+    // NaN fails too. An infinite l2 or a_len ≤ 0 cannot come from
+    // validated pixels and a point away from the FOE; they would give a
+    // NaN angle, which the processor flags `Grazing`.
+    if !(l2 > 0.0 && a_len > 0.0) {
         return (0.0, 1.0);
     }
     let l = sqrt_pos(l2);

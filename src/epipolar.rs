@@ -390,6 +390,12 @@ impl PairGeometry {
         })
     }
 
+    /// The frame-wide stretch bound that [`Self::compensate_in_frame`]
+    /// gives every point, if there is one.
+    pub(crate) fn frame_stretch(&self) -> Option<f32> {
+        self.stretch_bound.is_finite().then_some(self.stretch_bound)
+    }
+
     /// The epipolar line of a compensated point (the vector `a`).
     pub fn line(&self, c: &Compensated) -> EpipolarLine {
         let a = [

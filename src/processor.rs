@@ -770,16 +770,37 @@ struct MotionErrors {
     /// Whether a rotation error is configured (points then get the shift
     /// bound added to their frame-1 error).
     rotation: bool,
+    /// When every point has the same frame-1 error disc (a frame-wide
+    /// stretch and no rotation error): its radius `r₁` and the bound on
+    /// `|a|²` below which the disc holds the FOE, `max((|W'| max(r₁,
+    /// 10⁻³))², 10⁻¹²)`, as [`evaluate`] would compute them per point.
+    frame_disc: Option<(f32, f32)>,
 }
 
 impl MotionErrors {
     fn new(config: &Config, geom: &PairGeometry) -> Self {
         let [ex, ey, ez] = config.rotation_error;
+        let rotation = ex + ey + ez > 0.0;
         Self {
             translation: config.translation_error + 1.05 * geom.translation_norm() * (ex + ey + ez),
-            rotation: ex + ey + ez > 0.0,
+            rotation,
+            frame_disc: match geom.frame_stretch() {
+                Some(stretch) if !rotation => {
+                    let r1 = config.e1 * stretch;
+                    Some((r1, foe_guard2(geom.w(), r1)))
+                }
+                _ => None,
+            },
         }
     }
+}
+
+/// `|a| = |W'| ρ₁` (ρ₁ the distance to the FOE): `|a|²` at or below this
+/// means the frame-1 error disc of radius `r₁` holds the FOE (and `|a|` is
+/// not usable below 10⁻⁶ in any case).
+fn foe_guard2(w: f32, r1: f32) -> f32 {
+    let g = w.abs() * crate::math::fmax(r1, 1.0e-3);
+    crate::math::fmax(g * g, 1.0e-12)
 }
 
 fn flagged(pixel1: Pixel, status: Status) -> PointResult {
@@ -808,17 +829,21 @@ fn evaluate<S: CrossingSearch>(
     // The key of p₁' (computed in pass 1) is the key of its epipolar line.
     line.key = key;
     let w = geom.w();
-    let mut r1 = config.e1 * c.stretch;
-    if errors.rotation {
-        r1 += crate::motion_error::rotation_shift_bound(
-            c.pixel,
-            geom.camera2_intrinsics(),
-            config.rotation_error,
-        );
-    }
-    // |a| = |W'| ρ₁ (distance to the FOE): the error disc holds the FOE.
-    let foe_guard = w.abs() * crate::math::fmax(r1, 1.0e-3);
-    if line.a2 <= foe_guard * foe_guard || line.a2 <= 1.0e-12 {
+    let (r1, guard2) = match errors.frame_disc {
+        Some(disc) => disc,
+        None => {
+            let mut r1 = config.e1 * c.stretch;
+            if errors.rotation {
+                r1 += crate::motion_error::rotation_shift_bound(
+                    c.pixel,
+                    geom.camera2_intrinsics(),
+                    config.rotation_error,
+                );
+            }
+            (r1, foe_guard2(w, r1))
+        }
+    };
+    if line.a2 <= guard2 {
         return flagged(p1, Status::AtFoe);
     }
     let Some(b2) = b2 else {
@@ -871,7 +896,8 @@ fn evaluate<S: CrossingSearch>(
         f32::INFINITY
     };
     let (sin_low, cos) = crossing_angle(line.a, a_len, chord(b2, best.segment), config.e2);
-    if sin_low < config.sin_min_angle {
+    // A NaN angle (impossible for validated input) is grazing too.
+    if !(sin_low >= config.sin_min_angle) {
         r.status = Status::Grazing;
         return r;
     }

@@ -897,7 +897,7 @@ fn evaluate<S: CrossingSearch>(
     };
     let (sin_low, cos) = crossing_angle(line.a, a_len, chord(b2, best.segment), config.e2);
     // A NaN angle (impossible for validated input) is grazing too.
-    if !(sin_low >= config.sin_min_angle) {
+    if sin_low < config.sin_min_angle || sin_low.is_nan() {
         r.status = Status::Grazing;
         return r;
     }

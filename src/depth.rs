@@ -138,20 +138,10 @@ pub(crate) fn stick(
     spread_a: f32,
     spread_w: f32,
 ) -> Option<DepthInterval> {
-    let d = tau * a_len;
     if spread_a == 0.0 && spread_w == 0.0 {
-        // No translation error: the same formulas with the spreads at zero
-        // (the same bits), without the terms that vanish.
-        let h1 = fmax(r1 * (1.0 + w * tau), 0.0);
-        let eps = r1 + (e2 + h1 * cos) / sin_low;
-        if d - eps <= 0.0 {
-            return None;
-        }
-        let wr = w.abs() * r1;
-        let s_far = w + (a_len + wr) / (d - eps);
-        let s_near = w + fmax(a_len - wr, 0.0) / (d + eps + h1 * h1 / (2.0 * (d - eps)));
-        return interval(s_near, s_far, depth_scale);
+        return stick_exact(w, tau, a_len, r1, e2, sin_low, cos, depth_scale);
     }
+    let d = tau * a_len;
     let turn = spread_a / a_len; // ≥ sin of the angle between the lines
     if turn.is_nan() || turn >= 1.0 || turn * cos >= sin_low {
         return None;
@@ -168,6 +158,32 @@ pub(crate) fn stick(
     let a_lo = fmax(a_len - w_abs * r1 - spread_a, 0.0);
     let s_far = (w + spread_w) + a_hi / (d - eps);
     let s_near = (w - spread_w) + a_lo / (d + eps + h * h / (2.0 * (d - eps)));
+    interval(s_near, s_far, depth_scale)
+}
+
+/// [`stick`] without translation error: the same formulas with the
+/// spreads at zero (the same bits), without the terms that vanish.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn stick_exact(
+    w: f32,
+    tau: f32,
+    a_len: f32,
+    r1: f32,
+    e2: f32,
+    sin_low: f32,
+    cos: f32,
+    depth_scale: f32,
+) -> Option<DepthInterval> {
+    let d = tau * a_len;
+    let h1 = fmax(r1 * (1.0 + w * tau), 0.0);
+    let eps = r1 + (e2 + h1 * cos) / sin_low;
+    if d - eps <= 0.0 {
+        return None;
+    }
+    let wr = w.abs() * r1;
+    let s_far = w + (a_len + wr) / (d - eps);
+    let s_near = w + fmax(a_len - wr, 0.0) / (d + eps + h1 * h1 / (2.0 * (d - eps)));
     interval(s_near, s_far, depth_scale)
 }
 

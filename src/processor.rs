@@ -11,7 +11,9 @@ use core::fmt;
 
 use crate::boundary::Frame;
 use crate::camera::{Camera, Pixel};
-use crate::depth::{chord, crossing_angle, stick, DepthInterval, CHORD_HALF_WINDOW};
+use crate::depth::{
+    chord, crossing_angle, stick, stick_exact, DepthInterval, CHORD_HALF_WINDOW,
+};
 use crate::epipolar::{
     Compensated, CrossingSearch, EpipolarLine, IndexedSearch, PairGeometry, MAX_CROSSINGS,
     MAX_RAY_CROSSINGS,
@@ -896,8 +898,11 @@ fn evaluate<S: CrossingSearch>(
         f32::INFINITY
     };
     let (sin_low, cos) = crossing_angle(line.a, a_len, chord(b2, best.segment), config.e2);
-    // A NaN angle (impossible for validated input) is grazing too.
-    if sin_low < config.sin_min_angle || sin_low.is_nan() {
+    // A NaN angle (impossible for validated input) is grazing too: one
+    // negated comparison says both.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    let grazing = !(sin_low >= config.sin_min_angle);
+    if grazing {
         r.status = Status::Grazing;
         return r;
     }
@@ -912,40 +917,50 @@ fn evaluate<S: CrossingSearch>(
         r.status = Status::BeyondMaxDepth;
         return r;
     }
-    let (spread_a, spread_w) = if errors.translation > 0.0 {
-        crate::motion_error::spread(
+    let interval = if errors.translation > 0.0 {
+        let (spread_a, spread_w) = crate::motion_error::spread(
             geom.rotation(),
             geom.camera2_intrinsics(),
             c.pixel,
             errors.translation,
+        );
+        stick(
+            w,
+            best.tau,
+            a_len,
+            r1,
+            config.e2,
+            sin_low,
+            cos,
+            c.depth_scale,
+            spread_a,
+            spread_w,
         )
     } else {
-        (0.0, 0.0)
+        stick_exact(
+            w,
+            best.tau,
+            a_len,
+            r1,
+            config.e2,
+            sin_low,
+            cos,
+            c.depth_scale,
+        )
     };
-    let interval = stick(
-        w,
-        best.tau,
-        a_len,
-        r1,
-        config.e2,
-        sin_low,
-        cos,
-        c.depth_scale,
-        spread_a,
-        spread_w,
-    );
     match interval {
         Some(i) => {
             r.z = z;
             r.z_near = crate::math::fmin(i.z_near, z);
             r.z_far = crate::math::fmax(i.z_far, z);
+            // The fold test only matters where a depth would otherwise be
+            // given (here: `Ok` or `Ambiguous`); elsewhere the status
+            // already says why there is none.
+            if folded {
+                r.status = Status::Folded;
+            }
         }
         None => r.status = Status::Unbounded,
-    }
-    // The fold test only matters where a depth would otherwise be given:
-    // elsewhere the status already says why there is none.
-    if folded && r.status.has_depth() {
-        r.status = Status::Folded;
     }
     r
 }

@@ -1089,7 +1089,19 @@ impl<const N: usize> IndexedSearch<N> {
     /// ranges is the one interval `[min − ε, max + ε]` of those keys (a
     /// running prefix); the same holds for the segments `j ≥ i+4` and the
     /// suffix extremes from vertex `i+4`, which the build kept.
-    pub(crate) fn fold_each(&self, mut folded: impl FnMut(usize)) {
+    pub(crate) fn fold_each(&self, folded: impl FnMut(usize)) {
+        if self.orient > 0.0 {
+            self.fold_each_in::<true>(folded);
+        } else {
+            self.fold_each_in::<false>(folded);
+        }
+    }
+
+    /// [`Self::fold_each`] for keys that rise (`RISING`) or fall overall:
+    /// the same two comparisons for each range, the one that usually
+    /// fails first (the prefix lies behind the key, the suffix ahead).
+    #[inline(always)]
+    fn fold_each_in<const RISING: bool>(&self, mut folded: impl FnMut(usize)) {
         let n = self.segments + 1;
         let (Some(keys), Some(smin), Some(smax)) =
             (self.keys.get(..n), self.lo.get(..n), self.hi.get(..n))
@@ -1097,15 +1109,29 @@ impl<const N: usize> IndexedSearch<N> {
             return;
         };
         let eps = self.eps;
+        let within = |lo: f32, hi: f32, k: f32| {
+            if RISING {
+                k <= hi + eps && lo - eps <= k
+            } else {
+                lo - eps <= k && k <= hi + eps
+            }
+        };
+        let ahead = |lo: f32, hi: f32, k: f32| {
+            if RISING {
+                lo - eps <= k && k <= hi + eps
+            } else {
+                k <= hi + eps && lo - eps <= k
+            }
+        };
         // Vertex i − 4 (from i = 4 on) and the suffix extremes from vertex
         // i + 4 (while i + 5 < n), walked along with i: no indexing.
         let mut lagged = keys.iter();
-        let ahead = n.saturating_sub(1);
+        let last = n.saturating_sub(1);
         let mut suffix = smin
-            .get(4..ahead)
+            .get(4..last)
             .unwrap_or(&[])
             .iter()
-            .zip(smax.get(4..ahead).unwrap_or(&[]));
+            .zip(smax.get(4..last).unwrap_or(&[]));
         let (mut pmin, mut pmax) = (f32::INFINITY, f32::NEG_INFINITY);
         for (i, &k) in keys.iter().enumerate() {
             let mut met = false;
@@ -1113,11 +1139,11 @@ impl<const N: usize> IndexedSearch<N> {
                 if let Some(&v) = lagged.next() {
                     pmin = fmin(pmin, v);
                     pmax = fmax(pmax, v);
-                    met = i >= 5 && pmin - eps <= k && k <= pmax + eps;
+                    met = i >= 5 && within(pmin, pmax, k);
                 }
             }
             if let Some((&mn, &mx)) = suffix.next() {
-                met = met || (mn - eps <= k && k <= mx + eps);
+                met = met || ahead(mn, mx, k);
             }
             if met {
                 folded(i);

@@ -41,7 +41,7 @@
 use crate::camera::{Camera, Pixel};
 use crate::math::{
     ceil_i32, cross, dot, fmax, fmin, mat3_mul, mat3_transpose, mat3_vec, next_up, pseudo_angle,
-    sub,
+    pseudo_angle_nonzero, sub,
 };
 use crate::motion::Motion;
 
@@ -112,7 +112,8 @@ impl PencilKey {
                 if dot(d, d) < 1.0e-6 {
                     NO_KEY
                 } else {
-                    pseudo_angle(d)
+                    // |d|² ≥ 1e-6 (or NaN, which gives NaN either way).
+                    pseudo_angle_nonzero(d)
                 }
             }
             PencilKey::Projective { .. } => self.projective(v),
@@ -1379,10 +1380,7 @@ mod tests {
             for (i, p) in pts.iter_mut().enumerate().take(n) {
                 let a = a0 + sweep * i as f32 / n as f32;
                 let r = r0 + wobble * (rng.next() - 0.5) + 3.0 * i as f32;
-                *p = Pixel::new(
-                    centre[0] + r * libm::cosf(a),
-                    centre[1] + r * libm::sinf(a),
-                );
+                *p = Pixel::new(centre[0] + r * libm::cosf(a), centre[1] + r * libm::sinf(a));
             }
             if case % 17 == 0 {
                 pts[n / 2] = Pixel::new(centre[0], centre[1]);
@@ -1414,7 +1412,10 @@ mod tests {
                 found += got.len();
             }
         }
-        assert!(single > 1000 && general > 300 && found > 10_000, "{single} {general} {found}");
+        assert!(
+            single > 1000 && general > 300 && found > 10_000,
+            "{single} {general} {found}"
+        );
     }
 
     /// The frame-wide stretch bound is never below a point's own stretch,

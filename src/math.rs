@@ -193,13 +193,20 @@ pub(crate) fn sub(a: [f32; 2], b: [f32; 2]) -> [f32; 2] {
 /// The zero vector maps to 0 (callers treat that case separately).
 #[inline]
 pub(crate) fn pseudo_angle(d: [f32; 2]) -> f32 {
+    if d[0].abs() + d[1].abs() <= 0.0 {
+        return 0.0;
+    }
+    pseudo_angle_nonzero(d)
+}
+
+/// [`pseudo_angle`] of a vector the caller knows not to be zero (the same
+/// bits without the check).
+#[inline]
+pub(crate) fn pseudo_angle_nonzero(d: [f32; 2]) -> f32 {
     // Rotate so that "up" (0,-1) becomes the +x axis: (x, y) -> (-y, x).
     let x = -d[1];
     let y = d[0];
     let l1 = x.abs() + y.abs();
-    if l1 <= 0.0 {
-        return 0.0;
-    }
     let p = y / l1; // in [-1, 1]
     if x >= 0.0 {
         if y >= 0.0 {

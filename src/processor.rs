@@ -11,9 +11,7 @@ use core::fmt;
 
 use crate::boundary::Frame;
 use crate::camera::{Camera, Pixel};
-use crate::depth::{
-    chord, crossing_angle, stick, stick_exact, DepthInterval, CHORD_HALF_WINDOW,
-};
+use crate::depth::{chord, crossing_angle, stick, stick_exact, DepthInterval, CHORD_HALF_WINDOW};
 use crate::epipolar::{
     Compensated, CrossingSearch, EpipolarLine, IndexedSearch, PairGeometry, MAX_CROSSINGS,
     MAX_RAY_CROSSINGS,
@@ -659,27 +657,37 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
     let geom = PairGeometry::new(previous.camera(), frame.camera(), motion);
     let errors = MotionErrors::new(config, &geom);
     out.camera1 = *previous.camera();
-    out.boundaries.clear();
-    for (k, b1) in previous.boundaries().iter().enumerate() {
-        if out
-            .boundaries
-            .push(BoundaryStructure {
-                points: heapless::Vec::new(),
-            })
-            .is_err()
-        {
+    // The output keeps its buffers from the last frame: in a steady stream
+    // (the same number of points) nothing is pushed, only overwritten.
+    let count = previous.boundaries().len();
+    out.boundaries.truncate(count);
+    while out.boundaries.len() < count {
+        let empty = BoundaryStructure {
+            points: heapless::Vec::new(),
+        };
+        if out.boundaries.push(empty).is_err() {
             break;
         }
-        let Some(bs) = out.boundaries.last_mut() else {
-            break;
-        };
+    }
+    for (k, (b1, bs)) in previous
+        .boundaries()
+        .iter()
+        .zip(out.boundaries.iter_mut())
+        .enumerate()
+    {
         // Pass 1: compensate every frame-1 point once. The output entry
         // holds the compensated point until pass 2 overwrites it: p₁' in
         // `pixel2`, q_z in `z`, the stretch in `z_near`, the key of its
         // epipolar line in `z_far` (no extra memory).
         let key = *geom.key();
-        for &p1 in b1.points() {
-            let r = match geom.compensate_in_frame(p1) {
+        let n = b1.points().len();
+        bs.points.truncate(n);
+        if bs.points.resize_default(n).is_err() {
+            // A boundary holds at most N points: not reached.
+            bs.points.clear();
+        }
+        for (slot, &p1) in bs.points.iter_mut().zip(b1.points()) {
+            *slot = match geom.compensate_in_frame(p1) {
                 Some(c) => PointResult {
                     pixel1: p1,
                     pixel2: Pixel::new(c.pixel[0], c.pixel[1]),
@@ -690,9 +698,6 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
                 },
                 None => flagged(p1, Status::BehindCamera),
             };
-            if bs.points.push(r).is_err() {
-                break;
-            }
         }
         // The fold test (frame 1 only): does a point's epipolar line meet
         // the frame-1 boundary again, away from the point itself? The line

@@ -1102,6 +1102,9 @@ impl<const N: usize> IndexedSearch<N> {
     /// the same two comparisons for each range, the one that usually
     /// fails first (the prefix lies behind the key, the suffix ahead).
     #[inline(always)]
+    // The branches differ in the order of the two comparisons, which is
+    // the point (clippy sees them as the same).
+    #[allow(clippy::if_same_then_else)]
     fn fold_each_in<const RISING: bool>(&self, mut folded: impl FnMut(usize)) {
         let n = self.segments + 1;
         let (Some(keys), Some(smin), Some(smax)) =

@@ -228,7 +228,9 @@ impl EpipolarLine {
         let (v0, v1) = (v0.arr(), v1.arr());
         let s0 = cross(self.a, sub(v0, self.origin));
         let s1 = cross(self.a, sub(v1, self.origin));
-        if (s0 >= 0.0) == (s1 >= 0.0) {
+        // `σ ≥ 0` is a clear sign bit once −0 is made +0 (`+ 0.0`); a NaN
+        // σ (not from finite input) gives a NaN τ below, so no crossing.
+        if ((s0 + 0.0).to_bits() ^ (s1 + 0.0).to_bits()) >> 31 == 0 {
             return None;
         }
         // s0 and s1 have strictly different signs, so s0 - s1 != 0.
@@ -861,13 +863,15 @@ impl<const N: usize> IndexedSearch<N> {
 
     /// For a [`Self::single`] index: the one unwrapped key equal to `q`
     /// modulo the period that can lie in the widened key range (the
-    /// smallest one `≥ kmin − eps`), for `q` in `[0, 4)`; `None` otherwise.
+    /// smallest one `≥ kmin − eps`), for `q` in `[+0, 4)`; `None` otherwise.
     #[inline(always)]
     fn single_key(&self, q: f32) -> Option<f32> {
         if self.period <= 0.0 {
             return q.is_finite().then_some(q);
         }
-        if !(0.0..4.0).contains(&q) {
+        // q in [+0, 4) (not NaN, not −0): as bits, a u32 below that of 4
+        // (the order of non-negative floats is that of their bits).
+        if q.to_bits() >= 4.0f32.to_bits() {
             return None;
         }
         let qq = q + self.base;

@@ -1355,6 +1355,32 @@ mod tests {
         assert!(fast_cases > 3000 && folds > 1000, "{fast_cases} {folds}");
     }
 
+    /// A vertex on the line counts as on the positive side, also when its
+    /// σ comes out as −0: of the two segments through it, exactly the one
+    /// from the negative side reports the crossing.
+    #[test]
+    fn vertex_on_the_line_is_on_the_positive_side() {
+        // a = (−1, 0): σ of the vertex (5, 0) is (−1)(0) − (0)(5) = −0.
+        let line = EpipolarLine {
+            origin: [0.0, 0.0],
+            a: [-1.0, 0.0],
+            a2: 1.0,
+            tau_max: f32::INFINITY,
+            ray_min: f32::NEG_INFINITY,
+            ray_max: f32::INFINITY,
+            key: NO_KEY,
+        };
+        let on = Pixel::new(5.0, 0.0);
+        let sigma = cross(line.a, sub(on.arr(), line.origin));
+        assert!(sigma == 0.0 && sigma.is_sign_negative());
+        let (neg, pos) = (Pixel::new(5.0, 1.0), Pixel::new(5.0, -1.0));
+        let into = line.crossing(0, neg, on).expect("from the negative side");
+        assert_eq!(into.tau, -5.0);
+        assert_eq!(line.crossing(1, on, pos), None);
+        assert_eq!(line.crossing(2, pos, on), None);
+        assert!(line.crossing(3, on, neg).is_some());
+    }
+
     /// The index finds exactly the crossings a scan of every segment finds,
     /// on random polylines about the FOE (arcs that wrap past the cut of
     /// the pseudo-angle, zigzags, boundaries through the FOE) and for both

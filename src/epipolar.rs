@@ -1141,15 +1141,25 @@ impl<const N: usize> IndexedSearch<N> {
             .iter()
             .zip(smax.get(4..last).unwrap_or(&[]));
         let (mut pmin, mut pmax) = (f32::INFINITY, f32::NEG_INFINITY);
-        for (i, &k) in keys.iter().enumerate() {
-            let mut met = false;
-            if i >= 4 {
+        // Vertices 0 ..= 4: no segment behind them yet (vertex 4 starts
+        // the prefix with vertex 0).
+        for (i, &k) in keys.iter().enumerate().take(5) {
+            if i == 4 {
                 if let Some(&v) = lagged.next() {
                     pmin = fmin(pmin, v);
                     pmax = fmax(pmax, v);
-                    met = i >= 5 && within(pmin, pmax, k);
                 }
             }
+            if let Some((&mn, &mx)) = suffix.next() {
+                if ahead(mn, mx, k) {
+                    folded(i);
+                }
+            }
+        }
+        for ((i, &k), &v) in keys.iter().enumerate().skip(5).zip(lagged) {
+            pmin = fmin(pmin, v);
+            pmax = fmax(pmax, v);
+            let mut met = within(pmin, pmax, k);
             if let Some((&mn, &mx)) = suffix.next() {
                 met = met || ahead(mn, mx, k);
             }

@@ -94,12 +94,11 @@ pub(crate) fn chord(boundary: &[Pixel], j: usize) -> [f32; 2] {
 /// is the smallest angle consistent with the chord's own error.
 pub(crate) fn crossing_angle(a: [f32; 2], a_len: f32, chord: [f32; 2], e2: f32) -> (f32, f32) {
     let l2 = dot(chord, chord);
-    // NaN fails too. An infinite l2 or a_len ≤ 0 cannot come from
-    // validated pixels and a point away from the FOE; they would give a
-    // NaN angle, which the processor flags `Grazing`.
-    if !(l2 > 0.0 && a_len > 0.0) {
-        return (0.0, 1.0);
-    }
+    // The chord of a validated boundary has l2 > 0 and a point away from
+    // the FOE has a_len > 0. Anything else (l2 or a_len zero or not
+    // finite) cannot pass the grazing test below: 0 · ∞ and ∞ − ∞ give a
+    // NaN sin, and a zero chord gives `sin_low` ≤ 0; the processor flags
+    // both `Grazing` (a NaN by its negated comparison).
     let l = sqrt_pos(l2);
     let inv = 1.0 / (a_len * l);
     let sin = cross(a, chord).abs() * inv;

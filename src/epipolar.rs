@@ -96,7 +96,7 @@ pub enum PencilKey {
 }
 
 /// Key widening that covers rounding in the pseudo-angle (units of `[0, 4)`).
-const ANGULAR_EPS: f32 = 1.0e-4;
+pub(crate) const ANGULAR_EPS: f32 = 1.0e-4;
 /// Key widening in the projective mode, pixels (plus a relative part).
 const PROJECTIVE_EPS: f32 = 1.0e-3;
 /// Sentinel for "no usable key": the segment is always examined.
@@ -514,7 +514,7 @@ fn scan_all<F: FnMut(Crossing) -> bool>(line: &EpipolarLine, boundary: &[Pixel],
 /// than half a turn apart; projective keys pass unchanged. Unkeyable
 /// vertices ([`NO_KEY`]) pass unchanged and break the sequence.
 #[derive(Debug, Clone, Copy)]
-struct Unwrap {
+pub(crate) struct Unwrap {
     period: f32,
     offset: f32,
     prev: f32,
@@ -528,7 +528,12 @@ struct Unwrap {
 }
 
 impl Unwrap {
-    fn new(key: &PencilKey) -> Self {
+    /// Every key so far finite, and no segment through the FOE.
+    pub(crate) fn all_keyed(&self) -> bool {
+        self.all_keyed
+    }
+
+    pub(crate) fn new(key: &PencilKey) -> Self {
         Self {
             period: match key {
                 PencilKey::Angular { .. } => 4.0,
@@ -544,7 +549,7 @@ impl Unwrap {
 
     /// The unwrapped key of the next vertex, whose raw key is `raw`.
     #[inline(always)]
-    fn next(&mut self, raw: f32) -> f32 {
+    pub(crate) fn next(&mut self, raw: f32) -> f32 {
         // The usual step: both keys finite and less than 1.998 apart (NaN
         // and infinities fail the test), so no unwrapping, and the
         // unwrapped step (the same up to the rounding of `+ offset`, below
@@ -665,6 +670,91 @@ impl<const N: usize> Default for IndexedSearch<N> {
     }
 }
 
+/// A [`IndexedSearch`] whose keys span less than a turn and whose segments
+/// all have keys, borrowed for one boundary's matching pass: the crossing
+/// search of [`IndexedSearch::search`] for that case, with the run located
+/// and scanned in one place and the state in registers.
+pub(crate) struct SingleRun<'a, const N: usize> {
+    index: &'a IndexedSearch<N>,
+    hi: &'a [f32],
+    lo: &'a [f32],
+    boundary: &'a [Pixel],
+    /// A raw key `q` is usable iff `q.to_bits() & key_mask < key_limit`:
+    /// in `[+0, 4)` for pseudo-angles, finite for projective keys.
+    key_mask: u32,
+    key_limit: u32,
+    orient: f32,
+    eps: f32,
+    /// The smallest usable unwrapped key, `kmin − eps` (pseudo-angles;
+    /// −∞ for projective keys, which are not unwrapped).
+    lim: f32,
+    /// A usable raw key `q` stands for `q + base`, or `q + base4` when
+    /// that is below `lim` ([`IndexedSearch::single_key`]).
+    base: f32,
+    base4: f32,
+    hint: usize,
+}
+
+impl<const N: usize> SingleRun<'_, N> {
+    /// The frame-2 boundary.
+    pub(crate) fn boundary(&self) -> &[Pixel] {
+        self.boundary
+    }
+
+    /// Every crossing of `line`'s ray, up to [`MAX_RAY_CROSSINGS`]` + 1`,
+    /// by the general search of the index (for a line [`Self::search`]
+    /// declined). Out of line: rare, and `line` is a copy so that the
+    /// caller's stays in registers.
+    #[inline(never)]
+    pub(crate) fn collect_general(&mut self, line: EpipolarLine, out: &mut Crossings) {
+        self.index
+            .search_at(&mut self.hint, &line, self.boundary, |c| {
+                out.push(c).is_ok()
+            });
+    }
+
+    /// Visit the crossings of `line`'s ray with the boundary, as
+    /// [`IndexedSearch::search`] does (the same crossings, in increasing
+    /// segment order), until `visit` returns `false`. Returns `false`
+    /// without visiting anything when the line's key is not usable (the
+    /// caller then uses [`Self::collect_general`]).
+    #[inline(always)]
+    pub(crate) fn search<F: FnMut(Crossing) -> bool>(
+        &mut self,
+        line: &EpipolarLine,
+        mut visit: F,
+    ) -> bool {
+        let q = line.key;
+        if q.to_bits() & self.key_mask >= self.key_limit {
+            return false;
+        }
+        let mut qq = q + self.base;
+        if qq < self.lim {
+            qq = q + self.base4;
+        }
+        let oq = self.orient * qq;
+        let a = first_at_least(self.hi, oq - self.eps, self.hint);
+        self.hint = a;
+        let t_hi = oq + self.eps;
+        // The candidates: from `a` while the suffix minimum allows.
+        let mut j = a;
+        while let Some(&l) = self.lo.get(j) {
+            if l > t_hi {
+                break;
+            }
+            if let Some(&[v0, v1]) = self.boundary.get(j..j + 2) {
+                if let Some(c) = line.crossing(j, v0, v1) {
+                    if !visit(c) {
+                        break;
+                    }
+                }
+            }
+            j += 1;
+        }
+        true
+    }
+}
+
 /// First index `j` in `[0, v.len())` with `v[j] ≥ t` in a non-decreasing
 /// slice (or `v.len()`): linear probes from `hint`, then bisection.
 #[inline(always)]
@@ -748,6 +838,30 @@ impl<const N: usize> IndexedSearch<N> {
     /// every line (the crossing search) or none (the fold test, where such
     /// a vertex is at the FOE or behind the camera).
     fn build(&mut self, key: &PencilKey, unkeyed_meets_all: bool, keys: impl Iterator<Item = f32>) {
+        let mut unwrap = Unwrap::new(key);
+        let mut n: usize = 0;
+        for (slot, raw) in self.keys.iter_mut().zip(keys) {
+            *slot = unwrap.next(raw);
+            n += 1;
+        }
+        self.index_keys(key, unkeyed_meets_all, n, unwrap.all_keyed());
+    }
+
+    /// The key array, for a caller that unwraps the keys itself (with an
+    /// [`Unwrap`]) before [`Self::index_keys`].
+    pub(crate) fn keys_mut(&mut self) -> &mut [f32; N] {
+        &mut self.keys
+    }
+
+    /// Index the first `n` unwrapped keys already in the key array;
+    /// `all_keyed` as the [`Unwrap`] that made them says.
+    pub(crate) fn index_keys(
+        &mut self,
+        key: &PencilKey,
+        unkeyed_meets_all: bool,
+        n: usize,
+        all_keyed: bool,
+    ) {
         self.key = *key;
         self.unkeyed.clear();
         self.scan = false;
@@ -758,13 +872,7 @@ impl<const N: usize> IndexedSearch<N> {
             PencilKey::Angular { .. } => 4.0,
             PencilKey::Projective { .. } => 0.0,
         };
-        let mut unwrap = Unwrap::new(key);
-        let mut n: usize = 0;
-        for (slot, raw) in self.keys.iter_mut().zip(keys) {
-            *slot = unwrap.next(raw);
-            n += 1;
-        }
-        let all_keyed = unwrap.all_keyed;
+        let n = n.min(N);
         self.segments = n.saturating_sub(1);
         self.all_keyed = all_keyed;
         let keys = self.keys.get(..n).unwrap_or(&[]);
@@ -882,6 +990,39 @@ impl<const N: usize> IndexedSearch<N> {
         })
     }
 
+    /// The one-run view of a [`Self::single`] index built for `boundary`
+    /// (`None` for any other index): what the processor's lean matching
+    /// pass needs, borrowed once per boundary.
+    pub(crate) fn single_run<'a>(&'a self, boundary: &'a [Pixel]) -> Option<SingleRun<'a, N>> {
+        let s = self.segments;
+        if !self.single || boundary.len() != s + 1 {
+            return None;
+        }
+        let angular = self.period > 0.0;
+        Some(SingleRun {
+            index: self,
+            hi: self.hi.get(..s)?,
+            lo: self.lo.get(..s)?,
+            boundary,
+            key_mask: if angular { u32::MAX } else { 0x7fff_ffff },
+            key_limit: if angular {
+                4.0f32.to_bits()
+            } else {
+                f32::INFINITY.to_bits()
+            },
+            orient: self.orient,
+            eps: self.eps,
+            lim: if angular {
+                self.kmin - self.eps
+            } else {
+                f32::NEG_INFINITY
+            },
+            base: if angular { self.base } else { 0.0 },
+            base4: self.base + 4.0,
+            hint: self.hint,
+        })
+    }
+
     /// Visit the crossings on the candidate run of the unwrapped key `qq`
     /// for an index whose segments are all keyed; `false` when `visit`
     /// stopped the search.
@@ -891,7 +1032,8 @@ impl<const N: usize> IndexedSearch<N> {
     /// bench), so the exact side test is tried on all of it.
     #[inline(always)]
     fn keyed_run<F: FnMut(Crossing) -> bool>(
-        &mut self,
+        &self,
+        hint: &mut usize,
         qq: f32,
         line: &EpipolarLine,
         boundary: &[Pixel],
@@ -902,8 +1044,8 @@ impl<const N: usize> IndexedSearch<N> {
             return true;
         };
         let oq = self.orient * qq;
-        let a = first_at_least(hi, oq - self.eps, self.hint);
-        self.hint = a;
+        let a = first_at_least(hi, oq - self.eps, *hint);
+        *hint = a;
         let t_hi = oq + self.eps;
         let (Some(run), Some(pts)) = (lo.get(a..), boundary.get(a..)) else {
             return true;
@@ -1074,6 +1216,7 @@ impl<const N: usize> IndexedSearch<N> {
         true
     }
 
+    #[cfg(test)]
     /// Index the rotation-compensated frame-1 boundary (for the fold test)
     /// from the keys of its compensated points.
     pub(crate) fn prepare_keys(&mut self, key: &PencilKey, keys: impl Iterator<Item = f32>) {
@@ -1212,12 +1355,27 @@ impl<const N: usize> CrossingSearch for IndexedSearch<N> {
         &mut self,
         line: &EpipolarLine,
         boundary: &[Pixel],
+        visit: F,
+    ) {
+        let mut hint = self.hint;
+        self.search_at(&mut hint, line, boundary, visit);
+        self.hint = hint;
+    }
+}
+
+impl<const N: usize> IndexedSearch<N> {
+    /// [`CrossingSearch::search`] from the run start `hint` (updated).
+    fn search_at<F: FnMut(Crossing) -> bool>(
+        &self,
+        hint: &mut usize,
+        line: &EpipolarLine,
+        boundary: &[Pixel],
         mut visit: F,
     ) {
         let s = self.segments;
         if self.single && boundary.len() == s + 1 {
             if let Some(qq) = self.single_key(line.key) {
-                self.keyed_run(qq, line, boundary, &mut visit);
+                self.keyed_run(hint, qq, line, boundary, &mut visit);
                 return;
             }
         }
@@ -1248,7 +1406,7 @@ impl<const N: usize> CrossingSearch for IndexedSearch<N> {
         let mut qq = first;
         for _ in 0..count {
             if self.all_keyed {
-                if !self.keyed_run(qq, line, boundary, &mut visit) {
+                if !self.keyed_run(hint, qq, line, boundary, &mut visit) {
                     return;
                 }
                 qq += self.period;
@@ -1261,8 +1419,8 @@ impl<const N: usize> CrossingSearch for IndexedSearch<N> {
                 return;
             };
             let oq = o * qq;
-            let a = first_at_least(hi, oq - eps, self.hint);
-            self.hint = a;
+            let a = first_at_least(hi, oq - eps, *hint);
+            *hint = a;
             let t_hi = oq + eps;
             // Bounded by the slice `lo` (one entry per segment).
             let mut j = a;

@@ -13,9 +13,10 @@ use crate::boundary::Frame;
 use crate::camera::{Camera, Pixel};
 use crate::depth::{chord, crossing_angle, stick, stick_exact, DepthInterval, CHORD_HALF_WINDOW};
 use crate::epipolar::{
-    Compensated, CrossingSearch, EpipolarLine, IndexedSearch, PairGeometry, MAX_CROSSINGS,
-    MAX_RAY_CROSSINGS,
+    Compensated, CrossingSearch, Crossings, EpipolarLine, IndexedSearch, PairGeometry, PencilKey,
+    SingleRun, Unwrap, ANGULAR_EPS, MAX_CROSSINGS, MAX_RAY_CROSSINGS,
 };
+use crate::math::{fmax, fmin};
 use crate::motion::Motion;
 
 /// Tuning of the reconstruction. All values are validated by [`Config::new`].
@@ -609,6 +610,8 @@ trait Searches<const N: usize> {
     type Crossing: CrossingSearch;
     fn index(&mut self) -> &mut IndexedSearch<N>;
     fn crossing(&mut self) -> &mut Self::Crossing;
+    /// The built-in index as the crossing search, if it is the one used.
+    fn lean(&mut self) -> Option<&mut IndexedSearch<N>>;
 }
 
 struct OwnIndex<'a, const N: usize>(&'a mut IndexedSearch<N>);
@@ -621,6 +624,9 @@ impl<const N: usize> Searches<N> for OwnIndex<'_, N> {
     fn crossing(&mut self) -> &mut IndexedSearch<N> {
         self.0
     }
+    fn lean(&mut self) -> Option<&mut IndexedSearch<N>> {
+        Some(self.0)
+    }
 }
 
 struct WithSearch<'a, const N: usize, S>(&'a mut IndexedSearch<N>, &'a mut S);
@@ -632,6 +638,9 @@ impl<const N: usize, S: CrossingSearch> Searches<N> for WithSearch<'_, N, S> {
     }
     fn crossing(&mut self) -> &mut S {
         self.1
+    }
+    fn lean(&mut self) -> Option<&mut IndexedSearch<N>> {
+        None
     }
 }
 
@@ -675,10 +684,6 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
         .zip(out.boundaries.iter_mut())
         .enumerate()
     {
-        // Pass 1: compensate every frame-1 point once. The output entry
-        // holds the compensated point until pass 2 overwrites it: p₁' in
-        // `pixel2`, q_z in `z`, the stretch in `z_near`, the key of its
-        // epipolar line in `z_far` (no extra memory).
         let key = *geom.key();
         let n = b1.points().len();
         bs.points.truncate(n);
@@ -686,86 +691,211 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
             // A boundary holds at most N points: not reached.
             bs.points.clear();
         }
-        for (slot, &p1) in bs.points.iter_mut().zip(b1.points()) {
-            *slot = match geom.compensate_in_frame(p1) {
-                Some(c) => PointResult {
-                    pixel1: p1,
-                    pixel2: Pixel::new(c.pixel[0], c.pixel[1]),
-                    z: c.depth_scale,
-                    z_near: c.stretch,
-                    z_far: key.vertex_key(c.pixel),
-                    status: Status::NoIntersection,
-                },
-                None => flagged(p1, Status::BehindCamera),
-            };
-        }
+        // Pass 1: compensate every frame-1 point once. The output entry
+        // holds the compensated point until pass 2 overwrites it: p₁' in
+        // `pixel2`, q_z in `z`, the stretch in `z_near`, the raw key of
+        // its epipolar line in `z_far` (no extra memory); the unwrapped
+        // keys go to the index's key array.
+        //
         // The fold test (frame 1 only): does a point's epipolar line meet
         // the frame-1 boundary again, away from the point itself? The line
         // through the FOE and p₁' has p₁''s own key.
         let index = searches.index();
-        index.prepare_keys(
-            &key,
-            bs.points.iter().map(|r| {
-                if r.status == Status::BehindCamera {
-                    f32::INFINITY
-                } else {
-                    r.z_far
-                }
-            }),
-        );
-        if index.fold_fast() {
-            index.fold_each(|i| {
-                if let Some(r) = bs.points.get_mut(i) {
-                    r.status = Status::Folded;
-                }
-            });
+        let angular = matches!(key, PencilKey::Angular { .. });
+        let all_keyed = if angular {
+            pass1::<N, true>(&geom, b1.points(), &mut bs.points, index.keys_mut())
         } else {
-            for (i, r) in bs.points.iter_mut().enumerate() {
-                if r.status != Status::BehindCamera
-                    && index.meets_outside(
-                        r.z_far,
-                        (
-                            i.saturating_sub(CHORD_HALF_WINDOW),
-                            i + CHORD_HALF_WINDOW - 1,
-                        ),
-                    )
-                {
-                    r.status = Status::Folded;
+            pass1::<N, false>(&geom, b1.points(), &mut bs.points, index.keys_mut())
+        };
+        let fast = angular
+            && all_keyed
+            && fold_suffix(index.keys_mut().get(..n).unwrap_or(&[]), &mut bs.points);
+        if !fast {
+            if angular {
+                // Undo pass 1's tentative flags.
+                for r in bs.points.iter_mut() {
+                    if r.status == Status::Folded {
+                        r.status = Status::NoIntersection;
+                    }
+                }
+            }
+            index.index_keys(&key, false, n, all_keyed);
+            if index.fold_fast() {
+                index.fold_each(|i| {
+                    if let Some(r) = bs.points.get_mut(i) {
+                        r.status = Status::Folded;
+                    }
+                });
+            } else {
+                for (i, r) in bs.points.iter_mut().enumerate() {
+                    if r.status != Status::BehindCamera
+                        && index.meets_outside(
+                            r.z_far,
+                            (
+                                i.saturating_sub(CHORD_HALF_WINDOW),
+                                i + CHORD_HALF_WINDOW - 1,
+                            ),
+                        )
+                    {
+                        r.status = Status::Folded;
+                    }
                 }
             }
         }
         // Pass 2: intersect, triangulate, bound.
         let b2 = frame.boundaries().get(k).map(|b| b.points());
-        let search = searches.crossing();
         if let Some(b2) = b2 {
-            search.prepare(b2, &key);
+            searches.crossing().prepare(b2, &key);
         }
-        for r in bs.points.iter_mut() {
-            if r.status == Status::BehindCamera {
-                continue;
+        let lean = match (searches.lean(), b2, errors.frame_disc) {
+            (Some(index), Some(b2), Some(disc)) if errors.translation <= 0.0 => {
+                index.single_run(b2).map(|run| (run, disc))
             }
-            let c = Compensated {
-                pixel: [r.pixel2.u, r.pixel2.v],
-                depth_scale: r.z,
-                stretch: r.z_near,
-            };
-            *r = evaluate(
+            _ => None,
+        };
+        match lean {
+            Some((run, disc)) => pass2_lean(config, &geom, disc, &mut bs.points, run),
+            None => pass2(
                 config,
                 &geom,
-                r.pixel1,
-                &c,
-                r.z_far,
                 &errors,
-                r.status == Status::Folded,
+                &mut bs.points,
                 b2,
-                search,
-            );
+                searches.crossing(),
+            ),
         }
     }
     if replace {
         previous.assign(frame);
     }
     Ok(false)
+}
+
+/// Pass 1 over one frame-1 boundary: compensate every point exactly
+/// ([`PairGeometry::compensate_in_frame`]), key its epipolar line, and
+/// write the slot (see [`run`]) and the unwrapped key. With `PREFIX`
+/// (pseudo-angle keys, whose key margin is a constant) it also does the
+/// first half of the fold test in the same sweep: the slot of point `i`
+/// is marked [`Status::Folded`] when its key lies in the widened range of
+/// the keys of points `0 ..= i − 4`, the path of segments `0 ..= i − 5`
+/// (see [`IndexedSearch::fold_each`]); these marks hold only if the
+/// keys turn out all usable and span less than a turn (the caller checks).
+/// Returns whether every key is usable ([`crate::epipolar::Unwrap`]).
+#[inline(never)]
+fn pass1<const N: usize, const PREFIX: bool>(
+    geom: &PairGeometry,
+    b1: &[Pixel],
+    slots: &mut [PointResult],
+    keys: &mut [f32; N],
+) -> bool {
+    let key = *geom.key();
+    let mut unwrap = Unwrap::new(&key);
+    let eps = ANGULAR_EPS;
+    let (mut pmin, mut pmax) = (f32::INFINITY, f32::NEG_INFINITY);
+    for (i, (slot, &p1)) in slots.iter_mut().zip(b1).enumerate() {
+        let k = match geom.compensate_in_frame(p1) {
+            Some(c) => {
+                let raw = key.vertex_key(c.pixel);
+                let k = unwrap.next(raw);
+                let mut status = Status::NoIntersection;
+                if PREFIX {
+                    if let Some(&v) = keys.get(i.wrapping_sub(4)) {
+                        pmin = fmin(pmin, v);
+                        pmax = fmax(pmax, v);
+                        if i >= 5 && k <= pmax + eps && pmin - eps <= k {
+                            status = Status::Folded;
+                        }
+                    }
+                }
+                *slot = PointResult {
+                    pixel1: p1,
+                    pixel2: Pixel::new(c.pixel[0], c.pixel[1]),
+                    z: c.depth_scale,
+                    z_near: c.stretch,
+                    z_far: raw,
+                    status,
+                };
+                k
+            }
+            None => {
+                *slot = flagged(p1, Status::BehindCamera);
+                unwrap.next(f32::INFINITY)
+            }
+        };
+        if let Some(s) = keys.get_mut(i) {
+            *s = k;
+        }
+    }
+    unwrap.all_keyed()
+}
+
+/// The second half of the fold test for pseudo-angle keys, after
+/// [`pass1`]: marks point `i` [`Status::Folded`] when its key lies in the
+/// widened range of the keys of points `i + 4 ..`, the path of segments
+/// `i + 4 ..` (present while `i + 4 ≤ n − 2`). Returns whether the keys
+/// span less than a turn (less 0.1), the condition under which these
+/// tests, and pass 1's, equal the general query
+/// ([`IndexedSearch::meets_outside`]); otherwise the caller discards them.
+#[inline(never)]
+fn fold_suffix(keys: &[f32], slots: &mut [PointResult]) -> bool {
+    let eps = ANGULAR_EPS;
+    let n = keys.len().min(slots.len());
+    let (Some(keys), Some(slots)) = (keys.get(..n), slots.get_mut(..n)) else {
+        return false;
+    };
+    let Some(&last) = keys.last() else {
+        return false;
+    };
+    let (mut smin, mut smax) = (last, last);
+    // i = n − 6 down to 0, with vertex i + 4 joining the suffix first.
+    let m = n.saturating_sub(5);
+    let tested = keys.get(..m).unwrap_or(&[]);
+    let joining = keys.get(4..).unwrap_or(&[]);
+    for ((&k, &v), r) in tested.iter().zip(joining).zip(slots.iter_mut()).rev() {
+        smin = fmin(smin, v);
+        smax = fmax(smax, v);
+        if smin - eps <= k && k <= smax + eps {
+            r.status = Status::Folded;
+        }
+    }
+    for &k in keys.iter().take(4.min(n)) {
+        smin = fmin(smin, k);
+        smax = fmax(smax, k);
+    }
+    smax - smin < 4.0 - 0.1
+}
+
+/// Pass 2 over one boundary: intersect, triangulate, bound.
+#[inline(never)]
+fn pass2<S: CrossingSearch>(
+    config: &Config,
+    geom: &PairGeometry,
+    errors: &MotionErrors,
+    points: &mut [PointResult],
+    b2: Option<&[Pixel]>,
+    search: &mut S,
+) {
+    for r in points.iter_mut() {
+        if r.status == Status::BehindCamera {
+            continue;
+        }
+        let c = Compensated {
+            pixel: [r.pixel2.u, r.pixel2.v],
+            depth_scale: r.z,
+            stretch: r.z_near,
+        };
+        *r = evaluate(
+            config,
+            geom,
+            r.pixel1,
+            &c,
+            r.z_far,
+            errors,
+            r.status == Status::Folded,
+            b2,
+            search,
+        );
+    }
 }
 
 /// The motion-error model of one frame, worked out once per frame.
@@ -818,6 +948,67 @@ fn flagged(pixel1: Pixel, status: Status) -> PointResult {
     }
 }
 
+/// What the crossing search found on one epipolar ray: every crossing of
+/// the ray is visited (up to one more than [`MAX_RAY_CROSSINGS`]); those in
+/// the search range are counted and the one nearest `p₁'` is kept.
+struct Hits {
+    on_ray: usize,
+    valid: usize,
+    /// The crossing nearest `p₁'` (smallest `τ`, then lowest segment), if
+    /// `valid > 0`.
+    best_tau: f32,
+    best_segment: usize,
+}
+
+impl Hits {
+    fn new() -> Self {
+        Self {
+            on_ray: 0,
+            valid: 0,
+            best_tau: f32::INFINITY,
+            best_segment: 0,
+        }
+    }
+
+    /// Take one crossing (any order); `false` once there are too many to
+    /// tell apart.
+    #[inline(always)]
+    fn visit(&mut self, line: &EpipolarLine, x: crate::epipolar::Crossing) -> bool {
+        self.on_ray += 1;
+        if self.on_ray > MAX_RAY_CROSSINGS {
+            return false;
+        }
+        if line.in_search_range(&x) {
+            self.valid += 1;
+            if (x.tau, x.segment) < (self.best_tau, self.best_segment) {
+                self.best_tau = x.tau;
+                self.best_segment = x.segment;
+            }
+        }
+        true
+    }
+
+    /// [`Self::visit`] for crossings of a line from [`PairGeometry::line`]
+    /// (whose `ray_max` is its `tau_max`) that come in increasing segment
+    /// order: the crossing already satisfies `τ < tau_max`, and of two
+    /// with the same `τ` the earlier has the lower segment.
+    #[inline(always)]
+    fn visit_in_order(&mut self, x: crate::epipolar::Crossing) -> bool {
+        self.on_ray += 1;
+        if self.on_ray > MAX_RAY_CROSSINGS {
+            return false;
+        }
+        if x.tau > 0.0 {
+            self.valid += 1;
+            if x.tau < self.best_tau {
+                self.best_tau = x.tau;
+                self.best_segment = x.segment;
+            }
+        }
+        true
+    }
+}
+
 /// The whole per-point pipeline: compensate, draw the line, intersect,
 /// triangulate, bound.
 #[allow(clippy::too_many_arguments)]
@@ -856,43 +1047,105 @@ fn evaluate<S: CrossingSearch>(
     let Some(b2) = b2 else {
         return flagged(p1, Status::NoIntersection);
     };
-    // Every crossing of the ray, up to one more than can be told apart;
-    // those in the search range are counted and the one nearest p₁' kept.
-    let mut on_ray = 0usize;
-    let mut best: Option<crate::epipolar::Crossing> = None;
-    let mut valid = 0;
-    search.search(&line, b2, |x| {
-        on_ray += 1;
-        if on_ray > MAX_RAY_CROSSINGS {
-            return false;
+    let mut hits = Hits::new();
+    search.search(&line, b2, |x| hits.visit(&line, x));
+    conclude(config, geom, p1, c, &line, &hits, r1, errors, folded, b2)
+}
+
+/// Pass 2 for the usual case: a one-run index over the frame-2 boundary,
+/// a frame-wide frame-1 error disc `(r₁, guard)` and no translation error.
+/// The same results as [`evaluate`] for every point; the crossing search is
+/// inlined, and lines it declines go through the index's general search
+/// out of line.
+#[inline(never)]
+fn pass2_lean<const N: usize>(
+    config: &Config,
+    geom: &PairGeometry,
+    (r1, guard2): (f32, f32),
+    points: &mut [PointResult],
+    mut run: SingleRun<'_, N>,
+) {
+    let errors = MotionErrors {
+        translation: 0.0,
+        rotation: false,
+        frame_disc: Some((r1, guard2)),
+    };
+    for r in points.iter_mut() {
+        if r.status == Status::BehindCamera {
+            continue;
         }
-        if line.in_search_range(&x) {
-            valid += 1;
-            best = match best {
-                Some(b) if (b.tau, b.segment) <= (x.tau, x.segment) => Some(b),
-                _ => Some(x),
-            };
+        let c = Compensated {
+            pixel: [r.pixel2.u, r.pixel2.v],
+            depth_scale: r.z,
+            stretch: r.z_near,
+        };
+        let mut line: EpipolarLine = geom.line(&c);
+        line.key = r.z_far;
+        if line.a2 <= guard2 {
+            *r = flagged(r.pixel1, Status::AtFoe);
+            continue;
         }
-        true
-    });
-    if on_ray > MAX_RAY_CROSSINGS {
+        let mut hits = Hits::new();
+        if !run.search(&line, |x| hits.visit_in_order(x)) {
+            let mut found = Crossings::new();
+            run.collect_general(line, &mut found);
+            for &x in found.iter() {
+                if !hits.visit(&line, x) {
+                    break;
+                }
+            }
+        }
+        *r = conclude(
+            config,
+            geom,
+            r.pixel1,
+            &c,
+            &line,
+            &hits,
+            r1,
+            &errors,
+            r.status == Status::Folded,
+            run.boundary(),
+        );
+    }
+}
+
+/// The rest of the per-point pipeline once the crossings are known:
+/// choose, triangulate (eq. 2.3), bound (the stick).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn conclude(
+    config: &Config,
+    geom: &PairGeometry,
+    p1: Pixel,
+    c: &Compensated,
+    line: &EpipolarLine,
+    hits: &Hits,
+    r1: f32,
+    errors: &MotionErrors,
+    folded: bool,
+    b2: &[Pixel],
+) -> PointResult {
+    let w = geom.w();
+    if hits.on_ray > MAX_RAY_CROSSINGS {
         // More than MAX_RAY_CROSSINGS: the boundary runs along the ray.
         return flagged(p1, Status::Tangled);
     }
-    if valid > MAX_CROSSINGS {
+    if hits.valid > MAX_CROSSINGS {
         return flagged(p1, Status::Tangled);
     }
-    let Some(best) = best else {
+    if hits.valid == 0 {
         return flagged(p1, Status::NoIntersection);
-    };
-    let status = if valid > 1 {
+    }
+    let (best_tau, best_segment) = (hits.best_tau, hits.best_segment);
+    let status = if hits.valid > 1 {
         Status::Ambiguous
     } else {
         Status::Ok
     };
     let mut r = PointResult {
         pixel1: p1,
-        pixel2: line.at(best.tau),
+        pixel2: line.at(best_tau),
         status,
         ..PointResult::default()
     };
@@ -902,7 +1155,7 @@ fn evaluate<S: CrossingSearch>(
     } else {
         f32::INFINITY
     };
-    let (sin_low, cos) = crossing_angle(line.a, a_len, chord(b2, best.segment), config.e2);
+    let (sin_low, cos) = crossing_angle(line.a, a_len, chord(b2, best_segment), config.e2);
     // A NaN angle (impossible for validated input) is grazing too: one
     // negated comparison says both.
     #[allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -912,7 +1165,7 @@ fn evaluate<S: CrossingSearch>(
         return r;
     }
     // Eq. 2.3 along the disparity: s = W' + 1/τ (τ > 0 by construction).
-    let s = w + 1.0 / best.tau;
+    let s = w + 1.0 / best_tau;
     let z = s / c.depth_scale;
     if z.is_nan() || z <= 0.0 {
         r.status = Status::NonPositiveDepth;
@@ -931,7 +1184,7 @@ fn evaluate<S: CrossingSearch>(
         );
         stick(
             w,
-            best.tau,
+            best_tau,
             a_len,
             r1,
             config.e2,
@@ -944,7 +1197,7 @@ fn evaluate<S: CrossingSearch>(
     } else {
         stick_exact(
             w,
-            best.tau,
+            best_tau,
             a_len,
             r1,
             config.e2,

@@ -188,9 +188,16 @@ impl<const N: usize, const B: usize> Frame<N, B> {
                 return;
             }
             if let Some(dst) = self.boundaries.get_mut(i) {
-                dst.points.clear();
-                // Same capacity N on both sides: cannot fail.
-                let _ = dst.points.extend_from_slice(&src.points);
+                // Same capacity N on both sides: cannot fail. In a steady
+                // stream the lengths already agree and this is one block
+                // copy.
+                dst.points.truncate(src.points.len());
+                if dst.points.resize_default(src.points.len()).is_err() {
+                    dst.points.clear();
+                }
+                for (d, s) in dst.points.iter_mut().zip(src.points.iter()) {
+                    *d = *s;
+                }
             }
         }
     }

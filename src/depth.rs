@@ -80,7 +80,15 @@ pub struct DepthInterval {
 
 /// Direction of the boundary around segment `j`: the chord between the
 /// points `CHORD_HALF_WINDOW` before `j` and after `j + 1` (clamped).
+#[inline(always)]
 pub(crate) fn chord(boundary: &[Pixel], j: usize) -> [f32; 2] {
+    // Away from the ends (the usual case): one bounds check for the window.
+    if let Some(&[a, .., b]) = j
+        .checked_sub(CHORD_HALF_WINDOW)
+        .and_then(|i0| boundary.get(i0..i0 + 2 * CHORD_HALF_WINDOW + 2))
+    {
+        return sub(b.arr(), a.arr());
+    }
     let last = boundary.len().saturating_sub(1);
     let i0 = j.saturating_sub(CHORD_HALF_WINDOW);
     let i1 = (j + 1 + CHORD_HALF_WINDOW).min(last);

@@ -80,6 +80,18 @@ pub enum PencilKey {
         /// Sign of `W'`: +1 or −1.
         sign_w: f32,
     },
+    /// FOE off to one side of everything keyed (above or below it in the
+    /// image): the pseudo-angle of `v − FOE` within that half-plane,
+    /// `d_u / (|d_u| + t)` with `t = side · d_v`, in `(−1, 1)`. It needs no
+    /// quadrants and never wraps; a point with `t < min_t` has no key.
+    Half {
+        /// Focus of expansion, frame-2 pixels.
+        foe: [f32; 2],
+        /// +1 when the keyed points lie below the FOE (larger `v`), −1 above.
+        side: f32,
+        /// The smallest `t` with a key, pixels (at least [`HALF_MIN_DV`]).
+        min_t: f32,
+    },
     /// FOE far outside the image (or at infinity): the position, in pixels,
     /// where the line through the FOE crosses the reference line through
     /// `c₂` perpendicular to `g = (f_x U', f_y V')`.
@@ -95,12 +107,38 @@ pub enum PencilKey {
     },
 }
 
-/// Key widening that covers rounding in the pseudo-angle (units of `[0, 4)`).
+/// Key widening that covers rounding in the pseudo-angle (units of `[0, 4)`;
+/// also for [`PencilKey::Half`]).
 pub(crate) const ANGULAR_EPS: f32 = 1.0e-4;
+/// The smallest distance `t` from the FOE's row, pixels, of a point with a
+/// [`PencilKey::Half`] key, for coordinates (FOE, points, principal point)
+/// within 1 000 px; beyond that it grows in proportion. The key
+/// `d_u/(|d_u| + t)` moves by at most (rounding of `d`) / (|d_u| + t); `d`
+/// is rounded by at most 2⁻²⁴ of the larger coordinate, about 6e-5 px at
+/// 1 000 px, and the direction of the epipolar vector `a` differs from that
+/// of `p₁' − FOE` by a like amount: under 1e-4 ([`ANGULAR_EPS`]) in all.
+pub const HALF_MIN_DV: f32 = 4.0;
+/// [`PairGeometry::half_key`] is offered only for a boundary at least this
+/// far from the FOE's row (pixels), so that its frame-1 counterpart, after
+/// rotation compensation, is all keyed too.
+const HALF_MARGIN: f32 = 16.0;
 /// Key widening in the projective mode, pixels (plus a relative part).
 const PROJECTIVE_EPS: f32 = 1.0e-3;
 /// Sentinel for "no usable key": the segment is always examined.
 const NO_KEY: f32 = f32::INFINITY;
+
+/// [`PencilKey::Half`]'s key of a point `v`, or [`NO_KEY`].
+#[inline(always)]
+pub(crate) fn half_key(foe: [f32; 2], side: f32, min_t: f32, v: [f32; 2]) -> f32 {
+    let d = sub(v, foe);
+    let t = side * d[1];
+    // NaN fails the test too.
+    if t >= min_t {
+        d[0] / (d[0].abs() + t)
+    } else {
+        NO_KEY
+    }
+}
 
 impl PencilKey {
     /// Key of a boundary vertex, or [`NO_KEY`] when it cannot be keyed
@@ -116,6 +154,7 @@ impl PencilKey {
                     pseudo_angle_nonzero(d)
                 }
             }
+            PencilKey::Half { foe, side, min_t } => half_key(foe, side, min_t, v),
             PencilKey::Projective { .. } => self.projective(v),
         }
     }
@@ -137,7 +176,7 @@ impl PencilKey {
                     g_norm * dot(n_hat, d) / den
                 }
             }
-            PencilKey::Angular { .. } => NO_KEY,
+            PencilKey::Angular { .. } | PencilKey::Half { .. } => NO_KEY,
         }
     }
 
@@ -147,6 +186,7 @@ impl PencilKey {
             PencilKey::Angular { sign_w, .. } => {
                 pseudo_angle([sign_w * line.a[0], sign_w * line.a[1]])
             }
+            PencilKey::Half { foe, side, min_t } => half_key(foe, side, min_t, line.origin),
             PencilKey::Projective { .. } => self.projective(line.origin),
         }
     }
@@ -216,6 +256,14 @@ pub struct EpipolarLine {
     pub key: f32,
 }
 
+/// The side of a vertex from its `σ` ([`EpipolarLine::side`]): 0 for
+/// `σ ≥ 0`, 1 for `σ < 0`. The sign bit once −0 is made +0 (`+ 0.0`), so a
+/// vertex on the line counts as on the positive side.
+#[inline(always)]
+pub(crate) fn side_bit(sigma: f32) -> u32 {
+    (sigma + 0.0).to_bits() >> 31
+}
+
 impl EpipolarLine {
     /// The intersection of the ray from the FOE through `p₁'` with the
     /// segment `v0 → v1` (segment index `segment`), if any.
@@ -225,15 +273,33 @@ impl EpipolarLine {
     /// side), so two adjacent segments never both report a crossing through
     /// their shared vertex.
     pub fn crossing(&self, segment: usize, v0: Pixel, v1: Pixel) -> Option<Crossing> {
-        let (v0, v1) = (v0.arr(), v1.arr());
-        let s0 = cross(self.a, sub(v0, self.origin));
-        let s1 = cross(self.a, sub(v1, self.origin));
-        // `σ ≥ 0` is a clear sign bit once −0 is made +0 (`+ 0.0`); a NaN
-        // σ (not from finite input) gives a NaN τ below, so no crossing.
-        if ((s0 + 0.0).to_bits() ^ (s1 + 0.0).to_bits()) >> 31 == 0 {
+        let (s0, s1) = (self.side(v0), self.side(v1));
+        if side_bit(s0) == side_bit(s1) {
             return None;
         }
-        // s0 and s1 have strictly different signs, so s0 - s1 != 0.
+        self.crossing_between(segment, v0, v1, s0, s1)
+    }
+
+    /// `σ = a × (v − p₁')` of a vertex: its side of the line.
+    #[inline(always)]
+    pub(crate) fn side(&self, v: Pixel) -> f32 {
+        cross(self.a, sub(v.arr(), self.origin))
+    }
+
+    /// [`Self::crossing`] of a segment whose end points' sides `s0`, `s1`
+    /// ([`Self::side`]) have different [`side_bit`]s.
+    #[inline(always)]
+    pub(crate) fn crossing_between(
+        &self,
+        segment: usize,
+        v0: Pixel,
+        v1: Pixel,
+        s0: f32,
+        s1: f32,
+    ) -> Option<Crossing> {
+        let (v0, v1) = (v0.arr(), v1.arr());
+        // s0 and s1 have strictly different signs, so s0 - s1 != 0 (a NaN
+        // σ, not from finite input, gives a NaN τ below: no crossing).
         let u = s0 / (s0 - s1);
         let p = [v0[0] + u * (v1[0] - v0[0]), v0[1] + u * (v1[1] - v0[1])];
         // a2 > 0 is guaranteed by the caller (the point is not at the FOE).
@@ -350,6 +416,32 @@ impl PairGeometry {
             self.c2[1] + self.g[1] / self.w,
         ];
         (f[0].is_finite() && f[1].is_finite()).then_some(Pixel::new(f[0], f[1]))
+    }
+
+    /// [`PencilKey::Half`] for a frame-2 boundary whose rows run from
+    /// `v_first` to `v_last` (boundaries are monotone in the row, so these
+    /// bound all of it), when it lies wholly above or below the FOE's row
+    /// with some margin; `None` otherwise (no FOE, or too close to it).
+    pub fn half_key(&self, v_first: f32, v_last: f32) -> Option<PencilKey> {
+        let foe = self.focus_of_expansion()?;
+        let (lo, hi) = (fmin(v_first, v_last), fmax(v_first, v_last));
+        // Coordinates beyond 1 000 px scale the rounding (see HALF_MIN_DV).
+        let scale = fmax(foe.u.abs(), foe.v.abs()) + fmax(self.c2[0].abs(), self.c2[1].abs());
+        let min_t = HALF_MIN_DV * fmax(1.0, scale * 1.0e-3);
+        let need = fmax(HALF_MARGIN, 4.0 * min_t);
+        let side = if lo - foe.v >= need {
+            1.0
+        } else if foe.v - hi >= need {
+            -1.0
+        } else {
+            // Too close to the FOE's row, or NaN.
+            return None;
+        };
+        Some(PencilKey::Half {
+            foe: [foe.u, foe.v],
+            side,
+            min_t,
+        })
     }
 
     /// Exact rotation compensation of a frame-1 pixel; `None` when the ray
@@ -537,7 +629,7 @@ impl Unwrap {
         Self {
             period: match key {
                 PencilKey::Angular { .. } => 4.0,
-                PencilKey::Projective { .. } => 0.0,
+                PencilKey::Half { .. } | PencilKey::Projective { .. } => 0.0,
             },
             offset: 0.0,
             prev: NO_KEY,
@@ -696,6 +788,12 @@ pub(crate) struct SingleRun<'a, const N: usize> {
 }
 
 impl<const N: usize> SingleRun<'_, N> {
+    /// Whether the keys are pseudo-angles over the whole turn (see
+    /// [`Self::search`]).
+    pub(crate) fn periodic(&self) -> bool {
+        self.key_mask == u32::MAX
+    }
+
     /// The frame-2 boundary.
     pub(crate) fn boundary(&self) -> &[Pixel] {
         self.boundary
@@ -718,8 +816,11 @@ impl<const N: usize> SingleRun<'_, N> {
     /// segment order), until `visit` returns `false`. Returns `false`
     /// without visiting anything when the line's key is not usable (the
     /// caller then uses [`Self::collect_general`]).
+    ///
+    /// `PERIODIC` must say whether the keys are pseudo-angles over the whole
+    /// turn ([`Self::periodic`]); without it a key needs no turn chosen.
     #[inline(always)]
-    pub(crate) fn search<F: FnMut(Crossing) -> bool>(
+    pub(crate) fn search<const PERIODIC: bool, F: FnMut(Crossing) -> bool>(
         &mut self,
         line: &EpipolarLine,
         mut visit: F,
@@ -728,27 +829,43 @@ impl<const N: usize> SingleRun<'_, N> {
         if q.to_bits() & self.key_mask >= self.key_limit {
             return false;
         }
-        let mut qq = q + self.base;
-        if qq < self.lim {
-            qq = q + self.base4;
-        }
+        let qq = if PERIODIC {
+            let qq = q + self.base;
+            if qq < self.lim {
+                q + self.base4
+            } else {
+                qq
+            }
+        } else {
+            q
+        };
         let oq = self.orient * qq;
         let a = first_at_least(self.hi, oq - self.eps, self.hint);
         self.hint = a;
         let t_hi = oq + self.eps;
-        // The candidates: from `a` while the suffix minimum allows.
+        // The candidates: from `a` while the suffix minimum allows, each
+        // vertex's side computed once for the two segments that share it.
         let mut j = a;
+        let Some(&first) = self.boundary.get(j) else {
+            return true;
+        };
+        let (mut v0, mut s0) = (first, line.side(first));
         while let Some(&l) = self.lo.get(j) {
             if l > t_hi {
                 break;
             }
-            if let Some(&[v0, v1]) = self.boundary.get(j..j + 2) {
-                if let Some(c) = line.crossing(j, v0, v1) {
+            let Some(&v1) = self.boundary.get(j + 1) else {
+                break;
+            };
+            let s1 = line.side(v1);
+            if side_bit(s0) != side_bit(s1) {
+                if let Some(c) = line.crossing_between(j, v0, v1, s0, s1) {
                     if !visit(c) {
                         break;
                     }
                 }
             }
+            (v0, s0) = (v1, s1);
             j += 1;
         }
         true
@@ -870,7 +987,7 @@ impl<const N: usize> IndexedSearch<N> {
         self.hint = 0;
         self.period = match key {
             PencilKey::Angular { .. } => 4.0,
-            PencilKey::Projective { .. } => 0.0,
+            PencilKey::Half { .. } | PencilKey::Projective { .. } => 0.0,
         };
         let n = n.min(N);
         self.segments = n.saturating_sub(1);
@@ -943,7 +1060,7 @@ impl<const N: usize> IndexedSearch<N> {
         self.kmin = kmin;
         self.kmax = kmax;
         self.eps = match self.key {
-            PencilKey::Angular { .. } => ANGULAR_EPS,
+            PencilKey::Angular { .. } | PencilKey::Half { .. } => ANGULAR_EPS,
             PencilKey::Projective { .. } => PROJECTIVE_EPS + 1.0e-5 * fmax(kmin.abs(), kmax.abs()),
         };
     }
@@ -1344,7 +1461,21 @@ impl<const N: usize> IndexedSearch<N> {
 
 impl<const N: usize> CrossingSearch for IndexedSearch<N> {
     fn prepare(&mut self, boundary: &[Pixel], key: &PencilKey) {
-        self.build(key, true, boundary.iter().map(|p| key.vertex(p.arr())));
+        match *key {
+            // Half-plane keys never wrap: no unwrapping.
+            PencilKey::Half { foe, side, min_t } => {
+                let mut sum = 0.0f32;
+                let mut n = 0;
+                for (slot, p) in self.keys.iter_mut().zip(boundary) {
+                    let k = half_key(foe, side, min_t, p.arr());
+                    *slot = k;
+                    sum += k;
+                    n += 1;
+                }
+                self.index_keys(key, true, n, sum.is_finite());
+            }
+            _ => self.build(key, true, boundary.iter().map(|p| key.vertex(p.arr()))),
+        }
     }
 
     /// The sweep of [`IndexedSearch`] written out for the crossing search:
@@ -1442,6 +1573,24 @@ impl<const N: usize> IndexedSearch<N> {
                 j += 1;
             }
             qq += self.period;
+        }
+    }
+}
+
+#[cfg(test)]
+impl<const N: usize> IndexedSearch<N> {
+    /// For tests of other fold-test implementations: the general index
+    /// query ([`Self::meets_outside`] over envelopes, never the fast form)
+    /// for every point of the unwrapped, all usable `keys`, into `out`.
+    pub(crate) fn general_fold_flags(key: &PencilKey, keys: &[f32], out: &mut [bool]) {
+        let mut ix = Self::new();
+        let n = keys.len().min(N);
+        ix.keys[..n].copy_from_slice(&keys[..n]);
+        ix.index_keys(key, false, n, true);
+        ix.fold_fast = false;
+        ix.envelopes(false);
+        for (i, o) in out.iter_mut().enumerate().take(n) {
+            *o = ix.meets_outside(keys[i], (i.saturating_sub(4), i + 3));
         }
     }
 }
@@ -1616,6 +1765,91 @@ mod tests {
         assert!(
             single > 1000 && general > 300 && found > 10_000,
             "{single} {general} {found}"
+        );
+    }
+
+    /// With half-plane keys the index finds exactly the crossings a scan of
+    /// every segment finds: random motions whose FOE lies above or below
+    /// the boundary (in the image or far outside it, `W' > 0` and `< 0`),
+    /// boundaries monotone in the row that zigzag sideways, run steeply or
+    /// nearly along the rows, and lines from anywhere in the image,
+    /// including points too close to the FOE's row to have a key (the
+    /// general search takes those). Both the one-run path and the fallback
+    /// are exercised.
+    #[test]
+    fn half_key_index_finds_what_a_scan_finds() {
+        const M: usize = 48;
+        let mut rng = Rng(0x4a1f_2b3c);
+        let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).expect("camera");
+        let (mut keyed, mut unkeyed, mut found, mut boundaries) = (0, 0, 0, 0);
+        for case in 0..3000 {
+            let w = if case % 4 == 3 { -1.0 } else { 1.0 };
+            // FOE rows from well above the image to well below it.
+            let t = [0.6 * (rng.next() - 0.5), 0.9 * (rng.next() - 0.5) * 2.0, w];
+            let m = Motion::new(t, [0.0; 3]).expect("motion");
+            let g = PairGeometry::new(&cam, &cam, &m);
+            let Some(foe) = g.focus_of_expansion() else {
+                continue;
+            };
+            let n = 2 + (rng.next() * (M - 2) as f32) as usize;
+            // A run of rows on one side of the FOE, in the image.
+            let below = rng.next() < 0.5;
+            let (v0, v1) = if below {
+                (fmax(foe.v + 20.0, -1.0), 480.0)
+            } else {
+                (-1.0, fmin(foe.v - 20.0, 480.0))
+            };
+            if v1 - v0 < n as f32 * 0.01 {
+                continue;
+            }
+            let u0 = 512.0 * rng.next();
+            let slope = 4.0 * (rng.next() - 0.5) * [0.1, 1.0, 20.0][case % 3];
+            let zig = [0.0, 1.0, 30.0][case % 5 % 3];
+            let mut pts = [Pixel::new(0.0, 0.0); M];
+            for (i, p) in pts.iter_mut().enumerate().take(n) {
+                let v = v0 + (v1 - v0) * (i as f32 + 0.5) / n as f32;
+                let u = u0 + slope * (v - v0) + zig * (rng.next() - 0.5);
+                *p = Pixel::new(u.clamp(-1.0, 512.0), v);
+            }
+            let boundary = &pts[..n];
+            let Some(key) = g.half_key(boundary[0].v, boundary[n - 1].v) else {
+                continue;
+            };
+            boundaries += 1;
+            let mut index = IndexedSearch::<M>::new();
+            index.prepare(boundary, &key);
+            assert!(index.single, "case {case}: a half-plane index is one run");
+            for _ in 0..20 {
+                let p = Pixel::new(512.0 * rng.next(), 480.0 * rng.next());
+                let Some(c) = g.compensate(p) else { continue };
+                let mut line = g.line(&c);
+                if line.a2 <= 1.0e-6 {
+                    continue;
+                }
+                line.key = key.vertex_key(c.pixel);
+                if line.key.is_finite() {
+                    keyed += 1;
+                } else {
+                    unkeyed += 1;
+                }
+                let mut got = heapless::Vec::<Crossing, M>::new();
+                let mut want = heapless::Vec::<Crossing, M>::new();
+                if let Some(mut run) = index.single_run(boundary) {
+                    if !run.search::<false, _>(&line, |x| got.push(x).is_ok()) {
+                        let mut c = Crossings::new();
+                        run.collect_general(line, &mut c);
+                        got.extend(c.iter().copied());
+                    }
+                }
+                scan_all(&line, boundary, |x| want.push(x).is_ok());
+                got.sort_unstable_by_key(|x| x.segment);
+                assert_eq!(got, want, "case {case}");
+                found += got.len();
+            }
+        }
+        assert!(
+            boundaries > 1500 && keyed > 20_000 && unkeyed > 1_000 && found > 10_000,
+            "{boundaries} {keyed} {unkeyed} {found}"
         );
     }
 

@@ -12,6 +12,7 @@ use core::fmt;
 use crate::boundary::Frame;
 use crate::camera::{Camera, Pixel};
 use crate::depth::{chord, crossing_angle, stick, stick_exact, DepthInterval, CHORD_HALF_WINDOW};
+use crate::epipolar::half_key;
 use crate::epipolar::{
     Compensated, CrossingSearch, Crossings, EpipolarLine, IndexedSearch, PairGeometry, PencilKey,
     SingleRun, Unwrap, ANGULAR_EPS, MAX_CROSSINGS, MAX_RAY_CROSSINGS,
@@ -684,7 +685,17 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
         .zip(out.boundaries.iter_mut())
         .enumerate()
     {
-        let key = *geom.key();
+        // How epipolar lines are keyed for this boundary pair: by the
+        // half-plane pseudo-angle when the frame-2 boundary lies wholly
+        // above or below the FOE (the usual road scene), else as the pair
+        // geometry says.
+        let b2 = frame.boundaries().get(k).map(|b| b.points());
+        let key = b2
+            .and_then(|b| match (b.first(), b.last()) {
+                (Some(f), Some(l)) => geom.half_key(f.v, l.v),
+                _ => None,
+            })
+            .unwrap_or(*geom.key());
         let n = b1.points().len();
         bs.points.truncate(n);
         if bs.points.resize_default(n).is_err() {
@@ -699,19 +710,55 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
         //
         // The fold test (frame 1 only): does a point's epipolar line meet
         // the frame-1 boundary again, away from the point itself? The line
-        // through the FOE and p₁' has p₁''s own key.
+        // through the FOE and p₁' has p₁''s own key. Pass 1 and
+        // `fold_suffix` do it in two sweeps when the key margin is a
+        // constant (pseudo-angles, whole or half-plane).
         let index = searches.index();
-        let angular = matches!(key, PencilKey::Angular { .. });
-        let all_keyed = if angular {
-            pass1::<N, true>(&geom, b1.points(), &mut bs.points, index.keys_mut())
-        } else {
-            pass1::<N, false>(&geom, b1.points(), &mut bs.points, index.keys_mut())
+        let (prefix, periodic) = match key {
+            PencilKey::Angular { .. } => (true, true),
+            PencilKey::Half { .. } => (true, false),
+            PencilKey::Projective { .. } => (false, false),
         };
-        let fast = angular
-            && all_keyed
-            && fold_suffix(index.keys_mut().get(..n).unwrap_or(&[]), &mut bs.points);
+        let b1 = b1.points();
+        let (all_keyed, fast) = if prefix {
+            let o = fold_orientation(&geom, &key, b1);
+            let (all_keyed, pmax) = match key {
+                PencilKey::Half { foe, side, min_t } => pass1::<N, true, false>(
+                    &geom,
+                    &key,
+                    |v| half_key(foe, side, min_t, v),
+                    b1,
+                    &mut bs.points,
+                    index.keys_mut(),
+                    o,
+                ),
+                _ => pass1::<N, true, true>(
+                    &geom,
+                    &key,
+                    |v| key.vertex_key(v),
+                    b1,
+                    &mut bs.points,
+                    index.keys_mut(),
+                    o,
+                ),
+            };
+            let keys = index.keys_mut().get(..n).unwrap_or(&[]);
+            let fast = all_keyed && fold_suffix(keys, &mut bs.points, o, pmax, periodic);
+            (all_keyed, fast)
+        } else {
+            let (all_keyed, _) = pass1::<N, false, false>(
+                &geom,
+                &key,
+                |v| key.vertex_key(v),
+                b1,
+                &mut bs.points,
+                index.keys_mut(),
+                1.0,
+            );
+            (all_keyed, false)
+        };
         if !fast {
-            if angular {
+            if prefix {
                 // Undo pass 1's tentative flags.
                 for r in bs.points.iter_mut() {
                     if r.status == Status::Folded {
@@ -743,7 +790,6 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
             }
         }
         // Pass 2: intersect, triangulate, bound.
-        let b2 = frame.boundaries().get(k).map(|b| b.points());
         if let Some(b2) = b2 {
             searches.crossing().prepare(b2, &key);
         }
@@ -754,7 +800,10 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
             _ => None,
         };
         match lean {
-            Some((run, disc)) => pass2_lean(config, &geom, disc, &mut bs.points, run),
+            Some((run, disc)) if run.periodic() => {
+                pass2_lean::<N, true>(config, &geom, disc, &mut bs.points, run)
+            }
+            Some((run, disc)) => pass2_lean::<N, false>(config, &geom, disc, &mut bs.points, run),
             None => pass2(
                 config,
                 &geom,
@@ -780,32 +829,36 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
 /// the keys of points `0 ..= i − 4`, the path of segments `0 ..= i − 5`
 /// (see [`IndexedSearch::fold_each`]); these marks hold only if the
 /// keys turn out all usable and span less than a turn (the caller checks).
-/// Returns whether every key is usable ([`crate::epipolar::Unwrap`]).
+/// Returns whether every key is usable ([`crate::epipolar::Unwrap`]), and
+/// the largest oriented key `o k` of points `0 ..= n − 5` (with `PREFIX`).
 #[inline(never)]
-fn pass1<const N: usize, const PREFIX: bool>(
+fn pass1<const N: usize, const PREFIX: bool, const WRAPS: bool>(
     geom: &PairGeometry,
+    key: &PencilKey,
+    key_of: impl Fn([f32; 2]) -> f32,
     b1: &[Pixel],
     slots: &mut [PointResult],
     keys: &mut [f32; N],
-) -> bool {
-    let key = *geom.key();
-    let mut unwrap = Unwrap::new(&key);
-    let eps = ANGULAR_EPS;
-    let (mut pmin, mut pmax) = (f32::INFINITY, f32::NEG_INFINITY);
+    o: f32,
+) -> (bool, f32) {
+    let mut unwrap = Unwrap::new(key);
+    // Without wrapping (`!WRAPS`: keys that are not periodic) the keys are
+    // used as they come; they are all usable iff their sum is finite.
+    let mut sum = 0.0f32;
+    let mut prefix = PrefixFold::new(o);
     for (i, (slot, &p1)) in slots.iter_mut().zip(b1).enumerate() {
         let k = match geom.compensate_in_frame(p1) {
             Some(c) => {
-                let raw = key.vertex_key(c.pixel);
-                let k = unwrap.next(raw);
+                let raw = key_of(c.pixel);
+                let k = if WRAPS {
+                    unwrap.next(raw)
+                } else {
+                    sum += raw;
+                    raw
+                };
                 let mut status = Status::NoIntersection;
-                if PREFIX {
-                    if let Some(&v) = keys.get(i.wrapping_sub(4)) {
-                        pmin = fmin(pmin, v);
-                        pmax = fmax(pmax, v);
-                        if i >= 5 && k <= pmax + eps && pmin - eps <= k {
-                            status = Status::Folded;
-                        }
-                    }
+                if PREFIX && prefix.met(keys, i, k) {
+                    status = Status::Folded;
                 }
                 *slot = PointResult {
                     pixel1: p1,
@@ -819,6 +872,7 @@ fn pass1<const N: usize, const PREFIX: bool>(
             }
             None => {
                 *slot = flagged(p1, Status::BehindCamera);
+                sum = f32::INFINITY;
                 unwrap.next(f32::INFINITY)
             }
         };
@@ -826,18 +880,70 @@ fn pass1<const N: usize, const PREFIX: bool>(
             *s = k;
         }
     }
-    unwrap.all_keyed()
+    let all_keyed = if WRAPS {
+        unwrap.all_keyed()
+    } else {
+        sum.is_finite()
+    };
+    (all_keyed, prefix.pmax)
+}
+
+/// The prefix half of the fold test, one point at a time along the
+/// boundary (see [`pass1`]): extremes of the oriented keys `o k` of the
+/// points before, the maximum kept as the sweep goes, the minimum over
+/// `keys[..pmin_upto]` brought up to date only when a test needs it (each
+/// key joins it at most once). The orientation `o` only decides which
+/// extreme is kept eagerly ([`fold_orientation`]).
+struct PrefixFold {
+    o: f32,
+    pmin: f32,
+    pmax: f32,
+    pmin_upto: usize,
+}
+
+impl PrefixFold {
+    fn new(o: f32) -> Self {
+        Self {
+            o,
+            pmin: f32::INFINITY,
+            pmax: f32::NEG_INFINITY,
+            pmin_upto: 0,
+        }
+    }
+
+    /// Whether point `i` with unwrapped key `k` meets the segments
+    /// `0 ..= i − 5`: its key lies in the widened range of `keys[..= i − 4]`
+    /// (which must already hold the keys of the points before `i`). Called
+    /// for `i = 0, 1, 2, …` in turn.
+    #[inline(always)]
+    fn met(&mut self, keys: &[f32], i: usize, k: f32) -> bool {
+        let (o, eps) = (self.o, ANGULAR_EPS);
+        let Some(&v) = keys.get(i.wrapping_sub(4)) else {
+            return false;
+        };
+        self.pmax = fmax(self.pmax, o * v);
+        let ok = o * k;
+        if i >= 5 && ok <= self.pmax + eps {
+            for &w in keys.get(self.pmin_upto..i - 3).unwrap_or(&[]) {
+                self.pmin = fmin(self.pmin, o * w);
+            }
+            self.pmin_upto = i - 3;
+            return self.pmin - eps <= ok;
+        }
+        false
+    }
 }
 
 /// The second half of the fold test for pseudo-angle keys, after
 /// [`pass1`]: marks point `i` [`Status::Folded`] when its key lies in the
 /// widened range of the keys of points `i + 4 ..`, the path of segments
-/// `i + 4 ..` (present while `i + 4 ≤ n − 2`). Returns whether the keys
+/// `i + 4 ..` (present while `i + 4 ≤ n − 2`); `pmax` is [`pass1`]'s.
+/// Returns whether the keys
 /// span less than a turn (less 0.1), the condition under which these
 /// tests, and pass 1's, equal the general query
 /// ([`IndexedSearch::meets_outside`]); otherwise the caller discards them.
 #[inline(never)]
-fn fold_suffix(keys: &[f32], slots: &mut [PointResult]) -> bool {
+fn fold_suffix(keys: &[f32], slots: &mut [PointResult], o: f32, pmax: f32, periodic: bool) -> bool {
     let eps = ANGULAR_EPS;
     let n = keys.len().min(slots.len());
     let (Some(keys), Some(slots)) = (keys.get(..n), slots.get_mut(..n)) else {
@@ -846,23 +952,66 @@ fn fold_suffix(keys: &[f32], slots: &mut [PointResult]) -> bool {
     let Some(&last) = keys.last() else {
         return false;
     };
-    let (mut smin, mut smax) = (last, last);
+    // Extremes of the oriented keys of points `.. n`: the minimum kept as
+    // the sweep goes, the maximum over `keys[smax_from..]` brought up to
+    // date only when a test needs it.
+    let (mut smin, mut smax) = (o * last, o * last);
+    let mut smax_from = n - 1;
     // i = n − 6 down to 0, with vertex i + 4 joining the suffix first.
     let m = n.saturating_sub(5);
     let tested = keys.get(..m).unwrap_or(&[]);
     let joining = keys.get(4..).unwrap_or(&[]);
-    for ((&k, &v), r) in tested.iter().zip(joining).zip(slots.iter_mut()).rev() {
-        smin = fmin(smin, v);
-        smax = fmax(smax, v);
-        if smin - eps <= k && k <= smax + eps {
-            r.status = Status::Folded;
+    for (i, ((&k, &v), r)) in tested
+        .iter()
+        .zip(joining)
+        .zip(slots.iter_mut())
+        .enumerate()
+        .rev()
+    {
+        smin = fmin(smin, o * v);
+        let ok = o * k;
+        if smin - eps <= ok {
+            for &w in keys.get(i + 4..smax_from).unwrap_or(&[]) {
+                smax = fmax(smax, o * w);
+            }
+            smax_from = i + 4;
+            if ok <= smax + eps {
+                r.status = Status::Folded;
+            }
         }
     }
-    for &k in keys.iter().take(4.min(n)) {
-        smin = fmin(smin, k);
-        smax = fmax(smax, k);
+    // The span of all keys: `pmax` covers points `0 ..= n − 5`, `smin`
+    // points `4 ..`.
+    smax = fmax(smax, pmax);
+    for &w in keys.get(n.saturating_sub(4)..).unwrap_or(&[]) {
+        smax = fmax(smax, o * w);
     }
-    smax - smin < 4.0 - 0.1
+    for &w in keys.iter().take(4.min(n)) {
+        smin = fmin(smin, o * w);
+    }
+    !periodic || smax - smin < 4.0 - 0.1
+}
+
+/// The likely direction of the keys along a frame-1 boundary (+1 rising,
+/// −1 falling), from its two end points, for the fold test's order of
+/// work (any value gives the same results).
+fn fold_orientation(geom: &PairGeometry, key: &PencilKey, b1: &[Pixel]) -> f32 {
+    let raw = |p: Option<&Pixel>| {
+        p.and_then(|&p| geom.compensate_in_frame(p))
+            .map_or(f32::NAN, |c| key.vertex_key(c.pixel))
+    };
+    let mut d = raw(b1.last()) - raw(b1.first());
+    // Pseudo-angles: the shorter way round.
+    if d > 2.0 {
+        d -= 4.0;
+    } else if d < -2.0 {
+        d += 4.0;
+    }
+    if d < 0.0 {
+        -1.0
+    } else {
+        1.0
+    }
 }
 
 /// Pass 2 over one boundary: intersect, triangulate, bound.
@@ -1058,7 +1207,7 @@ fn evaluate<S: CrossingSearch>(
 /// inlined, and lines it declines go through the index's general search
 /// out of line.
 #[inline(never)]
-fn pass2_lean<const N: usize>(
+fn pass2_lean<const N: usize, const PERIODIC: bool>(
     config: &Config,
     geom: &PairGeometry,
     (r1, guard2): (f32, f32),
@@ -1086,7 +1235,7 @@ fn pass2_lean<const N: usize>(
             continue;
         }
         let mut hits = Hits::new();
-        if !run.search(&line, |x| hits.visit_in_order(x)) {
+        if !run.search::<PERIODIC, _>(&line, |x| hits.visit_in_order(x)) {
             let mut found = Crossings::new();
             run.collect_general(line, &mut found);
             for &x in found.iter() {
@@ -1221,4 +1370,110 @@ fn conclude(
         None => r.status = Status::Unbounded,
     }
     r
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::epipolar::Unwrap;
+
+    /// A small deterministic generator (xorshift), values in `[0, 1)`.
+    struct Rng(u32);
+    impl Rng {
+        fn next(&mut self) -> f32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 17;
+            self.0 ^= self.0 << 5;
+            (self.0 >> 8) as f32 / (1u32 << 24) as f32
+        }
+    }
+
+    /// The fold test in two sweeps (pass 1's prefix half, [`PrefixFold`],
+    /// and [`fold_suffix`]) answers exactly as the general index query,
+    /// whichever orientation it guesses, on key sequences that jitter
+    /// around the key margin, fold back and (pseudo-angles) wrap round at
+    /// 4, for whole-turn and half-plane keys; and it declines exactly when
+    /// whole-turn keys span a turn or more.
+    #[test]
+    fn two_sweep_fold_test_equals_the_general_query() {
+        const M: usize = 64;
+        let mut rng = Rng(0x5eed_f01d);
+        let (mut compared, mut folds, mut declined) = (0, 0, 0);
+        for case in 0..6000 {
+            let half = case % 2 == 0;
+            let key = if half {
+                PencilKey::Half {
+                    foe: [0.0, 0.0],
+                    side: 1.0,
+                    min_t: crate::epipolar::HALF_MIN_DV,
+                }
+            } else {
+                PencilKey::Angular {
+                    foe: [0.0, 0.0],
+                    sign_w: 1.0,
+                }
+            };
+            let n = 2 + (rng.next() * (M - 2) as f32) as usize;
+            // Steps well below the margin up to steps that wind the
+            // pseudo-angle round more than a turn.
+            let scale = [3.0e-5, 1.0e-4, 1.0e-3, 0.05, 0.3][case / 2 % 5];
+            let drift = (rng.next() - 0.5) * scale;
+            let mut raw = [0.0f32; M];
+            let mut k = if half {
+                rng.next() - 0.5
+            } else {
+                rng.next() * 4.0
+            };
+            for slot in raw.iter_mut().take(n) {
+                *slot = if half {
+                    k.clamp(-0.999, 0.999)
+                } else {
+                    k.rem_euclid(4.0)
+                };
+                let back = if rng.next() < 0.03 {
+                    -30.0 * drift
+                } else {
+                    0.0
+                };
+                k += drift + (rng.next() - 0.5) * scale + back;
+            }
+            // The keys as pass 1 leaves them.
+            let mut keys = [0.0f32; M];
+            let mut unwrap = Unwrap::new(&key);
+            for (u, &r) in keys.iter_mut().zip(&raw).take(n) {
+                *u = if half { r } else { unwrap.next(r) };
+            }
+            let keys = &keys[..n];
+            let o = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+            let mut prefix = PrefixFold::new(o);
+            let mut got = [false; M];
+            for (i, &k) in keys.iter().enumerate() {
+                got[i] = prefix.met(keys, i, k);
+            }
+            let mut slots = [PointResult::default(); M];
+            let fast = fold_suffix(keys, &mut slots[..n], o, prefix.pmax, !half);
+            let (lo, hi) = keys
+                .iter()
+                .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &k| {
+                    (a.min(k), b.max(k))
+                });
+            assert_eq!(fast, half || hi - lo < 3.9, "case {case}");
+            if !fast {
+                declined += 1;
+                continue;
+            }
+            let mut want = [false; M];
+            IndexedSearch::<M>::general_fold_flags(&key, keys, &mut want);
+            for i in 0..n {
+                let g = got[i] || slots[i].status == Status::Folded;
+                assert_eq!(g, want[i], "case {case}, point {i} of {n}, o = {o}");
+                folds += usize::from(g);
+            }
+            compared += 1;
+        }
+        assert!(
+            compared > 5000 && folds > 2000 && declined > 50,
+            "{compared} {folds} {declined}"
+        );
+    }
 }

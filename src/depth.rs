@@ -62,7 +62,7 @@
 //! `|ΔZ/Z| ≈ e/d` (Sec. 4.1.1).
 
 use crate::camera::Pixel;
-use crate::math::{cross, dot, fmax, fmin, sqrt_pos, sub};
+use crate::math::{cross, dot, fmax, sqrt_pos, sub};
 
 /// Half-width, in points, of the chord used to measure the boundary direction.
 pub const CHORD_HALF_WINDOW: usize = 4;
@@ -100,6 +100,12 @@ pub(crate) fn chord(boundary: &[Pixel], j: usize) -> [f32; 2] {
 
 /// Angle terms of an intersection: `(sin φ_low, |cos φ|)`, where `φ_low`
 /// is the smallest angle consistent with the chord's own error.
+///
+/// `|cos φ|` may round above 1 only when `sin φ` is below 1.001e-3 (the
+/// two are computed from the same `1/(|a| l)` with a few roundings each),
+/// which is under the sine of the smallest minimum angle a [`crate::Config`]
+/// accepts (0.1°, 1.745e-3): such a crossing is grazing, and its `cos` is
+/// never used.
 pub(crate) fn crossing_angle(a: [f32; 2], a_len: f32, chord: [f32; 2], e2: f32) -> (f32, f32) {
     let l2 = dot(chord, chord);
     // The chord of a validated boundary has l2 > 0 and a point away from
@@ -111,7 +117,7 @@ pub(crate) fn crossing_angle(a: [f32; 2], a_len: f32, chord: [f32; 2], e2: f32) 
     let inv = 1.0 / (a_len * l);
     let sin = cross(a, chord).abs() * inv;
     let cos = dot(a, chord).abs() * inv;
-    (sin - 2.0 * e2 / l, fmin(cos, 1.0))
+    (sin - 2.0 * e2 / l, cos)
 }
 
 /// The stick for a match at `tau` (see the module docs), also when each

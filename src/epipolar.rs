@@ -787,7 +787,7 @@ pub(crate) struct SingleRun<'a, const N: usize> {
     hint: usize,
 }
 
-impl<const N: usize> SingleRun<'_, N> {
+impl<'a, const N: usize> SingleRun<'a, N> {
     /// Whether the keys are pseudo-angles over the whole turn (see
     /// [`Self::search`]).
     pub(crate) fn periodic(&self) -> bool {
@@ -795,20 +795,20 @@ impl<const N: usize> SingleRun<'_, N> {
     }
 
     /// The frame-2 boundary.
-    pub(crate) fn boundary(&self) -> &[Pixel] {
+    pub(crate) fn boundary(&self) -> &'a [Pixel] {
         self.boundary
     }
 
     /// Every crossing of `line`'s ray, up to [`MAX_RAY_CROSSINGS`]` + 1`,
     /// by the general search of the index (for a line [`Self::search`]
-    /// declined). Out of line: rare, and `line` is a copy so that the
-    /// caller's stays in registers.
-    #[inline(never)]
+    /// declined). The work is out of line (rare) and only copies go there
+    /// (`line`, the hint), so that the caller keeps its line and this view
+    /// in registers.
+    #[inline(always)]
     pub(crate) fn collect_general(&mut self, line: EpipolarLine, out: &mut Crossings) {
-        self.index
-            .search_at(&mut self.hint, &line, self.boundary, |c| {
-                out.push(c).is_ok()
-            });
+        let mut hint = self.hint;
+        collect_general(self.index, &mut hint, line, self.boundary, out);
+        self.hint = hint;
     }
 
     /// Visit the crossings of `line`'s ray with the boundary, as
@@ -870,6 +870,18 @@ impl<const N: usize> SingleRun<'_, N> {
         }
         true
     }
+}
+
+/// [`SingleRun::collect_general`], out of line.
+#[inline(never)]
+fn collect_general<const N: usize>(
+    index: &IndexedSearch<N>,
+    hint: &mut usize,
+    line: EpipolarLine,
+    boundary: &[Pixel],
+    out: &mut Crossings,
+) {
+    index.search_at(hint, &line, boundary, |c| out.push(c).is_ok());
 }
 
 /// First index `j` in `[0, v.len())` with `v[j] ≥ t` in a non-decreasing

@@ -726,7 +726,7 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
                 PencilKey::Half { foe, side, min_t } => pass1::<N, true, false>(
                     &geom,
                     &key,
-                    |v| half_key(foe, side, min_t, v),
+                    move |v| half_key(foe, side, min_t, v),
                     b1,
                     &mut bs.points,
                     index.keys_mut(),
@@ -735,7 +735,7 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
                 _ => pass1::<N, true, true>(
                     &geom,
                     &key,
-                    |v| key.vertex_key(v),
+                    move |v| key.vertex_key(v),
                     b1,
                     &mut bs.points,
                     index.keys_mut(),
@@ -749,7 +749,7 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
             let (all_keyed, _) = pass1::<N, false, false>(
                 &geom,
                 &key,
-                |v| key.vertex_key(v),
+                move |v| key.vertex_key(v),
                 b1,
                 &mut bs.points,
                 index.keys_mut(),
@@ -1219,6 +1219,7 @@ fn pass2_lean<const N: usize, const PERIODIC: bool>(
         rotation: false,
         frame_disc: Some((r1, guard2)),
     };
+    let b2 = run.boundary();
     for r in points.iter_mut() {
         if r.status == Status::BehindCamera {
             continue;
@@ -1254,7 +1255,7 @@ fn pass2_lean<const N: usize, const PERIODIC: bool>(
             r1,
             &errors,
             r.status == Status::Folded,
-            run.boundary(),
+            b2,
         );
     }
 }
@@ -1275,35 +1276,78 @@ fn conclude(
     folded: bool,
     b2: &[Pixel],
 ) -> PointResult {
-    let w = geom.w();
-    if hits.on_ray > MAX_RAY_CROSSINGS {
-        // More than MAX_RAY_CROSSINGS: the boundary runs along the ray.
-        return flagged(p1, Status::Tangled);
+    let status = match_status(hits, folded);
+    if !is_match(status) {
+        return flagged(p1, status);
     }
-    if hits.valid > MAX_CROSSINGS {
-        return flagged(p1, Status::Tangled);
-    }
-    if hits.valid == 0 {
-        return flagged(p1, Status::NoIntersection);
-    }
-    let (best_tau, best_segment) = (hits.best_tau, hits.best_segment);
-    let status = if hits.valid > 1 {
+    triangulate(
+        config,
+        geom,
+        p1,
+        c,
+        line,
+        (hits.best_tau, hits.best_segment),
+        status,
+        r1,
+        errors,
+        b2,
+    )
+}
+
+/// The outcome of the search: [`Status::Tangled`] or
+/// [`Status::NoIntersection`] (final), or for a match its provisional
+/// status: [`Status::Folded`] when the fold test marked the point (it
+/// applies if a depth is given), else [`Status::Ambiguous`] or
+/// [`Status::Ok`].
+#[inline(always)]
+fn match_status(hits: &Hits, folded: bool) -> Status {
+    if hits.on_ray > MAX_RAY_CROSSINGS || hits.valid > MAX_CROSSINGS {
+        // Too many to tell apart: the boundary runs along the ray.
+        Status::Tangled
+    } else if hits.valid == 0 {
+        Status::NoIntersection
+    } else if folded {
+        Status::Folded
+    } else if hits.valid > 1 {
         Status::Ambiguous
     } else {
         Status::Ok
-    };
+    }
+}
+
+/// Whether [`match_status`] found a match.
+#[inline(always)]
+fn is_match(status: Status) -> bool {
+    matches!(status, Status::Ok | Status::Ambiguous | Status::Folded)
+}
+
+/// Triangulate the match `(τ, segment)` of a point (eq. 2.3) and bound it
+/// (the stick); `status` is the match's provisional one ([`match_status`]),
+/// kept when a depth is given.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn triangulate(
+    config: &Config,
+    geom: &PairGeometry,
+    p1: Pixel,
+    c: &Compensated,
+    line: &EpipolarLine,
+    (best_tau, best_segment): (f32, usize),
+    status: Status,
+    r1: f32,
+    errors: &MotionErrors,
+    b2: &[Pixel],
+) -> PointResult {
+    let w = geom.w();
     let mut r = PointResult {
         pixel1: p1,
         pixel2: line.at(best_tau),
         status,
         ..PointResult::default()
     };
-    // a2 > 1e-12 (checked above); infinite only for absurd motions.
-    let a_len = if line.a2.is_finite() {
-        crate::math::sqrt_pos(line.a2)
-    } else {
-        f32::INFINITY
-    };
+    // a2 > 1e-12 (checked above); infinite only for absurd motions, and
+    // then `a_len` is NaN, which the grazing test below flags.
+    let a_len = crate::math::sqrt_pos(line.a2);
     let (sin_low, cos) = crossing_angle(line.a, a_len, chord(b2, best_segment), config.e2);
     // A NaN angle (impossible for validated input) is grazing too: one
     // negated comparison says both.
@@ -1356,16 +1400,12 @@ fn conclude(
         )
     };
     match interval {
+        // The status stays: `Ok`, `Ambiguous`, or `Folded` (the fold test
+        // only matters where a depth would otherwise be given).
         Some(i) => {
             r.z = z;
             r.z_near = crate::math::fmin(i.z_near, z);
             r.z_far = crate::math::fmax(i.z_far, z);
-            // The fold test only matters where a depth would otherwise be
-            // given (here: `Ok` or `Ambiguous`); elsewhere the status
-            // already says why there is none.
-            if folded {
-                r.status = Status::Folded;
-            }
         }
         None => r.status = Status::Unbounded,
     }

@@ -297,14 +297,20 @@ impl EpipolarLine {
         s0: f32,
         s1: f32,
     ) -> Option<Crossing> {
-        let (v0, v1) = (v0.arr(), v1.arr());
-        // s0 and s1 have strictly different signs, so s0 - s1 != 0 (a NaN
-        // σ, not from finite input, gives a NaN τ below: no crossing).
-        let u = s0 / (s0 - s1);
-        let p = [v0[0] + u * (v1[0] - v0[0]), v0[1] + u * (v1[1] - v0[1])];
-        // a2 > 0 is guaranteed by the caller (the point is not at the FOE).
-        let tau = dot(sub(p, self.origin), self.a) / self.a2;
+        let tau = self.tau_between(v0, v1, s0, s1);
         (tau > self.ray_min && tau < self.ray_max).then_some(Crossing { segment, tau })
+    }
+
+    /// The position `τ` where the line meets the segment `v0 → v1` whose
+    /// end points' sides `s0`, `s1` have different [`side_bit`]s: from
+    /// `p₁' + τ a = v0 + u (v1 − v0)`, crossing both sides with
+    /// `e = v1 − v0`, `τ = ((v0 − p₁') × e) / (a × e)`, and
+    /// `a × e = σ₁ − σ₀`, which is not zero since the signs differ (a NaN
+    /// σ, not from finite input, gives a NaN τ: no crossing).
+    #[inline(always)]
+    pub(crate) fn tau_between(&self, v0: Pixel, v1: Pixel, s0: f32, s1: f32) -> f32 {
+        let (v0, v1) = (v0.arr(), v1.arr());
+        cross(sub(v0, self.origin), sub(v1, v0)) / (s1 - s0)
     }
 
     /// Whether a crossing lies in the search range: the half-line away from
@@ -745,6 +751,9 @@ pub struct IndexedSearch<const N: usize> {
     single: bool,
     /// A multiple of 4 with `base ≤ kmin − eps < base + 4`.
     base: f32,
+    /// When ±1: `hi` already holds the prefix maximum of the keys oriented
+    /// by this sign (written while the keys were made); 0 otherwise.
+    prefix_orient: f32,
     segments: usize,
     /// Range of the unwrapped keys.
     kmin: f32,
@@ -771,10 +780,9 @@ pub(crate) struct SingleRun<'a, const N: usize> {
     hi: &'a [f32],
     lo: &'a [f32],
     boundary: &'a [Pixel],
-    /// A raw key `q` is usable iff `q.to_bits() & key_mask < key_limit`:
-    /// in `[+0, 4)` for pseudo-angles, finite for projective keys.
-    key_mask: u32,
-    key_limit: u32,
+    /// Pseudo-angles over the whole turn (a usable raw key is in `[+0,
+    /// 4)`; other keys are usable when finite).
+    periodic: bool,
     orient: f32,
     eps: f32,
     /// The smallest usable unwrapped key, `kmin − eps` (pseudo-angles;
@@ -791,7 +799,7 @@ impl<'a, const N: usize> SingleRun<'a, N> {
     /// Whether the keys are pseudo-angles over the whole turn (see
     /// [`Self::search`]).
     pub(crate) fn periodic(&self) -> bool {
-        self.key_mask == u32::MAX
+        self.periodic
     }
 
     /// The frame-2 boundary.
@@ -819,14 +827,22 @@ impl<'a, const N: usize> SingleRun<'a, N> {
     ///
     /// `PERIODIC` must say whether the keys are pseudo-angles over the whole
     /// turn ([`Self::periodic`]); without it a key needs no turn chosen.
+    /// `visit` gets each crossing and whether it lies in the search range
+    /// ([`EpipolarLine::in_search_range`], for a line whose `ray_max` is its
+    /// `tau_max`, as [`PairGeometry::line`] makes them).
     #[inline(always)]
-    pub(crate) fn search<const PERIODIC: bool, F: FnMut(Crossing) -> bool>(
+    pub(crate) fn search<const PERIODIC: bool, F: FnMut(Crossing, bool) -> bool>(
         &mut self,
         line: &EpipolarLine,
         mut visit: F,
     ) -> bool {
         let q = line.key;
-        if q.to_bits() & self.key_mask >= self.key_limit {
+        let usable = if PERIODIC {
+            q.to_bits() < 4.0f32.to_bits()
+        } else {
+            q.is_finite()
+        };
+        if !usable {
             return false;
         }
         let qq = if PERIODIC {
@@ -859,10 +875,20 @@ impl<'a, const N: usize> SingleRun<'a, N> {
             };
             let s1 = line.side(v1);
             if side_bit(s0) != side_bit(s1) {
-                if let Some(c) = line.crossing_between(j, v0, v1, s0, s1) {
-                    if !visit(c) {
-                        break;
-                    }
+                // On the ray: ray_min < τ < ray_max; in the search range
+                // also τ > 0 (and τ < tau_max = ray_max).
+                let tau = line.tau_between(v0, v1, s0, s1);
+                let c = Crossing { segment: j, tau };
+                // (A NaN τ fails both `>`: no crossing, as in `crossing`.)
+                let more = if tau > 0.0 {
+                    tau >= line.ray_max || visit(c, true)
+                } else if tau > line.ray_min {
+                    visit(c, false)
+                } else {
+                    true
+                };
+                if !more {
+                    break;
                 }
             }
             (v0, s0) = (v1, s1);
@@ -941,6 +967,7 @@ impl<const N: usize> IndexedSearch<N> {
             all_keyed: false,
             single: false,
             base: 0.0,
+            prefix_orient: 0.0,
             segments: 0,
             kmin: 0.0,
             kmax: 0.0,
@@ -991,6 +1018,9 @@ impl<const N: usize> IndexedSearch<N> {
         n: usize,
         all_keyed: bool,
     ) {
+        // Consumed here whatever path follows: a mark left by a build that
+        // did not reach `envelopes` must not reach a later one.
+        let prefix_orient = core::mem::replace(&mut self.prefix_orient, 0.0);
         self.key = *key;
         self.unkeyed.clear();
         self.scan = false;
@@ -1038,7 +1068,7 @@ impl<const N: usize> IndexedSearch<N> {
                 }
             }
         }
-        self.envelopes(unkeyed_meets_all);
+        self.envelopes(unkeyed_meets_all, prefix_orient == o);
         let s = self.segments;
         let ends = (self.hi.get(s.wrapping_sub(1)), self.lo.first());
         match ends {
@@ -1122,6 +1152,7 @@ impl<const N: usize> IndexedSearch<N> {
     /// The one-run view of a [`Self::single`] index built for `boundary`
     /// (`None` for any other index): what the processor's lean matching
     /// pass needs, borrowed once per boundary.
+    #[inline(always)]
     pub(crate) fn single_run<'a>(&'a self, boundary: &'a [Pixel]) -> Option<SingleRun<'a, N>> {
         let s = self.segments;
         if !self.single || boundary.len() != s + 1 {
@@ -1133,12 +1164,7 @@ impl<const N: usize> IndexedSearch<N> {
             hi: self.hi.get(..s)?,
             lo: self.lo.get(..s)?,
             boundary,
-            key_mask: if angular { u32::MAX } else { 0x7fff_ffff },
-            key_limit: if angular {
-                4.0f32.to_bits()
-            } else {
-                f32::INFINITY.to_bits()
-            },
+            periodic: angular,
             orient: self.orient,
             eps: self.eps,
             lim: if angular {
@@ -1196,7 +1222,9 @@ impl<const N: usize> IndexedSearch<N> {
 
     /// The running envelopes `hi`, `lo` of the oriented keys (and the list
     /// of unkeyed segments) for the general search.
-    fn envelopes(&mut self, unkeyed_meets_all: bool) {
+    /// `prefix_ready`: `hi` already holds the prefix maximum (of the keys
+    /// oriented as `orient`).
+    fn envelopes(&mut self, unkeyed_meets_all: bool, prefix_ready: bool) {
         let (s, o, period) = (self.segments, self.orient, self.period);
         let (Some(keys), Some(hi), Some(lo)) = (
             self.keys.get(..s + 1),
@@ -1209,10 +1237,12 @@ impl<const N: usize> IndexedSearch<N> {
         if self.all_keyed {
             // Every segment counts: prefix maximum and suffix minimum of
             // the oriented vertex keys.
-            let mut run = keys.first().map_or(f32::NEG_INFINITY, |&k| o * k);
-            for (&k, h) in keys.iter().skip(1).zip(hi.iter_mut()) {
-                run = fmax(run, o * k);
-                *h = run;
+            if !prefix_ready {
+                let mut run = keys.first().map_or(f32::NEG_INFINITY, |&k| o * k);
+                for (&k, h) in keys.iter().skip(1).zip(hi.iter_mut()) {
+                    run = fmax(run, o * k);
+                    *h = run;
+                }
             }
             let mut run = keys.last().map_or(f32::INFINITY, |&k| o * k);
             for (&k, l) in keys.iter().zip(lo.iter_mut()).rev() {
@@ -1476,14 +1506,33 @@ impl<const N: usize> CrossingSearch for IndexedSearch<N> {
         match *key {
             // Half-plane keys never wrap: no unwrapping.
             PencilKey::Half { foe, side, min_t } => {
-                let mut sum = 0.0f32;
-                let mut n = 0;
-                for (slot, p) in self.keys.iter_mut().zip(boundary) {
+                let key_of =
+                    |p: Option<&Pixel>| p.map_or(NO_KEY, |p| half_key(foe, side, min_t, p.arr()));
+                // The orientation `index_keys` will find (from the first and
+                // the last key, when all are usable), known in advance: the
+                // prefix maximum `hi` is made with the keys.
+                let o = if key_of(boundary.last()) >= key_of(boundary.first()) {
+                    1.0
+                } else {
+                    -1.0
+                };
+                let (Some(k0), Some(first)) = (self.keys.first_mut(), boundary.first()) else {
+                    self.index_keys(key, true, 0, true);
+                    return;
+                };
+                *k0 = half_key(foe, side, min_t, first.arr());
+                let (mut sum, mut run) = (*k0, o * *k0);
+                let mut n = 1;
+                let rest = self.keys.iter_mut().skip(1).zip(self.hi.iter_mut());
+                for ((slot, h), p) in rest.zip(boundary.iter().skip(1)) {
                     let k = half_key(foe, side, min_t, p.arr());
                     *slot = k;
                     sum += k;
+                    run = fmax(run, o * k);
+                    *h = run;
                     n += 1;
                 }
+                self.prefix_orient = o;
                 self.index_keys(key, true, n, sum.is_finite());
             }
             _ => self.build(key, true, boundary.iter().map(|p| key.vertex(p.arr()))),
@@ -1600,7 +1649,7 @@ impl<const N: usize> IndexedSearch<N> {
         ix.keys[..n].copy_from_slice(&keys[..n]);
         ix.index_keys(key, false, n, true);
         ix.fold_fast = false;
-        ix.envelopes(false);
+        ix.envelopes(false, false);
         for (i, o) in out.iter_mut().enumerate().take(n) {
             *o = ix.meets_outside(keys[i], (i.saturating_sub(4), i + 3));
         }
@@ -1672,7 +1721,7 @@ mod tests {
             fast_cases += 1;
             let mut slow = fast.clone();
             slow.fold_fast = false;
-            slow.envelopes(false);
+            slow.envelopes(false, false);
             let mut got = [false; M];
             fast.fold_each(|i| got[i] = true);
             for (i, &g) in got.iter().enumerate().take(n) {
@@ -1847,7 +1896,7 @@ mod tests {
                 let mut got = heapless::Vec::<Crossing, M>::new();
                 let mut want = heapless::Vec::<Crossing, M>::new();
                 if let Some(mut run) = index.single_run(boundary) {
-                    if !run.search::<false, _>(&line, |x| got.push(x).is_ok()) {
+                    if !run.search::<false, _>(&line, |x, _| got.push(x).is_ok()) {
                         let mut c = Crossings::new();
                         run.collect_general(line, &mut c);
                         got.extend(c.iter().copied());

@@ -1137,17 +1137,16 @@ impl Hits {
         true
     }
 
-    /// [`Self::visit`] for crossings of a line from [`PairGeometry::line`]
-    /// (whose `ray_max` is its `tau_max`) that come in increasing segment
-    /// order: the crossing already satisfies `τ < tau_max`, and of two
-    /// with the same `τ` the earlier has the lower segment.
+    /// [`Self::visit`] for crossings that come in increasing segment order
+    /// with whether they lie in the search range ([`SingleRun::search`]):
+    /// of two with the same `τ` the earlier has the lower segment.
     #[inline(always)]
-    fn visit_in_order(&mut self, x: crate::epipolar::Crossing) -> bool {
+    fn visit_in_order(&mut self, x: crate::epipolar::Crossing, in_range: bool) -> bool {
         self.on_ray += 1;
         if self.on_ray > MAX_RAY_CROSSINGS {
             return false;
         }
-        if x.tau > 0.0 {
+        if in_range {
             self.valid += 1;
             if x.tau < self.best_tau {
                 self.best_tau = x.tau;
@@ -1236,7 +1235,7 @@ fn pass2_lean<const N: usize, const PERIODIC: bool>(
             continue;
         }
         let mut hits = Hits::new();
-        if !run.search::<PERIODIC, _>(&line, |x| hits.visit_in_order(x)) {
+        if !run.search::<PERIODIC, _>(&line, |x, in_range| hits.visit_in_order(x, in_range)) {
             let mut found = Crossings::new();
             run.collect_general(line, &mut found);
             for &x in found.iter() {

@@ -11,6 +11,7 @@
 
 use core::fmt;
 
+use crate::buffer::Buffer;
 use crate::camera::{Camera, Pixel};
 
 /// Why a boundary was rejected. Indices refer to the offending point.
@@ -74,11 +75,17 @@ impl fmt::Display for BoundaryError {
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Boundary<const N: usize> {
-    points: heapless::Vec<Pixel, N>,
+    points: Buffer<Pixel, N>,
 }
 
 impl<const N: usize> Boundary<N> {
-    fn validate(points: &[Pixel], camera: &Camera) -> Result<Self, BoundaryError> {
+    /// No points (a frame's unused boundary slot).
+    const EMPTY: Self = Self {
+        points: Buffer::new(Pixel::new(0.0, 0.0)),
+    };
+
+    /// Check that `points` make a valid boundary (see the module docs).
+    fn check(points: &[Pixel], camera: &Camera) -> Result<(), BoundaryError> {
         if points.len() < 2 {
             return Err(BoundaryError::TooFewPoints);
         }
@@ -109,33 +116,54 @@ impl<const N: usize> Boundary<N> {
             }
             prev = Some(p);
         }
-        let mut out = heapless::Vec::new();
-        for &p in points {
-            // Cannot fail: the length was checked against N above.
-            if out.push(p).is_err() {
-                return Err(BoundaryError::TooManyPoints {
-                    len: points.len(),
-                    capacity: N,
-                });
-            }
-        }
-        Ok(Self { points: out })
+        Ok(())
     }
 
     /// The points, in the order given.
     pub fn points(&self) -> &[Pixel] {
-        &self.points
+        self.points.as_slice()
     }
 }
 
 /// One camera frame: its intrinsics and up to `B` validated boundaries of up
 /// to `N` points each (index 0 = left road edge, 1 = right, by convention;
 /// boundary `k` of one frame corresponds to boundary `k` of the next).
-#[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+///
+/// Its storage is `B` boundary slots of `N` points, filled once when the
+/// frame is made: adding a boundary copies its points into the next slot,
+/// and nothing larger than a point is ever moved or built on the stack.
+#[derive(Clone)]
 pub struct Frame<const N: usize, const B: usize> {
     camera: Camera,
-    boundaries: heapless::Vec<Boundary<N>, B>,
+    slots: [Boundary<N>; B],
+    count: usize,
+}
+
+impl<const N: usize, const B: usize> PartialEq for Frame<N, B> {
+    fn eq(&self, other: &Self) -> bool {
+        self.camera == other.camera && self.boundaries() == other.boundaries()
+    }
+}
+
+impl<const N: usize, const B: usize> fmt::Debug for Frame<N, B> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Frame")
+            .field("camera", &self.camera)
+            .field("boundaries", &self.boundaries())
+            .finish()
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl<const N: usize, const B: usize> defmt::Format for Frame<N, B> {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "Frame {{ camera: {}, boundaries: {} }}",
+            self.camera,
+            self.boundaries()
+        )
+    }
 }
 
 impl<const N: usize, const B: usize> Frame<N, B> {
@@ -143,7 +171,8 @@ impl<const N: usize, const B: usize> Frame<N, B> {
     pub const fn new(camera: Camera) -> Self {
         Self {
             camera,
-            boundaries: heapless::Vec::new(),
+            slots: [Boundary::EMPTY; B],
+            count: 0,
         }
     }
 
@@ -163,48 +192,28 @@ impl<const N: usize, const B: usize> Frame<N, B> {
     /// # Ok::<(), BoundaryError>(())
     /// ```
     pub fn push_boundary(&mut self, points: &[Pixel]) -> Result<(), BoundaryError> {
-        if self.boundaries.is_full() {
+        let Some(slot) = self.slots.get_mut(self.count) else {
             return Err(BoundaryError::TooManyBoundaries);
-        }
-        let b = Boundary::validate(points, &self.camera)?;
-        self.boundaries
-            .push(b)
-            .map_err(|_| BoundaryError::TooManyBoundaries)
+        };
+        Boundary::<N>::check(points, &self.camera)?;
+        slot.points.copy_from(points);
+        self.count += 1;
+        Ok(())
     }
 
-    /// Make this frame a copy of `other` in place (no large temporaries).
+    /// Make this frame a copy of `other` in place: one slice copy per
+    /// boundary.
     pub(crate) fn assign(&mut self, other: &Self) {
         self.camera = other.camera;
-        self.boundaries.truncate(other.boundaries.len());
-        for (i, src) in other.boundaries.iter().enumerate() {
-            if self.boundaries.len() <= i
-                && self
-                    .boundaries
-                    .push(Boundary {
-                        points: heapless::Vec::new(),
-                    })
-                    .is_err()
-            {
-                return;
-            }
-            if let Some(dst) = self.boundaries.get_mut(i) {
-                // Same capacity N on both sides: cannot fail. In a steady
-                // stream the lengths already agree and this is one block
-                // copy.
-                dst.points.truncate(src.points.len());
-                if dst.points.resize_default(src.points.len()).is_err() {
-                    dst.points.clear();
-                }
-                for (d, s) in dst.points.iter_mut().zip(src.points.iter()) {
-                    *d = *s;
-                }
-            }
+        self.count = other.count;
+        for (dst, src) in self.slots.iter_mut().zip(other.boundaries()) {
+            dst.points.copy_from(src.points());
         }
     }
 
     /// Remove all boundaries (keeps the camera).
     pub fn clear(&mut self) {
-        self.boundaries.clear();
+        self.count = 0;
     }
 
     /// The camera of this frame.
@@ -214,6 +223,6 @@ impl<const N: usize, const B: usize> Frame<N, B> {
 
     /// The validated boundaries.
     pub fn boundaries(&self) -> &[Boundary<N>] {
-        &self.boundaries
+        self.slots.get(..self.count).unwrap_or(&[])
     }
 }

@@ -491,6 +491,22 @@ impl PairGeometry {
         })
     }
 
+    /// [`Self::compensate`] with the given stretch bound in place of the
+    /// point's own (the frame-wide one, [`Self::frame_stretch`]).
+    #[inline(always)]
+    pub(crate) fn compensate_bounded(&self, p1: Pixel, stretch: f32) -> Option<Compensated> {
+        let [x, y, z] = mat3_vec(&self.h, [p1.u, p1.v, 1.0]);
+        if z <= 1.0e-6 {
+            return None;
+        }
+        let iz = 1.0 / z;
+        Some(Compensated {
+            pixel: [x * iz, y * iz],
+            depth_scale: z,
+            stretch,
+        })
+    }
+
     /// The frame-wide stretch bound that [`Self::compensate_in_frame`]
     /// gives every point, if there is one.
     pub(crate) fn frame_stretch(&self) -> Option<f32> {

@@ -35,6 +35,7 @@
 
 pub mod analysis;
 pub mod boundary;
+mod buffer;
 pub mod calibration;
 pub mod camera;
 pub mod depth;

@@ -10,6 +10,7 @@
 use core::fmt;
 
 use crate::boundary::Frame;
+use crate::buffer::Buffer;
 use crate::camera::{Camera, Pixel};
 use crate::depth::{chord, crossing_angle, stick, stick_exact, DepthInterval, CHORD_HALF_WINDOW};
 use crate::epipolar::half_key;
@@ -298,6 +299,16 @@ pub struct PointResult {
 }
 
 impl PointResult {
+    /// No result (what unused output entries hold).
+    const EMPTY: Self = Self {
+        pixel1: Pixel::new(0.0, 0.0),
+        pixel2: Pixel::new(0.0, 0.0),
+        z: 0.0,
+        z_near: 0.0,
+        z_far: 0.0,
+        status: Status::NoIntersection,
+    };
+
     /// The outcome.
     pub fn status(&self) -> Status {
         self.status
@@ -327,29 +338,63 @@ impl PointResult {
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct BoundaryStructure<const N: usize> {
-    points: heapless::Vec<PointResult, N>,
+    points: Buffer<PointResult, N>,
 }
 
 impl<const N: usize> BoundaryStructure<N> {
+    const EMPTY: Self = Self {
+        points: Buffer::new(PointResult::EMPTY),
+    };
+
     /// The per-point results.
     pub fn points(&self) -> &[PointResult] {
-        &self.points
+        self.points.as_slice()
     }
 }
 
 /// The 3-D road structure recovered from one frame pair, in frame-1 camera
 /// coordinates.
-#[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+///
+/// Its storage is `B` slots of `N` results, filled once when the processor
+/// is made; each frame only sets how many are live.
+#[derive(Clone)]
 pub struct Structure<const N: usize, const B: usize> {
     camera1: Camera,
-    boundaries: heapless::Vec<BoundaryStructure<N>, B>,
+    slots: [BoundaryStructure<N>; B],
+    count: usize,
+}
+
+impl<const N: usize, const B: usize> PartialEq for Structure<N, B> {
+    fn eq(&self, other: &Self) -> bool {
+        self.camera1 == other.camera1 && self.boundaries() == other.boundaries()
+    }
+}
+
+impl<const N: usize, const B: usize> fmt::Debug for Structure<N, B> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Structure")
+            .field("camera1", &self.camera1)
+            .field("boundaries", &self.boundaries())
+            .finish()
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl<const N: usize, const B: usize> defmt::Format for Structure<N, B> {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "Structure {{ camera1: {}, boundaries: {} }}",
+            self.camera1,
+            self.boundaries()
+        )
+    }
 }
 
 impl<const N: usize, const B: usize> Structure<N, B> {
     /// Per-boundary results (index as in frame 1).
     pub fn boundaries(&self) -> &[BoundaryStructure<N>] {
-        &self.boundaries
+        self.slots.get(..self.count).unwrap_or(&[])
     }
 
     /// The camera of frame 1, in whose coordinates the points are given.
@@ -385,9 +430,9 @@ impl<const N: usize, const B: usize> Structure<N, B> {
                 h = (h ^ u32::from(b)).wrapping_mul(0x0100_0193);
             }
         };
-        for b in self.boundaries.iter() {
+        for b in self.boundaries() {
             eat(0xB0B0_B0B0);
-            for r in b.points.iter() {
+            for r in b.points() {
                 eat(r.status as u32);
                 for x in [
                     r.pixel1.u, r.pixel1.v, r.pixel2.u, r.pixel2.v, r.z, r.z_near, r.z_far,
@@ -402,7 +447,7 @@ impl<const N: usize, const B: usize> Structure<N, B> {
     /// How many points have each status, indexed like [`Status::ALL`].
     pub fn status_counts(&self) -> [usize; 11] {
         let mut c = [0usize; 11];
-        for r in self.boundaries.iter().flat_map(|b| b.points.iter()) {
+        for r in self.boundaries().iter().flat_map(|b| b.points()) {
             if let Some(slot) = c.get_mut(r.status as usize) {
                 *slot += 1;
             }
@@ -490,7 +535,8 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             search: IndexedSearch::new(),
             output: Structure {
                 camera1: Camera::PLACEHOLDER,
-                boundaries: heapless::Vec::new(),
+                slots: [BoundaryStructure::EMPTY; B],
+                count: 0,
             },
         }
     }
@@ -667,22 +713,12 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
     let geom = PairGeometry::new(previous.camera(), frame.camera(), motion);
     let errors = MotionErrors::new(config, &geom);
     out.camera1 = *previous.camera();
-    // The output keeps its buffers from the last frame: in a steady stream
-    // (the same number of points) nothing is pushed, only overwritten.
-    let count = previous.boundaries().len();
-    out.boundaries.truncate(count);
-    while out.boundaries.len() < count {
-        let empty = BoundaryStructure {
-            points: heapless::Vec::new(),
-        };
-        if out.boundaries.push(empty).is_err() {
-            break;
-        }
-    }
+    // The output's slots are sized, not filled: pass 1 writes every entry.
+    out.count = previous.boundaries().len();
     for (k, (b1, bs)) in previous
         .boundaries()
         .iter()
-        .zip(out.boundaries.iter_mut())
+        .zip(out.slots.iter_mut())
         .enumerate()
     {
         // How epipolar lines are keyed for this boundary pair: by the
@@ -697,11 +733,7 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
             })
             .unwrap_or(*geom.key());
         let n = b1.points().len();
-        bs.points.truncate(n);
-        if bs.points.resize_default(n).is_err() {
-            // A boundary holds at most N points: not reached.
-            bs.points.clear();
-        }
+        bs.points.set_len(n);
         // Pass 1: compensate every frame-1 point once. The output entry
         // holds the compensated point until pass 2 overwrites it: p₁' in
         // `pixel2`, q_z in `z`, the stretch in `z_near`, the raw key of
@@ -720,7 +752,7 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
             PencilKey::Projective { .. } => (false, false),
         };
         let b1 = b1.points();
-        let (all_keyed, fast) = if prefix {
+        let (all_keyed, fast, o) = if prefix {
             let o = fold_orientation(&geom, &key, b1);
             let (all_keyed, pmax) = match key {
                 PencilKey::Half { foe, side, min_t } => pass1::<N, true, false>(
@@ -728,7 +760,7 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
                     &key,
                     move |v| half_key(foe, side, min_t, v),
                     b1,
-                    &mut bs.points,
+                    bs.points.as_mut_slice(),
                     index.keys_mut(),
                     o,
                 ),
@@ -737,30 +769,30 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
                     &key,
                     move |v| key.vertex_key(v),
                     b1,
-                    &mut bs.points,
+                    bs.points.as_mut_slice(),
                     index.keys_mut(),
                     o,
                 ),
             };
             let keys = index.keys_mut().get(..n).unwrap_or(&[]);
-            let fast = all_keyed && fold_suffix(keys, &mut bs.points, o, pmax, periodic);
-            (all_keyed, fast)
+            let fast = all_keyed && fold_suffix(keys, bs.points.as_mut_slice(), pmax, periodic);
+            (all_keyed, fast, o)
         } else {
             let (all_keyed, _) = pass1::<N, false, false>(
                 &geom,
                 &key,
                 move |v| key.vertex_key(v),
                 b1,
-                &mut bs.points,
+                bs.points.as_mut_slice(),
                 index.keys_mut(),
                 1.0,
             );
-            (all_keyed, false)
+            (all_keyed, false, 1.0)
         };
         if !fast {
             if prefix {
                 // Undo pass 1's tentative flags.
-                for r in bs.points.iter_mut() {
+                for r in bs.points.as_mut_slice().iter_mut() {
                     if r.status == Status::Folded {
                         r.status = Status::NoIntersection;
                     }
@@ -769,15 +801,15 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
             index.index_keys(&key, false, n, all_keyed);
             if index.fold_fast() {
                 index.fold_each(|i| {
-                    if let Some(r) = bs.points.get_mut(i) {
+                    if let Some(r) = bs.points.as_mut_slice().get_mut(i) {
                         r.status = Status::Folded;
                     }
                 });
             } else {
-                for (i, r) in bs.points.iter_mut().enumerate() {
+                for (i, r) in bs.points.as_mut_slice().iter_mut().enumerate() {
                     if r.status != Status::BehindCamera
                         && index.meets_outside(
-                            r.z_far,
+                            o * r.z_far,
                             (
                                 i.saturating_sub(CHORD_HALF_WINDOW),
                                 i + CHORD_HALF_WINDOW - 1,
@@ -801,14 +833,16 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
         };
         match lean {
             Some((run, disc)) if run.periodic() => {
-                pass2_lean::<N, true>(config, &geom, disc, &mut bs.points, run)
+                pass2_lean::<N, true>(config, &geom, disc, bs.points.as_mut_slice(), run)
             }
-            Some((run, disc)) => pass2_lean::<N, false>(config, &geom, disc, &mut bs.points, run),
+            Some((run, disc)) => {
+                pass2_lean::<N, false>(config, &geom, disc, bs.points.as_mut_slice(), run)
+            }
             None => pass2(
                 config,
                 &geom,
                 &errors,
-                &mut bs.points,
+                bs.points.as_mut_slice(),
                 b2,
                 searches.crossing(),
             ),
@@ -845,9 +879,15 @@ fn pass1<const N: usize, const PREFIX: bool, const WRAPS: bool>(
     // Without wrapping (`!WRAPS`: keys that are not periodic) the keys are
     // used as they come; they are all usable iff their sum is finite.
     let mut sum = 0.0f32;
-    let mut prefix = PrefixFold::new(o);
+    let mut prefix = PrefixFold::new();
+    // The frame-wide stretch bound, decided once (else each point's own).
+    let frame_stretch = geom.frame_stretch();
     for (i, (slot, &p1)) in slots.iter_mut().zip(b1).enumerate() {
-        let k = match geom.compensate_in_frame(p1) {
+        let c = match frame_stretch {
+            Some(st) => geom.compensate_bounded(p1, st),
+            None => geom.compensate(p1),
+        };
+        let k = match c {
             Some(c) => {
                 let raw = key_of(c.pixel);
                 let k = if WRAPS {
@@ -857,7 +897,7 @@ fn pass1<const N: usize, const PREFIX: bool, const WRAPS: bool>(
                     raw
                 };
                 let mut status = Status::NoIntersection;
-                if PREFIX && prefix.met(keys, i, k) {
+                if PREFIX && prefix.met(keys, i, o * k) {
                     status = Status::Folded;
                 }
                 *slot = PointResult {
@@ -877,7 +917,7 @@ fn pass1<const N: usize, const PREFIX: bool, const WRAPS: bool>(
             }
         };
         if let Some(s) = keys.get_mut(i) {
-            *s = k;
+            *s = o * k;
         }
     }
     let all_keyed = if WRAPS {
@@ -889,46 +929,44 @@ fn pass1<const N: usize, const PREFIX: bool, const WRAPS: bool>(
 }
 
 /// The prefix half of the fold test, one point at a time along the
-/// boundary (see [`pass1`]): extremes of the oriented keys `o k` of the
-/// points before, the maximum kept as the sweep goes, the minimum over
-/// `keys[..pmin_upto]` brought up to date only when a test needs it (each
-/// key joins it at most once). The orientation `o` only decides which
-/// extreme is kept eagerly ([`fold_orientation`]).
+/// boundary (see [`pass1`]), on keys oriented by [`fold_orientation`]'s
+/// sign (the query does not change when every key changes sign): the
+/// maximum of the keys of the points before is kept as the sweep goes,
+/// the minimum over `keys[..pmin_upto]` is brought up to date only when a
+/// test needs it (each key joins it at most once). The orientation only
+/// decides which extreme is kept eagerly.
 struct PrefixFold {
-    o: f32,
     pmin: f32,
     pmax: f32,
     pmin_upto: usize,
 }
 
 impl PrefixFold {
-    fn new(o: f32) -> Self {
+    fn new() -> Self {
         Self {
-            o,
             pmin: f32::INFINITY,
             pmax: f32::NEG_INFINITY,
             pmin_upto: 0,
         }
     }
 
-    /// Whether point `i` with unwrapped key `k` meets the segments
-    /// `0 ..= i − 5`: its key lies in the widened range of `keys[..= i − 4]`
-    /// (which must already hold the keys of the points before `i`). Called
-    /// for `i = 0, 1, 2, …` in turn.
+    /// Whether point `i` with (oriented, unwrapped) key `k` meets the
+    /// segments `0 ..= i − 5`: its key lies in the widened range of
+    /// `keys[..= i − 4]` (which must already hold the keys of the points
+    /// before `i`). Called for `i = 0, 1, 2, …` in turn.
     #[inline(always)]
     fn met(&mut self, keys: &[f32], i: usize, k: f32) -> bool {
-        let (o, eps) = (self.o, ANGULAR_EPS);
+        let eps = ANGULAR_EPS;
         let Some(&v) = keys.get(i.wrapping_sub(4)) else {
             return false;
         };
-        self.pmax = fmax(self.pmax, o * v);
-        let ok = o * k;
-        if i >= 5 && ok <= self.pmax + eps {
+        self.pmax = fmax(self.pmax, v);
+        if i >= 5 && k <= self.pmax + eps {
             for &w in keys.get(self.pmin_upto..i - 3).unwrap_or(&[]) {
-                self.pmin = fmin(self.pmin, o * w);
+                self.pmin = fmin(self.pmin, w);
             }
             self.pmin_upto = i - 3;
-            return self.pmin - eps <= ok;
+            return self.pmin - eps <= k;
         }
         false
     }
@@ -937,13 +975,14 @@ impl PrefixFold {
 /// The second half of the fold test for pseudo-angle keys, after
 /// [`pass1`]: marks point `i` [`Status::Folded`] when its key lies in the
 /// widened range of the keys of points `i + 4 ..`, the path of segments
-/// `i + 4 ..` (present while `i + 4 ≤ n − 2`); `pmax` is [`pass1`]'s.
+/// `i + 4 ..` (present while `i + 4 ≤ n − 2`), on [`pass1`]'s oriented
+/// keys; `pmax` is [`pass1`]'s.
 /// Returns whether the keys
 /// span less than a turn (less 0.1), the condition under which these
 /// tests, and pass 1's, equal the general query
 /// ([`IndexedSearch::meets_outside`]); otherwise the caller discards them.
 #[inline(never)]
-fn fold_suffix(keys: &[f32], slots: &mut [PointResult], o: f32, pmax: f32, periodic: bool) -> bool {
+fn fold_suffix(keys: &[f32], slots: &mut [PointResult], pmax: f32, periodic: bool) -> bool {
     let eps = ANGULAR_EPS;
     let n = keys.len().min(slots.len());
     let (Some(keys), Some(slots)) = (keys.get(..n), slots.get_mut(..n)) else {
@@ -952,31 +991,25 @@ fn fold_suffix(keys: &[f32], slots: &mut [PointResult], o: f32, pmax: f32, perio
     let Some(&last) = keys.last() else {
         return false;
     };
-    // Extremes of the oriented keys of points `.. n`: the minimum kept as
-    // the sweep goes, the maximum over `keys[smax_from..]` brought up to
-    // date only when a test needs it.
-    let (mut smin, mut smax) = (o * last, o * last);
+    // Extremes of the keys of points `.. n`: the minimum kept as the sweep
+    // goes, the maximum over `keys[smax_from..]` brought up to date only
+    // when a test needs it.
+    let (mut smin, mut smax) = (last, last);
     let mut smax_from = n - 1;
-    // i = n − 6 down to 0, with vertex i + 4 joining the suffix first.
-    let m = n.saturating_sub(5);
-    let tested = keys.get(..m).unwrap_or(&[]);
-    let joining = keys.get(4..).unwrap_or(&[]);
-    for (i, ((&k, &v), r)) in tested
-        .iter()
-        .zip(joining)
-        .zip(slots.iter_mut())
-        .enumerate()
-        .rev()
-    {
-        smin = fmin(smin, o * v);
-        let ok = o * k;
-        if smin - eps <= ok {
-            for &w in keys.get(i + 4..smax_from).unwrap_or(&[]) {
-                smax = fmax(smax, o * w);
+    // i = n − 6 down to 0, with key i + 4 joining the suffix first.
+    let joins = keys.get(..n.saturating_sub(1)).unwrap_or(&[]);
+    for (i, w) in joins.windows(5).enumerate().rev() {
+        let [k, .., v] = *w else { continue };
+        smin = fmin(smin, v);
+        if smin - eps <= k {
+            for &x in keys.get(i + 4..smax_from).unwrap_or(&[]) {
+                smax = fmax(smax, x);
             }
             smax_from = i + 4;
-            if ok <= smax + eps {
-                r.status = Status::Folded;
+            if k <= smax + eps {
+                if let Some(r) = slots.get_mut(i) {
+                    r.status = Status::Folded;
+                }
             }
         }
     }
@@ -984,10 +1017,10 @@ fn fold_suffix(keys: &[f32], slots: &mut [PointResult], o: f32, pmax: f32, perio
     // points `4 ..`.
     smax = fmax(smax, pmax);
     for &w in keys.get(n.saturating_sub(4)..).unwrap_or(&[]) {
-        smax = fmax(smax, o * w);
+        smax = fmax(smax, w);
     }
     for &w in keys.iter().take(4.min(n)) {
-        smin = fmin(smin, o * w);
+        smin = fmin(smin, w);
     }
     !periodic || smax - smin < 4.0 - 0.1
 }
@@ -1483,14 +1516,20 @@ mod tests {
                 *u = if half { r } else { unwrap.next(r) };
             }
             let keys = &keys[..n];
+            // Pass 1 stores the keys oriented by its guess.
             let o = if rng.next() < 0.5 { 1.0 } else { -1.0 };
-            let mut prefix = PrefixFold::new(o);
+            let mut oriented = [0.0f32; M];
+            for (d, &k) in oriented.iter_mut().zip(keys) {
+                *d = o * k;
+            }
+            let oriented = &oriented[..n];
+            let mut prefix = PrefixFold::new();
             let mut got = [false; M];
-            for (i, &k) in keys.iter().enumerate() {
-                got[i] = prefix.met(keys, i, k);
+            for (i, &k) in oriented.iter().enumerate() {
+                got[i] = prefix.met(oriented, i, k);
             }
             let mut slots = [PointResult::default(); M];
-            let fast = fold_suffix(keys, &mut slots[..n], o, prefix.pmax, !half);
+            let fast = fold_suffix(oriented, &mut slots[..n], prefix.pmax, !half);
             let (lo, hi) = keys
                 .iter()
                 .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &k| {

@@ -40,7 +40,7 @@
 
 use crate::camera::{Camera, Pixel};
 use crate::math::{
-    ceil_i32, cross, dot, fmax, fmin, mat3_mul, mat3_transpose, mat3_vec, next_up, pseudo_angle,
+    ceil_i32, cross, dot, fmax, fmin, mat3_transpose, mat3_vec, next_up, pseudo_angle,
     pseudo_angle_nonzero, sub,
 };
 use crate::motion::Motion;
@@ -204,7 +204,8 @@ pub struct PairGeometry {
     h: crate::math::Mat3,
     r: crate::math::Mat3,
     k2: (f32, f32, f32, f32),
-    t_norm: f32,
+    /// `T' = Rᵀ T`, the compensated translation.
+    tp: [f32; 3],
     w: f32,
     g: [f32; 2],
     c2: [f32; 2],
@@ -335,24 +336,27 @@ impl PairGeometry {
         let tp = mat3_vec(&rt, motion.translation());
         // Camera::new guarantees fx, fy >= 1: the divisions are safe.
         let (ifx, ify) = (1.0 / cam1.fx(), 1.0 / cam1.fy());
-        let kinv = [
-            [ifx, 0.0, -cam1.cx() * ifx],
-            [0.0, ify, -cam1.cy() * ify],
-            [0.0, 0.0, 1.0],
+        let (kx, ky) = (-cam1.cx() * ifx, -cam1.cy() * ify);
+        // H = K₂ Rᵀ K₁⁻¹ with the zeros of the intrinsic matrices skipped
+        // (each sum keeps the dense product's order: the same value).
+        let m = rt.map(|[r0, r1, r2]| [r0 * ifx, r1 * ify, r0 * kx + r1 * ky + r2]);
+        let [[a0, a1, a2], [b0, b1, b2], m2] = m;
+        let [c0, c1, c2] = m2;
+        let (fx2, fy2, cx2, cy2) = (cam2.fx(), cam2.fy(), cam2.cx(), cam2.cy());
+        let h = [
+            [fx2 * a0 + cx2 * c0, fx2 * a1 + cx2 * c1, fx2 * a2 + cx2 * c2],
+            [fy2 * b0 + cy2 * c0, fy2 * b1 + cy2 * c1, fy2 * b2 + cy2 * c2],
+            m2,
         ];
-        let k2 = [
-            [cam2.fx(), 0.0, cam2.cx()],
-            [0.0, cam2.fy(), cam2.cy()],
-            [0.0, 0.0, 1.0],
-        ];
-        let h = mat3_mul(&k2, &mat3_mul(&rt, &kinv));
         let w = tp[2];
         let g = [cam2.fx() * tp[0], cam2.fy() * tp[1]];
         let c2 = [cam2.cx(), cam2.cy()];
-        let g_norm = crate::math::sqrt(dot(g, g));
         // Projective keys are well conditioned when the FOE is at least two
-        // image reaches away from the principal point (or at infinity).
-        let key = if w.abs() * cam2.reach() <= 0.5 * g_norm && g_norm > 0.0 {
+        // image reaches away from the principal point (or at infinity):
+        // `|w| reach ≤ |g| / 2`, squared.
+        let (wr, g2) = (w.abs() * cam2.reach(), dot(g, g));
+        let key = if 4.0 * (wr * wr) <= g2 && g2 > 0.0 {
+            let g_norm = crate::math::sqrt(g2);
             PencilKey::Projective {
                 c: c2,
                 g_hat: [g[0] / g_norm, g[1] / g_norm],
@@ -360,7 +364,7 @@ impl PairGeometry {
                 w,
             }
         } else {
-            // Here |w| * reach > 0.5 * g_norm >= 0, so w != 0.
+            // Here (|w| reach)² > |g|²/4 ≥ 0, so w != 0.
             PencilKey::Angular {
                 foe: [c2[0] + g[0] / w, c2[1] + g[1] / w],
                 sign_w: if w > 0.0 { 1.0 } else { -1.0 },
@@ -370,10 +374,7 @@ impl PairGeometry {
             h,
             r: motion.rotation_matrix(),
             k2: (cam2.fx(), cam2.fy(), cam2.cx(), cam2.cy()),
-            t_norm: {
-                let [tx, ty, tz] = tp;
-                crate::math::sqrt(tx * tx + ty * ty + tz * tz)
-            },
+            tp,
             w,
             g,
             c2,
@@ -393,7 +394,8 @@ impl PairGeometry {
 
     /// `|T|`, the length of the translation.
     pub(crate) fn translation_norm(&self) -> f32 {
-        self.t_norm
+        let [tx, ty, tz] = self.tp;
+        crate::math::sqrt(tx * tx + ty * ty + tz * tz)
     }
 
     /// Frame-2 intrinsics `(f_x, f_y, c_x, c_y)`.

@@ -753,7 +753,7 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
         };
         let b1 = b1.points();
         let (all_keyed, fast, o) = if prefix {
-            let o = fold_orientation(&geom, &key, b1);
+            let o = fold_orientation(&geom, &key, b1, b2);
             let (all_keyed, pmax) = match key {
                 PencilKey::Half { foe, side, min_t } => pass1::<N, true, false>(
                     &geom,
@@ -1026,14 +1026,29 @@ fn fold_suffix(keys: &[f32], slots: &mut [PointResult], pmax: f32, periodic: boo
 }
 
 /// The likely direction of the keys along a frame-1 boundary (+1 rising,
-/// −1 falling), from its two end points, for the fold test's order of
-/// work (any value gives the same results).
-fn fold_orientation(geom: &PairGeometry, key: &PencilKey, b1: &[Pixel]) -> f32 {
-    let raw = |p: Option<&Pixel>| {
-        p.and_then(|&p| geom.compensate_in_frame(p))
-            .map_or(f32::NAN, |c| key.vertex_key(c.pixel))
+/// −1 falling), for the fold test's order of work (any value gives the
+/// same results): that of its frame-2 counterpart `b2`, from its end
+/// vertices (the same boundary seen from nearly the same place), or of
+/// `b1`'s compensated end points when there is none.
+fn fold_orientation(
+    geom: &PairGeometry,
+    key: &PencilKey,
+    b1: &[Pixel],
+    b2: Option<&[Pixel]>,
+) -> f32 {
+    let mut d = match b2 {
+        Some(b2) => {
+            let raw = |p: Option<&Pixel>| p.map_or(f32::NAN, |p| key.vertex_key([p.u, p.v]));
+            raw(b2.last()) - raw(b2.first())
+        }
+        None => {
+            let raw = |p: Option<&Pixel>| {
+                p.and_then(|&p| geom.compensate_in_frame(p))
+                    .map_or(f32::NAN, |c| key.vertex_key(c.pixel))
+            };
+            raw(b1.last()) - raw(b1.first())
+        }
     };
-    let mut d = raw(b1.last()) - raw(b1.first());
     // Pseudo-angles: the shorter way round.
     if d > 2.0 {
         d -= 4.0;

@@ -121,7 +121,33 @@ pub fn demo(n: usize, max_points: usize) -> (Intrinsics, Vec<DriveFrame>) {
 /// spread evenly, sub-pixel, over each boundary's visible extent): the
 /// Fig. 6 set-up on a right curve of radius 15 (forward 0.4, 5° right).
 pub fn bench_pair(n: usize) -> (Intrinsics, Vec<DriveFrame>) {
-    let k = Intrinsics::default();
+    bench_pair_at(n, Intrinsics::default())
+}
+
+/// [`bench_pair`] seen by a camera with enough rows for one detector point
+/// per image row: the paper's camera (512 × 480, f = 800 px) scaled by the
+/// smallest power of two that gives the shorter boundary at least `n`
+/// rows (the same field of view, the same road and motion). At the
+/// paper's resolution the right boundary spans 152 rows, so `n` up to 128
+/// is the paper's camera, 256 the 1024 × 960 one, 512 the 2048 × 1920 one.
+pub fn bench_pair_one_per_row(n: usize) -> (Intrinsics, Vec<DriveFrame>) {
+    let mut scale = 1u16;
+    while 152 * usize::from(scale) < n {
+        scale *= 2;
+    }
+    let base = Intrinsics::default();
+    let s = f64::from(scale);
+    let k = Intrinsics {
+        f: base.f * s,
+        cx: (base.cx + 0.5) * s - 0.5,
+        cy: (base.cy + 0.5) * s - 0.5,
+        width: base.width * scale,
+        height: base.height * scale,
+    };
+    bench_pair_at(n, k)
+}
+
+fn bench_pair_at(n: usize, k: Intrinsics) -> (Intrinsics, Vec<DriveFrame>) {
     let road = Road {
         curvature_a: 1.0 / 15.0,
         curvature_b: 1.0 / 15.0,

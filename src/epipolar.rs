@@ -216,6 +216,9 @@ pub struct PairGeometry {
     /// [`EpipolarLine::tau_max`] (also `ray_max`) and `ray_min`: the same
     /// for every line of the pair.
     tau_range: (f32, f32),
+    /// For [`Self::half_key`]: the FOE, the keys' `min_t` and the distance
+    /// a boundary must keep from the FOE's row (none without a FOE).
+    half: Option<([f32; 2], f32, f32)>,
 }
 
 /// A frame-1 pixel after exact rotation compensation.
@@ -263,6 +266,22 @@ pub struct EpipolarLine {
 #[inline(always)]
 pub(crate) fn side_bit(sigma: f32) -> u32 {
     (sigma + 0.0).to_bits() >> 31
+}
+
+/// Whether two vertices with sides `s0`, `s1` ([`EpipolarLine::side`]) lie
+/// on opposite sides of the line: `side_bit(s0) != side_bit(s1)`, decided
+/// by the sign of `s0 s1` (one compare) except for an exact zero (a vertex
+/// on the line, or underflow) or NaN, which take the sign-bit rule.
+#[inline(always)]
+pub(crate) fn opposite_sides(s0: f32, s1: f32) -> bool {
+    let p = s0 * s1;
+    if p < 0.0 {
+        true
+    } else if p > 0.0 {
+        false
+    } else {
+        side_bit(s0) != side_bit(s1)
+    }
 }
 
 impl EpipolarLine {
@@ -344,8 +363,16 @@ impl PairGeometry {
         let [c0, c1, c2] = m2;
         let (fx2, fy2, cx2, cy2) = (cam2.fx(), cam2.fy(), cam2.cx(), cam2.cy());
         let h = [
-            [fx2 * a0 + cx2 * c0, fx2 * a1 + cx2 * c1, fx2 * a2 + cx2 * c2],
-            [fy2 * b0 + cy2 * c0, fy2 * b1 + cy2 * c1, fy2 * b2 + cy2 * c2],
+            [
+                fx2 * a0 + cx2 * c0,
+                fx2 * a1 + cx2 * c1,
+                fx2 * a2 + cx2 * c2,
+            ],
+            [
+                fy2 * b0 + cy2 * c0,
+                fy2 * b1 + cy2 * c1,
+                fy2 * b2 + cy2 * c2,
+            ],
             m2,
         ];
         let w = tp[2];
@@ -380,6 +407,16 @@ impl PairGeometry {
             c2,
             key,
             stretch_bound: stretch_bound(&h, cam1),
+            half: (w != 0.0)
+                .then(|| [c2[0] + g[0] / w, c2[1] + g[1] / w])
+                .filter(|f| f[0].is_finite() && f[1].is_finite())
+                .map(|foe| {
+                    // Coordinates beyond 1 000 px scale the rounding (see
+                    // HALF_MIN_DV).
+                    let scale = fmax(foe[0].abs(), foe[1].abs()) + fmax(c2[0].abs(), c2[1].abs());
+                    let min_t = HALF_MIN_DV * fmax(1.0, scale * 1.0e-3);
+                    (foe, min_t, fmax(HALF_MARGIN, 4.0 * min_t))
+                }),
             tau_range: (
                 if w < 0.0 { -1.0 / w } else { f32::INFINITY },
                 if w > 0.0 { -1.0 / w } else { f32::NEG_INFINITY },
@@ -431,25 +468,17 @@ impl PairGeometry {
     /// bound all of it), when it lies wholly above or below the FOE's row
     /// with some margin; `None` otherwise (no FOE, or too close to it).
     pub fn half_key(&self, v_first: f32, v_last: f32) -> Option<PencilKey> {
-        let foe = self.focus_of_expansion()?;
+        let (foe, min_t, need) = self.half?;
         let (lo, hi) = (fmin(v_first, v_last), fmax(v_first, v_last));
-        // Coordinates beyond 1 000 px scale the rounding (see HALF_MIN_DV).
-        let scale = fmax(foe.u.abs(), foe.v.abs()) + fmax(self.c2[0].abs(), self.c2[1].abs());
-        let min_t = HALF_MIN_DV * fmax(1.0, scale * 1.0e-3);
-        let need = fmax(HALF_MARGIN, 4.0 * min_t);
-        let side = if lo - foe.v >= need {
+        let side = if lo - foe[1] >= need {
             1.0
-        } else if foe.v - hi >= need {
+        } else if foe[1] - hi >= need {
             -1.0
         } else {
             // Too close to the FOE's row, or NaN.
             return None;
         };
-        Some(PencilKey::Half {
-            foe: [foe.u, foe.v],
-            side,
-            min_t,
-        })
+        Some(PencilKey::Half { foe, side, min_t })
     }
 
     /// Exact rotation compensation of a frame-1 pixel; `None` when the ray
@@ -892,7 +921,7 @@ impl<'a, const N: usize> SingleRun<'a, N> {
                 break;
             };
             let s1 = line.side(v1);
-            if side_bit(s0) != side_bit(s1) {
+            if opposite_sides(s0, s1) {
                 // On the ray: ray_min < τ < ray_max; in the search range
                 // also τ > 0 (and τ < tau_max = ray_max).
                 let tau = line.tau_between(v0, v1, s0, s1);
@@ -1113,6 +1142,45 @@ impl<const N: usize> IndexedSearch<N> {
                 self.set_range(mn, mx);
             }
         }
+    }
+
+    /// [`Self::index_keys`] for the crossing search over `n ≥ 2` half-plane
+    /// keys, all usable, whose prefix maximum (oriented by `o`, which is
+    /// what `index_keys` finds from the end keys) is already in `hi`: the
+    /// same index, without the general case's branches.
+    fn finish_half(&mut self, key: &PencilKey, n: usize, o: f32) {
+        self.prefix_orient = 0.0;
+        self.key = *key;
+        self.unkeyed.clear();
+        self.scan = false;
+        self.fold_fast = false;
+        self.hint = 0;
+        self.period = 0.0;
+        let n = n.min(N);
+        let s = n - 1;
+        self.segments = s;
+        self.all_keyed = true;
+        self.orient = o;
+        let (Some(keys), Some(lo), Some(&top)) =
+            (self.keys.get(..n), self.lo.get_mut(..s), self.hi.get(s - 1))
+        else {
+            self.scan = true;
+            self.single = false;
+            return;
+        };
+        let mut run = keys.last().map_or(f32::INFINITY, |&k| o * k);
+        for (&k, l) in keys.iter().zip(lo.iter_mut()).rev() {
+            run = fmin(run, o * k);
+            *l = run;
+        }
+        let bottom = lo.first().copied().unwrap_or(run);
+        if o > 0.0 {
+            self.set_range(bottom, top);
+        } else {
+            self.set_range(-top, -bottom);
+        }
+        // Half-plane keys are not periodic: one run always.
+        self.single = true;
     }
 
     /// The range of the unwrapped keys and the key margin that follows.
@@ -1550,8 +1618,12 @@ impl<const N: usize> CrossingSearch for IndexedSearch<N> {
                     *h = run;
                     n += 1;
                 }
-                self.prefix_orient = o;
-                self.index_keys(key, true, n, sum.is_finite());
+                if sum.is_finite() && n >= 2 {
+                    self.finish_half(key, n, o);
+                } else {
+                    self.prefix_orient = o;
+                    self.index_keys(key, true, n, sum.is_finite());
+                }
             }
             _ => self.build(key, true, boundary.iter().map(|p| key.vertex(p.arr()))),
         }
@@ -1775,6 +1847,37 @@ mod tests {
         assert_eq!(line.crossing(1, on, pos), None);
         assert_eq!(line.crossing(2, pos, on), None);
         assert!(line.crossing(3, on, neg).is_some());
+    }
+
+    /// The one-compare side test gives the sign-bit rule's answer for
+    /// every pair of special and ordinary values.
+    #[test]
+    fn opposite_sides_is_the_sign_bit_rule() {
+        let values = [
+            0.0f32,
+            -0.0,
+            f32::from_bits(1),
+            -f32::from_bits(1),
+            1.0e-30,
+            -1.0e-30,
+            1.0e-20,
+            -1.0e-20,
+            0.5,
+            -0.5,
+            3.0e20,
+            -3.0e20,
+            f32::MAX,
+            -f32::MAX,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            -f32::NAN,
+        ];
+        for &a in &values {
+            for &b in &values {
+                assert_eq!(opposite_sides(a, b), side_bit(a) != side_bit(b), "{a} {b}");
+            }
+        }
     }
 
     /// The index finds exactly the crossings a scan of every segment finds,

@@ -1013,6 +1013,9 @@ fn fold_suffix(keys: &[f32], slots: &mut [PointResult], pmax: f32, periodic: boo
             }
         }
     }
+    if !periodic {
+        return true;
+    }
     // The span of all keys: `pmax` covers points `0 ..= n − 5`, `smin`
     // points `4 ..`.
     smax = fmax(smax, pmax);
@@ -1022,7 +1025,7 @@ fn fold_suffix(keys: &[f32], slots: &mut [PointResult], pmax: f32, periodic: boo
     for &w in keys.iter().take(4.min(n)) {
         smin = fmin(smin, w);
     }
-    !periodic || smax - smin < 4.0 - 0.1
+    smax - smin < 4.0 - 0.1
 }
 
 /// The likely direction of the keys along a frame-1 boundary (+1 rising,

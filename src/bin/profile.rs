@@ -22,12 +22,12 @@ fn marker(tag: u32) -> u32 {
 
 #[entry]
 fn main() -> ! {
-    let mut processor = Processor::<256, 2>::new(Config::default());
+    let mut processor = Processor::<512, 2>::new(Config::default());
     let Ok(mut d) = fw::Drive::new(DATA) else {
         fw::exit(false)
     };
-    let mut f1 = Frame::<256, 2>::new(d.camera);
-    let mut f2 = Frame::<256, 2>::new(d.camera);
+    let mut f1 = Frame::<512, 2>::new(d.camera);
+    let mut f2 = Frame::<512, 2>::new(d.camera);
     let (Ok(_), Ok(Some(m))) = (d.next_frame(&mut f1), d.next_frame(&mut f2)) else {
         fw::exit(false)
     };

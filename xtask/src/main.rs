@@ -420,6 +420,24 @@ fn bench(b: &Budget) -> Result<(), String> {
             ));
         }
     }
+    let stress = records(&log, "stress n=");
+    if !stress.is_empty() {
+        println!(
+            "\nstress pairs (not budgeted): the paper's 512 x 480 camera sampled at up to 3.4 points per image row"
+        );
+        println!("| N per boundary | points | instructions per frame | per point | ok |");
+        println!("|---:|---:|---:|---:|---:|");
+        for r in &stress {
+            println!(
+                "| {} | {} | {} | {} | {} |",
+                num(r, "n"),
+                num(r, "points"),
+                num(r, "instr"),
+                num(r, "per_point"),
+                num(r, "ok")
+            );
+        }
+    }
     let deadline = (b.frame_ms * 1e-3 * b.cpu_mhz * 1e6 * b.share_percent / 100.0) as u64;
     let mut hard = Vec::new();
     match (per.get(&64), per.get(&512)) {

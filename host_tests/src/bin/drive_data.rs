@@ -1,6 +1,9 @@
 //! Write the firmware's embedded frame data: `drive_data OUT_DIR`
 //! (default `../src/bin/data`): `drive.bin` (the demo drive, 24 frames, up
-//! to 256 points per boundary) and `bench_N.bin` for N = 32 … 512.
+//! to 256 points per boundary), `bench_N.bin` for N = 32 … 512 (one
+//! detector point per image row: [`drive::bench_pair_one_per_row`]) and
+//! `stress_N.bin` for N = 256, 512 (the paper's 512 × 480 camera sampled at
+//! up to 3.4 points per row: [`drive::bench_pair`]).
 
 use host_tests::drive;
 
@@ -17,17 +20,31 @@ fn main() -> std::io::Result<()> {
         println!("drive frame {i}: points {n:?}");
     }
     std::fs::write(dir.join("drive.bin"), drive::encode(&k, &frames))?;
-    for n in [32, 64, 128, 256, 512] {
-        let (k, frames) = drive::bench_pair(n);
-        let counts: Vec<Vec<usize>> = frames
-            .iter()
-            .map(|f| f.boundaries.iter().map(Vec::len).collect())
-            .collect();
-        println!("bench {n}: points {counts:?}");
-        std::fs::write(
-            dir.join(format!("bench_{n}.bin")),
-            drive::encode(&k, &frames),
-        )?;
+    type Make = fn(usize) -> (host_tests::synth::Intrinsics, Vec<drive::DriveFrame>);
+    let sets: [(&str, Make, &[usize]); 2] = [
+        (
+            "bench",
+            drive::bench_pair_one_per_row,
+            &[32, 64, 128, 256, 512],
+        ),
+        ("stress", drive::bench_pair, &[256, 512]),
+    ];
+    for (name, make, sizes) in sets {
+        for &n in sizes {
+            let (k, frames) = make(n);
+            let counts: Vec<Vec<usize>> = frames
+                .iter()
+                .map(|f| f.boundaries.iter().map(Vec::len).collect())
+                .collect();
+            println!(
+                "{name} {n}: {}x{} camera, points {counts:?}",
+                k.width, k.height
+            );
+            std::fs::write(
+                dir.join(format!("{name}_{n}.bin")),
+                drive::encode(&k, &frames),
+            )?;
+        }
     }
     Ok(())
 }

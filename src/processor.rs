@@ -752,9 +752,9 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
             PencilKey::Projective { .. } => (false, false),
         };
         let b1 = b1.points();
-        let (all_keyed, fast, o) = if prefix {
+        let (o, pass) = if prefix {
             let o = fold_orientation(&geom, &key, b1, b2);
-            let (all_keyed, pmax) = match key {
+            let pass = match key {
                 PencilKey::Half { foe, side, min_t } => pass1::<N, true, false>(
                     &geom,
                     &key,
@@ -762,7 +762,7 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
                     b1,
                     bs.points.as_mut_slice(),
                     index.keys_mut(),
-                    o,
+                    (o, periodic),
                 ),
                 _ => pass1::<N, true, true>(
                     &geom,
@@ -771,24 +771,23 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
                     b1,
                     bs.points.as_mut_slice(),
                     index.keys_mut(),
-                    o,
+                    (o, periodic),
                 ),
             };
-            let keys = index.keys_mut().get(..n).unwrap_or(&[]);
-            let fast = all_keyed && fold_suffix(keys, bs.points.as_mut_slice(), pmax, periodic);
-            (all_keyed, fast, o)
+            (o, pass)
         } else {
-            let (all_keyed, _) = pass1::<N, false, false>(
+            let pass = pass1::<N, false, false>(
                 &geom,
                 &key,
                 move |v| key.vertex_key(v),
                 b1,
                 bs.points.as_mut_slice(),
                 index.keys_mut(),
-                1.0,
+                (1.0, false),
             );
-            (all_keyed, false, 1.0)
+            (1.0, pass)
         };
+        let (all_keyed, fast) = pass;
         if !fast {
             if prefix {
                 // Undo pass 1's tentative flags.
@@ -863,8 +862,13 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
 /// the keys of points `0 ..= i − 4`, the path of segments `0 ..= i − 5`
 /// (see [`IndexedSearch::fold_each`]); these marks hold only if the
 /// keys turn out all usable and span less than a turn (the caller checks).
+/// With `PREFIX` it then does the second half ([`fold_suffix`]).
+///
 /// Returns whether every key is usable ([`crate::epipolar::Unwrap`]), and
-/// the largest oriented key `o k` of points `0 ..= n − 5` (with `PREFIX`).
+/// whether the fold test was done here (`PREFIX`, all keys usable, and
+/// for whole-turn keys a span under a turn); `(o, periodic)` are the keys'
+/// orientation ([`fold_orientation`]) and whether they are whole-turn
+/// pseudo-angles.
 #[inline(never)]
 fn pass1<const N: usize, const PREFIX: bool, const WRAPS: bool>(
     geom: &PairGeometry,
@@ -873,8 +877,8 @@ fn pass1<const N: usize, const PREFIX: bool, const WRAPS: bool>(
     b1: &[Pixel],
     slots: &mut [PointResult],
     keys: &mut [f32; N],
-    o: f32,
-) -> (bool, f32) {
+    (o, periodic): (f32, bool),
+) -> (bool, bool) {
     let mut unwrap = Unwrap::new(key);
     // Without wrapping (`!WRAPS`: keys that are not periodic) the keys are
     // used as they come; they are all usable iff their sum is finite.
@@ -925,7 +929,11 @@ fn pass1<const N: usize, const PREFIX: bool, const WRAPS: bool>(
     } else {
         sum.is_finite()
     };
-    (all_keyed, prefix.pmax)
+    let n = slots.len().min(b1.len());
+    let fast = PREFIX
+        && all_keyed
+        && fold_suffix(keys.get(..n).unwrap_or(&[]), slots, prefix.pmax, periodic);
+    (all_keyed, fast)
 }
 
 /// The prefix half of the fold test, one point at a time along the
@@ -981,7 +989,7 @@ impl PrefixFold {
 /// span less than a turn (less 0.1), the condition under which these
 /// tests, and pass 1's, equal the general query
 /// ([`IndexedSearch::meets_outside`]); otherwise the caller discards them.
-#[inline(never)]
+#[inline(always)]
 fn fold_suffix(keys: &[f32], slots: &mut [PointResult], pmax: f32, periodic: bool) -> bool {
     let eps = ANGULAR_EPS;
     let n = keys.len().min(slots.len());

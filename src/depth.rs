@@ -196,7 +196,12 @@ pub(crate) fn stick_exact(
     }
     let wr = w.abs() * r1;
     let s_far = w + (a_len + wr) / (d - eps);
-    let s_near = w + fmax(a_len - wr, 0.0) / (d + eps + h1 * h1 / (2.0 * (d - eps)));
+    // `|a| > |W'| r₁` here: the processor flags a point whose disc holds the
+    // FOE (`|a|² ≤ (|W'| max(r₁, 10⁻³))²`, `AtFoe`) before this. Within an
+    // ulp of that guard `|a| − |W'| r₁` may round below zero; that only
+    // lowers `s_near`, a longer stick, still a bound. (`stick` keeps the
+    // clamp: its spreads can exceed the guard's margin.)
+    let s_near = w + (a_len - wr) / (d + eps + h1 * h1 / (2.0 * (d - eps)));
     interval(s_near, s_far, depth_scale)
 }
 

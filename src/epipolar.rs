@@ -382,6 +382,8 @@ impl PairGeometry {
         // image reaches away from the principal point (or at infinity):
         // `|w| reach ≤ |g| / 2`, squared.
         let (wr, g2) = (w.abs() * cam2.reach(), dot(g, g));
+        // Eq. A.1 (infinite or NaN when W' = 0).
+        let foe = [c2[0] + g[0] / w, c2[1] + g[1] / w];
         let key = if 4.0 * (wr * wr) <= g2 && g2 > 0.0 {
             let g_norm = crate::math::sqrt(g2);
             PencilKey::Projective {
@@ -393,7 +395,7 @@ impl PairGeometry {
         } else {
             // Here (|w| reach)² > |g|²/4 ≥ 0, so w != 0.
             PencilKey::Angular {
-                foe: [c2[0] + g[0] / w, c2[1] + g[1] / w],
+                foe,
                 sign_w: if w > 0.0 { 1.0 } else { -1.0 },
             }
         };
@@ -407,16 +409,13 @@ impl PairGeometry {
             c2,
             key,
             stretch_bound: stretch_bound(&h, cam1),
-            half: (w != 0.0)
-                .then(|| [c2[0] + g[0] / w, c2[1] + g[1] / w])
-                .filter(|f| f[0].is_finite() && f[1].is_finite())
-                .map(|foe| {
-                    // Coordinates beyond 1 000 px scale the rounding (see
-                    // HALF_MIN_DV).
-                    let scale = fmax(foe[0].abs(), foe[1].abs()) + fmax(c2[0].abs(), c2[1].abs());
-                    let min_t = HALF_MIN_DV * fmax(1.0, scale * 1.0e-3);
-                    (foe, min_t, fmax(HALF_MARGIN, 4.0 * min_t))
-                }),
+            half: (w != 0.0 && foe[0].is_finite() && foe[1].is_finite()).then(|| {
+                // Coordinates beyond 1 000 px scale the rounding (see
+                // HALF_MIN_DV).
+                let scale = fmax(foe[0].abs(), foe[1].abs()) + fmax(c2[0].abs(), c2[1].abs());
+                let min_t = HALF_MIN_DV * fmax(1.0, scale * 1.0e-3);
+                (foe, min_t, fmax(HALF_MARGIN, 4.0 * min_t))
+            }),
             tau_range: (
                 if w < 0.0 { -1.0 / w } else { f32::INFINITY },
                 if w > 0.0 { -1.0 / w } else { f32::NEG_INFINITY },
@@ -581,26 +580,27 @@ fn stretch_bound(h: &crate::math::Mat3, cam: &Camera) -> f32 {
         f32::from(cam.width()) - 1.0 + m,
         f32::from(cam.height()) - 1.0 + m,
     );
-    let [[h00, h01, _], [h10, h11, _], [h20, h21, _]] = *h;
-    let (mut zmin, mut xmin, mut xmax, mut ymin, mut ymax) = (
-        f32::INFINITY,
-        f32::INFINITY,
-        f32::NEG_INFINITY,
-        f32::INFINITY,
-        f32::NEG_INFINITY,
-    );
-    for (u, v) in [(-m, -m), (u1, -m), (-m, v1), (u1, v1)] {
-        let [x, y, z] = mat3_vec(h, [u, v, 1.0]);
-        if z.is_nan() || z <= 1.0e-3 {
-            return f32::INFINITY;
-        }
-        let (px, py) = (x / z, y / z);
-        zmin = fmin(zmin, z);
-        xmin = fmin(xmin, px);
-        xmax = fmax(xmax, px);
-        ymin = fmin(ymin, py);
-        ymax = fmax(ymax, py);
+    let [[h00, h01, h02], [h10, h11, h12], [h20, h21, h22]] = *h;
+    // A row of H at the corners: (h_0 u + h_1 v) + h_2, as `mat3_vec` sums.
+    let row = |a: f32, b: f32, c: f32| {
+        let (au0, au1, bv0, bv1) = (a * -m, a * u1, b * -m, b * v1);
+        [au0 + bv0 + c, au1 + bv0 + c, au0 + bv1 + c, au1 + bv1 + c]
+    };
+    let (xs, ys, zs) = (row(h00, h01, h02), row(h10, h11, h12), row(h20, h21, h22));
+    let [z0, z1, z2, z3] = zs;
+    let zmin = fmin(fmin(z0, z1), fmin(z2, z3));
+    // (A NaN corner gives a NaN bound below, which is refused too.)
+    if zmin.is_nan() || zmin <= 1.0e-3 {
+        return f32::INFINITY;
     }
+    let extremes = |ps: [f32; 4]| {
+        let [p0, p1, p2, p3] = ps;
+        let (lo01, hi01) = if p0 < p1 { (p0, p1) } else { (p1, p0) };
+        let (lo23, hi23) = if p2 < p3 { (p2, p3) } else { (p3, p2) };
+        (fmin(lo01, lo23), fmax(hi01, hi23))
+    };
+    let (xmin, xmax) = extremes([xs[0] / z0, xs[1] / z1, xs[2] / z2, xs[3] / z3]);
+    let (ymin, ymax) = extremes([ys[0] / z0, ys[1] / z1, ys[2] / z2, ys[3] / z3]);
     let bound =
         |c: f32, p0: f32, p1: f32, k: f32| fmax((c - p0 * k).abs(), (c - p1 * k).abs()) / zmin;
     let j00 = bound(h00, xmin, xmax, h20);
@@ -1587,21 +1587,23 @@ impl<const N: usize> IndexedSearch<N> {
     }
 }
 
-impl<const N: usize> CrossingSearch for IndexedSearch<N> {
-    fn prepare(&mut self, boundary: &[Pixel], key: &PencilKey) {
+impl<const N: usize> IndexedSearch<N> {
+    /// [`CrossingSearch::prepare`] given the keys of the boundary's first
+    /// and last vertices (`key.vertex_key` of each), which the caller may
+    /// already have.
+    pub(crate) fn prepare_with_ends(
+        &mut self,
+        boundary: &[Pixel],
+        key: &PencilKey,
+        (k_first, k_last): (f32, f32),
+    ) {
         match *key {
             // Half-plane keys never wrap: no unwrapping.
             PencilKey::Half { foe, side, min_t } => {
-                let key_of =
-                    |p: Option<&Pixel>| p.map_or(NO_KEY, |p| half_key(foe, side, min_t, p.arr()));
                 // The orientation `index_keys` will find (from the first and
                 // the last key, when all are usable), known in advance: the
                 // prefix maximum `hi` is made with the keys.
-                let o = if key_of(boundary.last()) >= key_of(boundary.first()) {
-                    1.0
-                } else {
-                    -1.0
-                };
+                let o = if k_last >= k_first { 1.0 } else { -1.0 };
                 let (Some(k0), Some(first)) = (self.keys.first_mut(), boundary.first()) else {
                     self.index_keys(key, true, 0, true);
                     return;
@@ -1627,6 +1629,14 @@ impl<const N: usize> CrossingSearch for IndexedSearch<N> {
             }
             _ => self.build(key, true, boundary.iter().map(|p| key.vertex(p.arr()))),
         }
+    }
+}
+
+impl<const N: usize> CrossingSearch for IndexedSearch<N> {
+    fn prepare(&mut self, boundary: &[Pixel], key: &PencilKey) {
+        let key_of = |p: Option<&Pixel>| p.map_or(NO_KEY, |p| key.vertex(p.arr()));
+        let ends = (key_of(boundary.first()), key_of(boundary.last()));
+        self.prepare_with_ends(boundary, key, ends);
     }
 
     /// The sweep of [`IndexedSearch`] written out for the crossing search:

@@ -732,6 +732,12 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
                 _ => None,
             })
             .unwrap_or(*geom.key());
+        // The keys of the frame-2 boundary's end vertices: the orientation
+        // of its keys, and a guess for frame 1's (the fold test).
+        let ends = b2.and_then(|b| match (b.first(), b.last()) {
+            (Some(f), Some(l)) => Some((key.vertex_key(f.arr()), key.vertex_key(l.arr()))),
+            _ => None,
+        });
         let n = b1.points().len();
         bs.points.set_len(n);
         // Pass 1: compensate every frame-1 point once. The output entry
@@ -753,7 +759,7 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
         };
         let b1 = b1.points();
         let (o, pass) = if prefix {
-            let o = fold_orientation(&geom, &key, b1, b2);
+            let o = fold_orientation(&geom, &key, b1, ends);
             let pass = match key {
                 PencilKey::Half { foe, side, min_t } => pass1::<N, true, false>(
                     &geom,
@@ -822,7 +828,10 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
         }
         // Pass 2: intersect, triangulate, bound.
         if let Some(b2) = b2 {
-            searches.crossing().prepare(b2, &key);
+            match (searches.lean(), ends) {
+                (Some(index), Some(ends)) => index.prepare_with_ends(b2, &key, ends),
+                _ => searches.crossing().prepare(b2, &key),
+            }
         }
         let lean = match (searches.lean(), b2, errors.frame_disc) {
             (Some(index), Some(b2), Some(disc)) if errors.translation <= 0.0 => {
@@ -1038,20 +1047,17 @@ fn fold_suffix(keys: &[f32], slots: &mut [PointResult], pmax: f32, periodic: boo
 
 /// The likely direction of the keys along a frame-1 boundary (+1 rising,
 /// −1 falling), for the fold test's order of work (any value gives the
-/// same results): that of its frame-2 counterpart `b2`, from its end
-/// vertices (the same boundary seen from nearly the same place), or of
-/// `b1`'s compensated end points when there is none.
+/// same results): that of its frame-2 counterpart, from the keys of its
+/// end vertices `b2_ends` (the same boundary seen from nearly the same
+/// place), or of `b1`'s compensated end points when there is none.
 fn fold_orientation(
     geom: &PairGeometry,
     key: &PencilKey,
     b1: &[Pixel],
-    b2: Option<&[Pixel]>,
+    b2_ends: Option<(f32, f32)>,
 ) -> f32 {
-    let mut d = match b2 {
-        Some(b2) => {
-            let raw = |p: Option<&Pixel>| p.map_or(f32::NAN, |p| key.vertex_key([p.u, p.v]));
-            raw(b2.last()) - raw(b2.first())
-        }
+    let mut d = match b2_ends {
+        Some((first, last)) => last - first,
         None => {
             let raw = |p: Option<&Pixel>| {
                 p.and_then(|&p| geom.compensate_in_frame(p))

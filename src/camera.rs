@@ -194,12 +194,12 @@ impl Camera {
             && (-m..=f32::from(self.height) - 1.0 + m).contains(&p.v)
     }
 
-    /// Largest distance, pixels, from the principal point to any point the
-    /// image (with its margin) can hold.
-    pub(crate) fn reach(&self) -> f32 {
+    /// The square of the largest distance, pixels, from the principal
+    /// point to any point the image (with its margin) can hold.
+    pub(crate) fn reach2(&self) -> f32 {
         let m = IMAGE_MARGIN_PX;
         let dx = crate::math::fmax(self.cx + m, f32::from(self.width) - 1.0 + m - self.cx);
         let dy = crate::math::fmax(self.cy + m, f32::from(self.height) - 1.0 + m - self.cy);
-        crate::math::sqrt(dx * dx + dy * dy)
+        dx * dx + dy * dy
     }
 }

@@ -381,10 +381,10 @@ impl PairGeometry {
         // Projective keys are well conditioned when the FOE is at least two
         // image reaches away from the principal point (or at infinity):
         // `|w| reach ≤ |g| / 2`, squared.
-        let (wr, g2) = (w.abs() * cam2.reach(), dot(g, g));
+        let (wr2, g2) = ((w * w) * cam2.reach2(), dot(g, g));
         // Eq. A.1 (infinite or NaN when W' = 0).
         let foe = [c2[0] + g[0] / w, c2[1] + g[1] / w];
-        let key = if 4.0 * (wr * wr) <= g2 && g2 > 0.0 {
+        let key = if 4.0 * wr2 <= g2 && g2 > 0.0 {
             let g_norm = crate::math::sqrt(g2);
             PencilKey::Projective {
                 c: c2,
@@ -393,7 +393,7 @@ impl PairGeometry {
                 w,
             }
         } else {
-            // Here (|w| reach)² > |g|²/4 ≥ 0, so w != 0.
+            // Here (w reach)² > |g|²/4 ≥ 0, so w != 0.
             PencilKey::Angular {
                 foe,
                 sign_w: if w > 0.0 { 1.0 } else { -1.0 },

@@ -1132,8 +1132,14 @@ impl MotionErrors {
     fn new(config: &Config, geom: &PairGeometry) -> Self {
         let [ex, ey, ez] = config.rotation_error;
         let rotation = ex + ey + ez > 0.0;
+        // |T| only when a rotation error turns it (else the term is 0).
+        let turn = if rotation {
+            1.05 * geom.translation_norm() * (ex + ey + ez)
+        } else {
+            0.0
+        };
         Self {
-            translation: config.translation_error + 1.05 * geom.translation_norm() * (ex + ey + ez),
+            translation: config.translation_error + turn,
             rotation,
             frame_disc: match geom.frame_stretch() {
                 Some(stretch) if !rotation => {

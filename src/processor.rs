@@ -1427,8 +1427,11 @@ fn triangulate(
         r.status = Status::Grazing;
         return r;
     }
-    // Eq. 2.3 along the disparity: s = W' + 1/τ (τ > 0 by construction).
-    let s = w + 1.0 / best_tau;
+    // Eq. 2.3 along the disparity: s = W' + |a|/d with the disparity
+    // d = τ|a| (τ > 0 by construction), written as the stick writes its
+    // ends (see below).
+    let d = best_tau * a_len;
+    let s = w + a_len / d;
     let z = s / c.depth_scale;
     if z.is_nan() || z <= 0.0 {
         r.status = Status::NonPositiveDepth;
@@ -1438,6 +1441,13 @@ fn triangulate(
         r.status = Status::BeyondMaxDepth;
         return r;
     }
+    // The stick holds `z`. For `stick_exact` that needs no clamp: its ends
+    // are `(W' + (|a| ± |W'|r₁)/(d ∓ ε…))/q_z` with `ε > 0`, `d − ε > 0`,
+    // `q_z > 0` (pass 1 flags the rest), and correctly rounded `+ − × ÷`
+    // are monotone in each argument, so the rounded far end is at least
+    // the rounded `z` and the near end at most (test
+    // `every_depth_lies_in_its_stick`). `stick`'s spreads move its ends by
+    // other expressions, so there the stick is widened to `z` if need be.
     let interval = if errors.translation > 0.0 {
         let (spread_a, spread_w) = crate::motion_error::spread(
             geom.rotation(),
@@ -1457,6 +1467,10 @@ fn triangulate(
             spread_a,
             spread_w,
         )
+        .map(|i| DepthInterval {
+            z_near: crate::math::fmin(i.z_near, z),
+            z_far: crate::math::fmax(i.z_far, z),
+        })
     } else {
         stick_exact(
             w,
@@ -1474,8 +1488,8 @@ fn triangulate(
         // only matters where a depth would otherwise be given).
         Some(i) => {
             r.z = z;
-            r.z_near = crate::math::fmin(i.z_near, z);
-            r.z_far = crate::math::fmax(i.z_far, z);
+            r.z_near = i.z_near;
+            r.z_far = i.z_far;
         }
         None => r.status = Status::Unbounded,
     }

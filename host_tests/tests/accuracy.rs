@@ -122,6 +122,50 @@ fn quantised_random_scenarios_truth_inside_every_stick() {
     assert!(ok >= 100_000);
 }
 
+/// Every depth lies in its own stick, `z_near ≤ z ≤ z_far`, as computed in
+/// `f32`: without translation error by the monotonicity of rounding (the
+/// processor does not clamp), with it by the processor's widening. Also
+/// with zero localisation error, where the exact stick collapses onto `z`.
+#[test]
+fn every_depth_lies_in_its_stick() {
+    let configs = [
+        Config::default(),
+        Config::new(0.0, 0.0, 10.0, 200.0).expect("valid"),
+        Config::new(0.3, 0.0, 5.0, 500.0).expect("valid"),
+        Config::default()
+            .with_translation_error(0.01)
+            .expect("valid"),
+    ];
+    let mut checked = 0usize;
+    for (ci, config) in configs.iter().enumerate() {
+        for seed in 0..150 {
+            let s = scenarios::random(seed);
+            let r = s.render();
+            for quantised in [false, true] {
+                let p = reconstruct(&r, &s.intrinsics, quantised, *config);
+                for p in point_stats(&r, &s.intrinsics, &p)
+                    .iter()
+                    .filter(|p| p.status.has_depth())
+                {
+                    assert!(
+                        p.z_near <= p.z && p.z <= p.z_far,
+                        "config {ci}, {} b{} i{}: z {} outside [{}, {}]",
+                        s.name,
+                        p.boundary,
+                        p.index,
+                        p.z,
+                        p.z_near,
+                        p.z_far
+                    );
+                    checked += 1;
+                }
+            }
+        }
+    }
+    println!("{checked} depths inside their sticks");
+    assert!(checked >= 50_000, "{checked}");
+}
+
 /// Sticks are not vacuous: where the epipolar line crosses the boundary at
 /// more than 60°, the median relative half-length is within 2× of `e/d`.
 #[test]

@@ -493,7 +493,7 @@ impl fmt::Display for ProcessError {
 ///
 /// Size (bytes, 32-bit target): about `8·B·N` (previous frame) + `12·N`
 /// (search index) + `32·B·N` (output) + ~100; for `N = 256, B = 2` about
-/// 23.2 KiB (23 736 B on the Cortex-M4F), checked by a test.
+/// 23.2 KiB (23 740 B on the Cortex-M4F), checked by a test.
 ///
 /// ```
 /// use roadstereo::{Camera, Config, Frame, Motion, Pixel, Processor, Step};

@@ -35,6 +35,11 @@ fn main() -> ! {
     marker(1);
     let ok = processor.process(black_box(&f2), Some(&m)).is_ok();
     marker(2);
-    defmt::info!("profile digest={=u32:08x}", processor.structure().digest());
+    let points: usize = f2.boundaries().iter().map(|b| b.points().len()).sum();
+    defmt::info!(
+        "profile points={=usize} digest={=u32:08x}",
+        points,
+        processor.structure().digest()
+    );
     fw::exit(ok)
 }

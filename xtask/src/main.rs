@@ -708,14 +708,14 @@ fn profile() -> Result<(), String> {
         *by_line.entry((l, f)).or_default() += c;
     }
     let mut funcs: Vec<_> = by_func.into_iter().collect();
-    funcs.sort_by(|a, b| b.1.cmp(&a.1));
+    funcs.sort_by_key(|f| std::cmp::Reverse(f.1));
     println!("\n| function (not inlined) | instructions | per point |");
     println!("|---|---:|---:|");
     for (f, c) in &funcs {
         println!("| `{f}` | {c} | {:.1} |", per(*c));
     }
     let mut lines: Vec<_> = by_line.into_iter().collect();
-    lines.sort_by(|a, b| b.1.cmp(&a.1));
+    lines.sort_by_key(|l| std::cmp::Reverse(l.1));
     println!("\n| source line (innermost, inlined code included) | in function | per point |");
     println!("|---|---|---:|");
     for ((l, f), c) in lines.iter().take(30) {

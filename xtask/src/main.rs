@@ -695,7 +695,7 @@ fn profile() -> Result<(), String> {
     let total: u64 = counts.values().sum();
     let per = |c: u64| c as f64 / points as f64;
     println!(
-        "\none per-frame call (N = 256, {points} points): {total} instructions, {:.1} per point",
+        "\none per-frame call ({points} points): {total} instructions, {:.1} per point",
         per(total)
     );
     let mut by_func = std::collections::BTreeMap::<&str, u64>::new();

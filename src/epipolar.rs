@@ -1759,17 +1759,7 @@ impl<const N: usize> IndexedSearch<N> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A small deterministic generator (xorshift), values in `[0, 1)`.
-    struct Rng(u32);
-    impl Rng {
-        fn next(&mut self) -> f32 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 17;
-            self.0 ^= self.0 << 5;
-            (self.0 >> 8) as f32 / (1u32 << 24) as f32
-        }
-    }
+    use crate::test_rng::Rng;
 
     /// The `O(1)` fold test answers exactly as the general index query, on
     /// key sequences that jitter (steps around the key margin), fold back,

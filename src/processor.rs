@@ -1079,6 +1079,18 @@ fn fold_orientation(
     }
 }
 
+/// The compensated point pass 1 left in an output entry (see [`run`]):
+/// `p₁'` in `pixel2`, `q_z` in `z`, the stretch in `z_near`; `None` for a
+/// point behind the camera.
+#[inline(always)]
+fn stashed(r: &PointResult) -> Option<Compensated> {
+    (r.status != Status::BehindCamera).then_some(Compensated {
+        pixel: [r.pixel2.u, r.pixel2.v],
+        depth_scale: r.z,
+        stretch: r.z_near,
+    })
+}
+
 /// Pass 2 over one boundary: intersect, triangulate, bound.
 #[inline(never)]
 fn pass2<S: CrossingSearch>(
@@ -1090,13 +1102,8 @@ fn pass2<S: CrossingSearch>(
     search: &mut S,
 ) {
     for r in points.iter_mut() {
-        if r.status == Status::BehindCamera {
+        let Some(c) = stashed(r) else {
             continue;
-        }
-        let c = Compensated {
-            pixel: [r.pixel2.u, r.pixel2.v],
-            depth_scale: r.z,
-            stretch: r.z_near,
         };
         *r = evaluate(
             config,
@@ -1291,13 +1298,8 @@ fn pass2_lean<const N: usize, const PERIODIC: bool>(
     };
     let b2 = run.boundary();
     for r in points.iter_mut() {
-        if r.status == Status::BehindCamera {
+        let Some(c) = stashed(r) else {
             continue;
-        }
-        let c = Compensated {
-            pixel: [r.pixel2.u, r.pixel2.v],
-            depth_scale: r.z,
-            stretch: r.z_near,
         };
         let mut line: EpipolarLine = geom.line(&c);
         line.key = r.z_far;
@@ -1500,17 +1502,7 @@ fn triangulate(
 mod tests {
     use super::*;
     use crate::epipolar::Unwrap;
-
-    /// A small deterministic generator (xorshift), values in `[0, 1)`.
-    struct Rng(u32);
-    impl Rng {
-        fn next(&mut self) -> f32 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 17;
-            self.0 ^= self.0 << 5;
-            (self.0 >> 8) as f32 / (1u32 << 24) as f32
-        }
-    }
+    use crate::test_rng::Rng;
 
     /// The fold test in two sweeps (pass 1's prefix half, [`PrefixFold`],
     /// and [`fold_suffix`]) answers exactly as the general index query,

@@ -84,6 +84,44 @@ mod stack {
     }
 }
 
+/// One measured frame pair: the processor reset, frame 1 given, then the
+/// instructions of the per-frame call for frame 2.
+struct Measured {
+    processed: bool,
+    instr: u32,
+    points: u32,
+    ok: u32,
+}
+
+fn measure_pair(
+    processor: &mut Processor<CAP, 2>,
+    f1: &Frame<CAP, 2>,
+    f2: &Frame<CAP, 2>,
+    m: &roadstereo::Motion,
+) -> Measured {
+    processor.reset();
+    let _ = processor.process(f1, None);
+    let (processed, instr) = fw::measure(|| processor.process(black_box(f2), Some(m)).is_ok());
+    let points: usize = processor
+        .structure()
+        .boundaries()
+        .iter()
+        .map(|b| b.points().len())
+        .sum();
+    let ok = processor
+        .structure()
+        .status_counts()
+        .first()
+        .copied()
+        .unwrap_or(0);
+    Measured {
+        processed,
+        instr,
+        points: points as u32,
+        ok: ok as u32,
+    }
+}
+
 #[entry]
 fn main() -> ! {
     let Some(mut core) = cortex_m::Peripherals::take() else {
@@ -102,25 +140,16 @@ fn main() -> ! {
             defmt::error!("bad bench data for n={=u32}", n);
             fw::exit(false)
         };
-        processor.reset();
-        let _ = processor.process(&f1, None);
-        let (ok, instr) = fw::measure(|| processor.process(black_box(&f2), Some(&m)).is_ok());
-        let points: usize = processor
-            .structure()
-            .boundaries()
-            .iter()
-            .map(|b| b.points().len())
-            .sum();
-        let c = processor.structure().status_counts();
+        let r = measure_pair(&mut processor, &f1, &f2, &m);
         defmt::info!(
             "bench n={=u32} points={=u32} instr={=u32} per_point={=u32} ok={=u32} digest={=u32:08x} processed={=bool}",
             n,
-            points as u32,
-            instr,
-            instr / (points.max(1) as u32),
-            c.first().copied().unwrap_or(0) as u32,
+            r.points,
+            r.instr,
+            r.instr / r.points.max(1),
+            r.ok,
             processor.structure().digest(),
-            ok
+            r.processed
         );
         if *n == 256 {
             stages(&f1, &f2, &m);
@@ -137,24 +166,15 @@ fn main() -> ! {
             defmt::error!("bad stress data for n={=u32}", n);
             fw::exit(false)
         };
-        processor.reset();
-        let _ = processor.process(&f1, None);
-        let (ok, instr) = fw::measure(|| processor.process(black_box(&f2), Some(&m)).is_ok());
-        let points: usize = processor
-            .structure()
-            .boundaries()
-            .iter()
-            .map(|b| b.points().len())
-            .sum();
-        let c = processor.structure().status_counts();
+        let r = measure_pair(&mut processor, &f1, &f2, &m);
         defmt::info!(
             "stress n={=u32} points={=u32} instr={=u32} per_point={=u32} ok={=u32} processed={=bool}",
             n,
-            points as u32,
-            instr,
-            instr / (points.max(1) as u32),
-            c.first().copied().unwrap_or(0) as u32,
-            ok
+            r.points,
+            r.instr,
+            r.instr / r.points.max(1),
+            r.ok,
+            r.processed
         );
     }
     defmt::info!(

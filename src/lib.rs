@@ -46,21 +46,6 @@ pub mod motion;
 pub mod motion_error;
 pub mod processor;
 
-/// Unit tests' random numbers.
-#[cfg(test)]
-mod test_rng {
-    /// A small deterministic generator (xorshift), values in `[0, 1)`.
-    pub(crate) struct Rng(pub(crate) u32);
-    impl Rng {
-        pub(crate) fn next(&mut self) -> f32 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 17;
-            self.0 ^= self.0 << 5;
-            (self.0 >> 8) as f32 / (1u32 << 24) as f32
-        }
-    }
-}
-
 pub use boundary::{Boundary, BoundaryError, Frame};
 pub use camera::{Camera, CameraError, Pixel, IMAGE_MARGIN_PX};
 pub use depth::DepthInterval;
@@ -78,3 +63,18 @@ pub use processor::{
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
+
+/// Unit tests' random numbers.
+#[cfg(test)]
+mod test_rng {
+    /// A small deterministic generator (xorshift), values in `[0, 1)`.
+    pub(crate) struct Rng(pub(crate) u32);
+    impl Rng {
+        pub(crate) fn next(&mut self) -> f32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 17;
+            self.0 ^= self.0 << 5;
+            (self.0 >> 8) as f32 / (1u32 << 24) as f32
+        }
+    }
+}

@@ -384,6 +384,13 @@ fn capture(program: &Path, args: &[&str]) -> Result<String, String> {
     Ok(String::from_utf8_lossy(&out.stdout).to_string())
 }
 
+const BENCH_USAGE: &str =
+    "usage: cargo xtask bench [--frame-ms 33] [--cpu-mhz 168] [--share-percent 5] [--per-point 400]
+  every budget is hard (exit code 1 when one is missed): instructions per point at every N,
+  per-point scaling N = 512 / N = 64 <= 1.25, the 2 x 256 frame within share-percent of a
+  frame-ms frame at cpu-mhz (one instruction = one cycle), stack <= 4 KiB, no software f64,
+  no allocator, the panic-never link";
+
 struct Budget {
     per_point: u64,
     frame_ms: f64,
@@ -594,12 +601,7 @@ fn bench_args(args: &[String]) -> Result<Budget, String> {
             "--cpu-mhz" => b.cpu_mhz = val()?,
             "--share-percent" => b.share_percent = val()?,
             "--per-point" => b.per_point = val()? as u64,
-            _ => {
-                return Err(
-                    "usage: cargo xtask bench [--frame-ms 33] [--cpu-mhz 168] [--share-percent 5] [--per-point 400]"
-                        .into(),
-                )
-            }
+            _ => return Err(BENCH_USAGE.into()),
         }
     }
     Ok(b)
@@ -780,6 +782,10 @@ fn main() -> ExitCode {
     let result = match task.as_str() {
         "test" => test(),
         "demo" => demo(rest.iter().any(|a| a == "--check")),
+        "bench" if rest.iter().any(|a| a == "--help" || a == "-h") => {
+            println!("{BENCH_USAGE}");
+            Ok(())
+        }
         "bench" => bench_args(rest).and_then(|b| bench(&b)),
         "figures" => figures(),
         "ci" => ci(),

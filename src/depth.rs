@@ -16,6 +16,12 @@
 //! is small). Without rotation and with `f_x = f_y = f` it reduces to eq. 2.3
 //! exactly.
 //!
+//! The processor evaluates it as `s = W' + |a|/D` with the disparity
+//! length `D = τ|a|` (the same value, one rounding more), because the
+//! stick's ends below are that expression with `|a| ± |W'|r₁` and `D ∓ …`:
+//! IEEE `+ − × ÷` are monotone in each argument, so the rounded stick
+//! holds the rounded depth with no clamp.
+//!
 //! # The stick, guaranteed
 //! The paper bounds the depth by a disparity error `e = e₁ + e₂` along `y`.
 //! Here both localisation errors are discs (any direction):

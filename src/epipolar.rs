@@ -116,7 +116,7 @@ pub(crate) const ANGULAR_EPS: f32 = 1.0e-4;
 /// `d_u/(|d_u| + t)` moves by at most (rounding of `d`) / (|d_u| + t); `d`
 /// is rounded by at most 2⁻²⁴ of the larger coordinate, about 6e-5 px at
 /// 1 000 px, and the direction of the epipolar vector `a` differs from that
-/// of `p₁' − FOE` by a like amount: under 1e-4 ([`ANGULAR_EPS`]) in all.
+/// of `p₁' − FOE` by a like amount: under the key margin, 1e-4, in all.
 pub const HALF_MIN_DV: f32 = 4.0;
 /// [`PairGeometry::half_key`] is offered only for a boundary at least this
 /// far from the FOE's row (pixels), so that its frame-1 counterpart, after

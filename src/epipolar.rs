@@ -483,27 +483,28 @@ impl PairGeometry {
     /// Exact rotation compensation of a frame-1 pixel; `None` when the ray
     /// points behind the frame-2 camera orientation (`q_z ≤ 1e-6`).
     pub fn compensate(&self, p1: Pixel) -> Option<Compensated> {
-        self.compensate_with(p1, false)
+        self.compensate_with(p1, None)
     }
 
     /// [`Self::compensate`] with the frame-wide stretch bound in place of
     /// the point's own (when there is one): what the processor uses.
     #[inline]
     pub(crate) fn compensate_in_frame(&self, p1: Pixel) -> Option<Compensated> {
-        self.compensate_with(p1, true)
+        self.compensate_with(p1, self.frame_stretch())
     }
 
+    /// [`Self::compensate`] with `stretch` as the stretch bound (the
+    /// frame-wide one, [`Self::frame_stretch`]), or the point's own when
+    /// `None`.
     #[inline(always)]
-    fn compensate_with(&self, p1: Pixel, frame_bound: bool) -> Option<Compensated> {
+    pub(crate) fn compensate_with(&self, p1: Pixel, stretch: Option<f32>) -> Option<Compensated> {
         let [x, y, z] = mat3_vec(&self.h, [p1.u, p1.v, 1.0]);
         if z <= 1.0e-6 {
             return None;
         }
         let iz = 1.0 / z;
         let (px, py) = (x * iz, y * iz);
-        let stretch = if frame_bound && self.stretch_bound.is_finite() {
-            self.stretch_bound
-        } else {
+        let stretch = stretch.unwrap_or_else(|| {
             // Jacobian of (x/z, y/z) with respect to (u, v).
             let [[h00, h01, _], [h10, h11, _], [h20, h21, _]] = self.h;
             let j00 = (h00 - px * h20) * iz;
@@ -513,25 +514,9 @@ impl PairGeometry {
             let n1 = fmax(j00.abs() + j10.abs(), j01.abs() + j11.abs());
             let ninf = fmax(j00.abs() + j01.abs(), j10.abs() + j11.abs());
             fmax(n1, ninf)
-        };
+        });
         Some(Compensated {
             pixel: [px, py],
-            depth_scale: z,
-            stretch,
-        })
-    }
-
-    /// [`Self::compensate`] with the given stretch bound in place of the
-    /// point's own (the frame-wide one, [`Self::frame_stretch`]).
-    #[inline(always)]
-    pub(crate) fn compensate_bounded(&self, p1: Pixel, stretch: f32) -> Option<Compensated> {
-        let [x, y, z] = mat3_vec(&self.h, [p1.u, p1.v, 1.0]);
-        if z <= 1.0e-6 {
-            return None;
-        }
-        let iz = 1.0 / z;
-        Some(Compensated {
-            pixel: [x * iz, y * iz],
             depth_scale: z,
             stretch,
         })

@@ -726,18 +726,13 @@ fn run<const N: usize, const B: usize, S: Searches<N>>(
         // above or below the FOE (the usual road scene), else as the pair
         // geometry says.
         let b2 = frame.boundaries().get(k).map(|b| b.points());
-        let key = b2
-            .and_then(|b| match (b.first(), b.last()) {
-                (Some(f), Some(l)) => geom.half_key(f.v, l.v),
-                _ => None,
-            })
+        let b2_ends = b2.and_then(|b| Some((*b.first()?, *b.last()?)));
+        let key = b2_ends
+            .and_then(|(f, l)| geom.half_key(f.v, l.v))
             .unwrap_or(*geom.key());
         // The keys of the frame-2 boundary's end vertices: the orientation
         // of its keys, and a guess for frame 1's (the fold test).
-        let ends = b2.and_then(|b| match (b.first(), b.last()) {
-            (Some(f), Some(l)) => Some((key.vertex_key(f.arr()), key.vertex_key(l.arr()))),
-            _ => None,
-        });
+        let ends = b2_ends.map(|(f, l)| (key.vertex_key(f.arr()), key.vertex_key(l.arr())));
         let n = b1.points().len();
         bs.points.set_len(n);
         // Pass 1: compensate every frame-1 point once. The output entry
@@ -896,8 +891,10 @@ fn pass1<const N: usize, const PREFIX: bool, const WRAPS: bool>(
     // The frame-wide stretch bound, decided once (else each point's own).
     let frame_stretch = geom.frame_stretch();
     for (i, (slot, &p1)) in slots.iter_mut().zip(b1).enumerate() {
+        // The branch per point, with each arm inlined whole (one `Option`
+        // passed through costs two instructions a point).
         let c = match frame_stretch {
-            Some(st) => geom.compensate_bounded(p1, st),
+            Some(st) => geom.compensate_with(p1, Some(st)),
             None => geom.compensate(p1),
         };
         let k = match c {

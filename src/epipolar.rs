@@ -1142,13 +1142,16 @@ impl<const N: usize> IndexedSearch<N> {
         self.hint = 0;
         self.period = 0.0;
         let n = n.min(N);
-        let s = n - 1;
+        // (The caller ensures n ≥ 2; anything less falls to the scan.)
+        let s = n.saturating_sub(1);
         self.segments = s;
         self.all_keyed = true;
         self.orient = o;
-        let (Some(keys), Some(lo), Some(&top)) =
-            (self.keys.get(..n), self.lo.get_mut(..s), self.hi.get(s - 1))
-        else {
+        let (Some(keys), Some(lo), Some(&top)) = (
+            self.keys.get(..n),
+            self.lo.get_mut(..s),
+            s.checked_sub(1).and_then(|i| self.hi.get(i)),
+        ) else {
             self.scan = true;
             self.single = false;
             return;

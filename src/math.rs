@@ -35,16 +35,22 @@ pub(crate) fn sqrt(x: f32) -> f32 {
 /// `(y + x/y)/2` rounded once, as in [`sqrt`]: the same bits (test
 /// `sqrt_pos_is_sqrt`).
 ///
-/// The first estimate is `micromath`'s (half the exponent, by adding the
-/// bits of 1.0 and shifting) without its branch for negative input, which
-/// the caller rules out.
+/// The first estimate is [`sqrt_estimate`].
 #[inline]
 pub(crate) fn sqrt_pos(x: f32) -> f32 {
     let h = 0.5 * x;
-    let mut y = f32::from_bits((x.to_bits() >> 1) + (0x3f80_0000 >> 1));
+    let mut y = sqrt_estimate(x);
     y = 0.5 * y + h / y;
     y = 0.5 * y + h / y;
     0.5 * y + h / y
+}
+
+/// `micromath`'s first estimate of `√x` (half the exponent, by adding the
+/// bits of 1.0 and shifting) without its branch for negative input, which
+/// [`sqrt_pos`]'s callers rule out (test `sqrt_estimate_is_micromaths`).
+#[inline(always)]
+fn sqrt_estimate(x: f32) -> f32 {
+    f32::from_bits((x.to_bits() >> 1) + (0x3f80_0000 >> 1))
 }
 
 /// Sine and cosine of an angle in radians, `|x| ≤ π/2` (callers validate).
@@ -275,10 +281,10 @@ mod tests {
     }
 
     #[test]
-    fn sqrt_pos_estimate_is_micromaths() {
+    fn sqrt_estimate_is_micromaths() {
         let mut x = 1.0e-30f32;
         while x < 1.0e30 {
-            let ours = f32::from_bits((x.to_bits() >> 1) + (0x3f80_0000 >> 1));
+            let ours = sqrt_estimate(x);
             assert_eq!(ours.to_bits(), micromath::F32(x).sqrt().0.to_bits(), "{x}");
             x *= 1.001_3;
         }

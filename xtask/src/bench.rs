@@ -1,7 +1,16 @@
 //! `cargo xtask bench`: instruction counts, stage costs, stack, memory
 //! figures and the link-time proofs, every budget hard.
+//!
+//! The steps, in the order they print: build the three firmware binaries
+//! (the `nopanic` link is itself a proof), run the bench firmware, the
+//! budget table (instructions per point at every N), the stress pairs, the
+//! scaling and deadline checks, the stage costs, the memory table, the
+//! symbol checks, and the verdict.
 
-use crate::firmware::{build_firmware, field, num, records, run_firmware};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use crate::firmware::{build_firmware, field, num, records, run_firmware, Record};
 use crate::setup::setup_emulator;
 use crate::util::{capture, tool};
 
@@ -12,6 +21,7 @@ pub const BENCH_USAGE: &str =
   frame-ms frame at cpu-mhz (one instruction = one cycle), stack <= 4 KiB, no software f64,
   no allocator, the panic-never link";
 
+/// The bench's budgets (`--help` lists the knobs).
 pub struct Budget {
     per_point: u64,
     frame_ms: f64,
@@ -21,22 +31,80 @@ pub struct Budget {
     scaling: f64,
 }
 
+impl Budget {
+    /// Instructions one frame may take: `share_percent` of a `frame_ms`
+    /// frame at `cpu_mhz`, one instruction = one cycle.
+    fn deadline(&self) -> u64 {
+        (self.frame_ms * 1e-3 * self.cpu_mhz * 1e6 * self.share_percent / 100.0) as u64
+    }
+}
+
+/// The budgets from the command line (defaults: 400 per point, 5 % of a
+/// 33 ms frame at 168 MHz, 4 KiB of stack, scaling 1.25).
+pub fn bench_args(args: &[String]) -> Result<Budget, String> {
+    let mut b = Budget {
+        per_point: 400,
+        frame_ms: 33.0,
+        cpu_mhz: 168.0,
+        share_percent: 5.0,
+        stack: 4096,
+        scaling: 1.25,
+    };
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        let mut val = || {
+            it.next()
+                .and_then(|v| v.parse::<f64>().ok())
+                .ok_or(format!("{a} needs a number"))
+        };
+        match a.as_str() {
+            "--frame-ms" => b.frame_ms = val()?,
+            "--cpu-mhz" => b.cpu_mhz = val()?,
+            "--share-percent" => b.share_percent = val()?,
+            "--per-point" => b.per_point = val()? as u64,
+            _ => return Err(BENCH_USAGE.into()),
+        }
+    }
+    Ok(b)
+}
+
+/// Per N: (instructions per frame, per point).
+type PerN = BTreeMap<u64, (u64, u64)>;
+
+/// `cargo xtask bench`. Every budget is hard: any miss fails the task (and
+/// CI), after every table is printed.
 pub fn bench(b: &Budget) -> Result<(), String> {
     setup_emulator()?;
+    let (elf, demo_elf) = build()?;
+    let log = run_firmware(&elf)?;
+    let mut misses = Vec::new();
+    let per = budget_table(&log, b, &mut misses);
+    stress_table(&log);
+    scaling_and_deadline(&per, b, &mut misses);
+    stage_costs(&log);
+    memory_table(&log, &demo_elf, b, &mut misses)?;
+    symbol_checks(&[&elf, &demo_elf], &mut misses)?;
+    verdict(&misses, b)
+}
+
+/// Build the bench and demo firmware (their ELF paths) and link `nopanic`.
+fn build() -> Result<(PathBuf, PathBuf), String> {
     let elf = build_firmware("bench")?;
     let demo_elf = build_firmware("demo")?;
     // The link-time proof: this build fails if a panic path remains.
     build_firmware("nopanic")?;
     println!("xtask: panic-never check binary linked: no panicking branch in the per-frame code");
-    let log = run_firmware(&elf)?;
-    // Every budget is hard: any miss fails the task (and CI).
-    let mut hard = Vec::new();
-    let rows = records(&log, "bench n=");
+    Ok((elf, demo_elf))
+}
+
+/// The representative rows (`bench n=…`) with the per-point budget checked
+/// at every N.
+fn budget_table(log: &str, b: &Budget, misses: &mut Vec<String>) -> PerN {
     println!();
     println!("| N per boundary | points | instructions per frame | per point |");
     println!("|---:|---:|---:|---:|");
-    let mut per = std::collections::BTreeMap::new();
-    for r in &rows {
+    let mut per = PerN::new();
+    for r in &records(log, "bench n=") {
         println!(
             "| {} | {} | {} | {} |",
             num(r, "n"),
@@ -48,31 +116,41 @@ pub fn bench(b: &Budget) -> Result<(), String> {
     }
     for (n, (_, pp)) in &per {
         if *pp > b.per_point {
-            hard.push(format!(
+            misses.push(format!(
                 "N = {n}: {pp} instructions per point > budget {}",
                 b.per_point
             ));
         }
     }
-    let stress = records(&log, "stress n=");
-    if !stress.is_empty() {
-        println!(
-            "\nstress pairs (not budgeted): the paper's 512 x 480 camera sampled at up to 3.4 points per image row"
-        );
-        println!("| N per boundary | points | instructions per frame | per point | ok |");
-        println!("|---:|---:|---:|---:|---:|");
-        for r in &stress {
-            println!(
-                "| {} | {} | {} | {} | {} |",
-                num(r, "n"),
-                num(r, "points"),
-                num(r, "instr"),
-                num(r, "per_point"),
-                num(r, "ok")
-            );
-        }
+    per
+}
+
+/// The stress pairs (`stress n=…`), reported, not budgeted.
+fn stress_table(log: &str) {
+    let stress = records(log, "stress n=");
+    if stress.is_empty() {
+        return;
     }
-    let deadline = (b.frame_ms * 1e-3 * b.cpu_mhz * 1e6 * b.share_percent / 100.0) as u64;
+    println!(
+        "\nstress pairs (not budgeted): the paper's 512 x 480 camera sampled at up to 3.4 points per image row"
+    );
+    println!("| N per boundary | points | instructions per frame | per point | ok |");
+    println!("|---:|---:|---:|---:|---:|");
+    for r in &stress {
+        println!(
+            "| {} | {} | {} | {} | {} |",
+            num(r, "n"),
+            num(r, "points"),
+            num(r, "instr"),
+            num(r, "per_point"),
+            num(r, "ok")
+        );
+    }
+}
+
+/// Per-point cost at N = 512 against N = 64, and the 2 × 256 frame against
+/// the deadline.
+fn scaling_and_deadline(per: &PerN, b: &Budget, misses: &mut Vec<String>) {
     match (per.get(&64), per.get(&512)) {
         (Some((_, p64)), Some((_, p512))) => {
             let ratio = *p512 as f64 / (*p64).max(1) as f64;
@@ -81,11 +159,12 @@ pub fn bench(b: &Budget) -> Result<(), String> {
                 b.scaling
             );
             if ratio > b.scaling {
-                hard.push(format!("scaling {ratio:.3} > {:.2}", b.scaling));
+                misses.push(format!("scaling {ratio:.3} > {:.2}", b.scaling));
             }
         }
-        _ => hard.push("missing N = 64 or N = 512 rows".into()),
+        _ => misses.push("missing N = 64 or N = 512 rows".into()),
     }
+    let deadline = b.deadline();
     if let Some((i256, _)) = per.get(&256) {
         println!(
             "frame of 2 × 256 points: {i256} instructions; deadline {deadline} ({} % of {} ms at {} MHz, one instruction = one cycle): {:.0} % of it",
@@ -95,13 +174,17 @@ pub fn bench(b: &Budget) -> Result<(), String> {
             100.0 * *i256 as f64 / deadline as f64
         );
         if *i256 > deadline {
-            hard.push(format!(
+            misses.push(format!(
                 "2 × 256 frame: {i256} instructions > deadline {deadline}"
             ));
         }
     }
+}
+
+/// Where the N = 256 frame's instructions go, stage by stage.
+fn stage_costs(log: &str) {
     println!("\nwhere the instructions go (N = 256, through the public API):");
-    for s in records(&log, "stage name=") {
+    for s in records(log, "stage name=") {
         println!(
             "  {:22} {:>9} instructions, {:>4} per point",
             field(&s, "name").unwrap_or("?"),
@@ -109,15 +192,24 @@ pub fn bench(b: &Budget) -> Result<(), String> {
             num(&s, "per_point")
         );
     }
-    let stack = records(&log, "stack per_frame_call=")
+}
+
+/// The demo firmware's flash and RAM (`llvm-size`), the library's sizes
+/// and the painted stack from the bench's log; the stack budget checked.
+fn memory_table(
+    log: &str,
+    demo_elf: &Path,
+    b: &Budget,
+    misses: &mut Vec<String>,
+) -> Result<(), String> {
+    let stack = records(log, "stack per_frame_call=")
         .first()
         .map(|r| num(r, "per_frame_call"))
         .unwrap_or(u64::MAX);
-    let sizes = records(&log, "sizes ")
+    let sizes: Record = records(log, "sizes ")
         .into_iter()
         .next()
         .unwrap_or_default();
-    // Memory figures from the linked demo firmware.
     let size = capture(&tool("llvm-size")?, &["-A", &demo_elf.to_string_lossy()])?;
     let sec = |name: &str| -> u64 {
         size.lines()
@@ -155,14 +247,20 @@ pub fn bench(b: &Budget) -> Result<(), String> {
         ram + num(&sizes, "processor_256_2") + num(&sizes, "frame_256_2") + stack
     );
     if stack > b.stack {
-        hard.push(format!("stack {stack} B > {} B", b.stack));
+        misses.push(format!("stack {stack} B > {} B", b.stack));
     }
-    // Symbols: no software double precision, no allocator.
-    for elf in [&elf, &demo_elf] {
+    Ok(())
+}
+
+/// No software double precision (`__aeabi_d*`) and no allocator symbols in
+/// the given firmware (`llvm-nm`).
+fn symbol_checks(elfs: &[&Path], misses: &mut Vec<String>) -> Result<(), String> {
+    let mut found = Vec::new();
+    for elf in elfs {
         let syms = capture(&tool("llvm-nm")?, &[&elf.to_string_lossy()])?;
         let bad_f64: Vec<&str> = syms.lines().filter(|l| l.contains("__aeabi_d")).collect();
         if !bad_f64.is_empty() {
-            hard.push(format!(
+            found.push(format!(
                 "{}: software f64 linked: {bad_f64:?}",
                 elf.display()
             ));
@@ -174,56 +272,28 @@ pub fn bench(b: &Budget) -> Result<(), String> {
             })
             .collect();
         if !alloc.is_empty() {
-            hard.push(format!("{}: allocator linked: {alloc:?}", elf.display()));
+            found.push(format!("{}: allocator linked: {alloc:?}", elf.display()));
         }
     }
     println!(
         "no __aeabi_d* (software f64) and no allocator symbols in the demo and bench firmware: {}",
-        if hard
-            .iter()
-            .any(|h| h.contains("f64") || h.contains("allocator"))
-        {
-            "FAILED"
-        } else {
-            "ok"
-        }
+        if found.is_empty() { "ok" } else { "FAILED" }
     );
-    for h in &hard {
-        println!("xtask: budget NOT MET: {h}");
+    misses.extend(found);
+    Ok(())
+}
+
+/// Every missed budget, then the verdict.
+fn verdict(misses: &[String], b: &Budget) -> Result<(), String> {
+    for m in misses {
+        println!("xtask: budget NOT MET: {m}");
     }
-    if !hard.is_empty() {
-        return Err(hard.join("; "));
+    if !misses.is_empty() {
+        return Err(misses.join("; "));
     }
     println!(
         "xtask: all budgets met (≤ {} instructions per point at every N, scaling, deadline, stack, no f64, no allocator, panic-never)",
         b.per_point
     );
     Ok(())
-}
-
-pub fn bench_args(args: &[String]) -> Result<Budget, String> {
-    let mut b = Budget {
-        per_point: 400,
-        frame_ms: 33.0,
-        cpu_mhz: 168.0,
-        share_percent: 5.0,
-        stack: 4096,
-        scaling: 1.25,
-    };
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        let mut val = || {
-            it.next()
-                .and_then(|v| v.parse::<f64>().ok())
-                .ok_or(format!("{a} needs a number"))
-        };
-        match a.as_str() {
-            "--frame-ms" => b.frame_ms = val()?,
-            "--cpu-mhz" => b.cpu_mhz = val()?,
-            "--share-percent" => b.share_percent = val()?,
-            "--per-point" => b.per_point = val()? as u64,
-            _ => return Err(BENCH_USAGE.into()),
-        }
-    }
-    Ok(b)
 }

@@ -1,14 +1,14 @@
 //! The host-side tasks: `test`, `figures` and `ci` (everything `.ci/run`
 //! runs).
 
-use std::path::Path;
-
 use crate::bench::{bench, bench_args};
 use crate::demo::demo;
 use crate::profile::profile;
 use crate::setup::setup_toolchain;
 use crate::util::{root, run, THUMB};
 
+/// The README's test command: the library's unit and doc tests on the host,
+/// then `host_tests`.
 pub fn test() -> Result<(), String> {
     let r = root();
     run(&r, "cargo", &["test", "--target", "host-tuple", "--lib"])?;
@@ -16,6 +16,7 @@ pub fn test() -> Result<(), String> {
     run(&r.join("host_tests"), "cargo", &["test"])
 }
 
+/// Re-render `docs/` (figures and the replay example).
 pub fn figures() -> Result<(), String> {
     run(
         &root().join("host_tests"),
@@ -24,69 +25,38 @@ pub fn figures() -> Result<(), String> {
     )
 }
 
+/// What `ci` runs before the tests, in order: (folder under the repository
+/// root, `""` for the root itself; cargo's arguments).
+#[rustfmt::skip]
+const CARGO_CHECKS: &[(&str, &[&str])] = &[
+    ("", &["fmt", "--check"]),
+    ("host_tests", &["fmt", "--check"]),
+    ("xtask", &["fmt", "--check"]),
+    // The library for the vehicle controller, without and with defmt.
+    ("", &["build", "--release", "--target", THUMB]),
+    ("", &["build", "--release", "--target", THUMB, "--features", "defmt"]),
+    ("", &["clippy", "--target", THUMB, "--", "-D", "warnings"]),
+    ("", &["clippy", "--target", THUMB, "--features", "defmt", "--", "-D", "warnings"]),
+    // The library's tests and the host tests.
+    ("", &["clippy", "--target", "host-tuple", "--all-targets", "--", "-D", "warnings"]),
+    ("host_tests", &["clippy", "--all-targets", "--", "-D", "warnings"]),
+    // The firmware binaries.
+    ("", &["clippy", "--release", "--target", THUMB, "--features", "firmware", "--bins", "--", "-D", "warnings"]),
+];
+
+/// Everything CI runs: toolchain setup, the cargo checks above, the tests,
+/// then the firmware on the emulated controller.
 pub fn ci() -> Result<(), String> {
     let r = root();
-    let h = r.join("host_tests");
     setup_toolchain()?;
-    let cargo = |dir: &Path, args: &[&str]| run(dir, "cargo", args);
-    cargo(&r, &["fmt", "--check"])?;
-    cargo(&h, &["fmt", "--check"])?;
-    cargo(&r.join("xtask"), &["fmt", "--check"])?;
-    // The library for the vehicle controller, without and with defmt.
-    cargo(&r, &["build", "--release", "--target", THUMB])?;
-    cargo(
-        &r,
-        &[
-            "build",
-            "--release",
-            "--target",
-            THUMB,
-            "--features",
-            "defmt",
-        ],
-    )?;
-    cargo(&r, &["clippy", "--target", THUMB, "--", "-D", "warnings"])?;
-    cargo(
-        &r,
-        &[
-            "clippy",
-            "--target",
-            THUMB,
-            "--features",
-            "defmt",
-            "--",
-            "-D",
-            "warnings",
-        ],
-    )?;
-    cargo(
-        &r,
-        &[
-            "clippy",
-            "--target",
-            "host-tuple",
-            "--all-targets",
-            "--",
-            "-D",
-            "warnings",
-        ],
-    )?;
-    cargo(&h, &["clippy", "--all-targets", "--", "-D", "warnings"])?;
-    cargo(
-        &r,
-        &[
-            "clippy",
-            "--release",
-            "--target",
-            THUMB,
-            "--features",
-            "firmware",
-            "--bins",
-            "--",
-            "-D",
-            "warnings",
-        ],
-    )?;
+    for (dir, args) in CARGO_CHECKS {
+        let dir = if dir.is_empty() {
+            r.clone()
+        } else {
+            r.join(dir)
+        };
+        run(&dir, "cargo", args)?;
+    }
     // The README's test command.
     test()?;
     // The firmware on the emulated controller: the demo, compared frame by

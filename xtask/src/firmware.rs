@@ -54,8 +54,11 @@ pub fn run_firmware(elf: &Path) -> Result<String, String> {
     Ok(text)
 }
 
-/// `key=value` pairs of the log lines containing `marker`.
-pub fn records(text: &str, marker: &str) -> Vec<Vec<(String, String)>> {
+/// One log line's `key=value` pairs, in order.
+pub type Record = Vec<(String, String)>;
+
+/// The records of the log lines containing `marker`.
+pub fn records(text: &str, marker: &str) -> Vec<Record> {
     text.lines()
         .filter(|l| l.contains(marker))
         .map(|l| {
@@ -67,10 +70,12 @@ pub fn records(text: &str, marker: &str) -> Vec<Vec<(String, String)>> {
         .collect()
 }
 
+/// The value of `key` in a record.
 pub fn field<'a>(rec: &'a [(String, String)], key: &str) -> Option<&'a str> {
     rec.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str())
 }
 
+/// The value of `key` as a number (0 when missing or not a number).
 pub fn num(rec: &[(String, String)], key: &str) -> u64 {
     field(rec, key).and_then(|v| v.parse().ok()).unwrap_or(0)
 }

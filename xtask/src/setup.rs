@@ -29,38 +29,43 @@ pub fn setup_toolchain() -> Result<(), String> {
     )
 }
 
-/// Install what the emulated controller needs, if missing.
+/// Install what the emulated controller needs, if missing: the toolchain's
+/// parts, `qemu-system-arm` (apt) and `defmt-print` (cargo).
 pub fn setup_emulator() -> Result<(), String> {
     setup_toolchain()?;
-    let r = root();
     if !have("qemu-system-arm", "--version") {
-        let sudo = if have("id", "-u")
-            && Command::new("id")
-                .arg("-u")
-                .output()
-                .map(|o| String::from_utf8_lossy(&o.stdout).trim() != "0")
-                .unwrap_or(false)
-        {
-            vec!["sudo"]
-        } else {
-            vec![]
-        };
-        let apt = |args: &[&str]| -> Result<(), String> {
-            let mut all: Vec<&str> = sudo.clone();
-            all.push("apt-get");
-            all.extend_from_slice(args);
-            let (p, rest) = all.split_first().ok_or("empty command")?;
-            run(&r, p, rest)
-        };
-        apt(&["update", "-qq"])?;
-        apt(&["install", "-y", "-qq", "qemu-system-arm"])?;
+        install_qemu()?;
     }
     if !have("defmt-print", "--version") {
         run(
-            &r,
+            &root(),
             "cargo",
             &["install", "defmt-print", "--version", "1.2.0", "--locked"],
         )?;
     }
     Ok(())
+}
+
+/// `apt-get install qemu-system-arm`, through `sudo` unless running as root.
+fn install_qemu() -> Result<(), String> {
+    let r = root();
+    let sudo: &[&str] = if running_as_root() { &[] } else { &["sudo"] };
+    let apt = |args: &[&str]| -> Result<(), String> {
+        let mut all: Vec<&str> = sudo.to_vec();
+        all.push("apt-get");
+        all.extend_from_slice(args);
+        let (p, rest) = all.split_first().ok_or("empty command")?;
+        run(&r, p, rest)
+    };
+    apt(&["update", "-qq"])?;
+    apt(&["install", "-y", "-qq", "qemu-system-arm"])
+}
+
+/// Whether `id -u` says 0 (or cannot tell: then no `sudo` either).
+fn running_as_root() -> bool {
+    Command::new("id")
+        .arg("-u")
+        .output()
+        .map(|o| !o.status.success() || String::from_utf8_lossy(&o.stdout).trim() == "0")
+        .unwrap_or(true)
 }

@@ -21,6 +21,7 @@
 
 mod bench;
 mod ci;
+mod cycles;
 mod demo;
 mod firmware;
 mod profile;

@@ -1,6 +1,11 @@
-//! Profiling aid: the N = 256 benchmark frame pair processed once, so a
-//! QEMU execution trace of this binary shows where one per-frame call's
+//! Profiling aid: a list of named windows, each one per-frame call on a
+//! frame pair from an embedded data file, processed between two marker
+//! calls, so a QEMU execution trace of this binary shows where each call's
 //! instructions go (`cargo xtask profile`).
+//!
+//! Window `k` (from 0) is the code between the entries into `marker(2k + 1)`
+//! and `marker(2k + 2)`; after it the firmware logs
+//! `profile window=k name=… points=… digest=…`, outside the window.
 
 #![no_std]
 #![no_main]
@@ -13,7 +18,20 @@ use cortex_m_rt::entry;
 use defmt_semihosting as _;
 use roadstereo::{Config, Frame, Processor};
 
-static DATA: &[u8] = include_bytes!("data/bench_256.bin");
+/// The traced windows, in order: a name (no spaces) and a frame pair in the
+/// format of `host_tests/src/drive.rs` (the first two frames are used). To
+/// add a window, add one line here, e.g.
+/// `("worst", include_bytes!("data/worst_256.bin")),`; `cargo xtask profile`
+/// reports every window the firmware logs.
+static WINDOWS: &[(&str, &[u8])] = &[
+    // The bench's representative N = 256 pair (one detector point per row).
+    ("representative", include_bytes!("data/bench_256.bin")),
+    // The bench's N = 256 stress pair (up to 3.4 points per row).
+    ("stress", include_bytes!("data/stress_256.bin")),
+];
+
+/// Capacity: the bench's, so the per-frame code is the bench's too.
+const CAP: usize = 512;
 
 #[inline(never)]
 fn marker(tag: u32) -> u32 {
@@ -22,24 +40,39 @@ fn marker(tag: u32) -> u32 {
 
 #[entry]
 fn main() -> ! {
-    let mut processor = Processor::<512, 2>::new(Config::default());
-    let Ok(mut d) = fw::Drive::new(DATA) else {
-        fw::exit(false)
+    let mut ok = true;
+    for (k, (name, data)) in WINDOWS.iter().enumerate() {
+        ok &= window(k, name, data);
+    }
+    fw::exit(ok)
+}
+
+/// Window `k`: a fresh processor takes the pair's first frame, then its
+/// second between `marker(2k + 1)` and `marker(2k + 2)`; log the result.
+/// Whether the data was read and the call succeeded.
+fn window(k: usize, name: &str, data: &'static [u8]) -> bool {
+    let mut processor = Processor::<CAP, 2>::new(Config::default());
+    let Ok(mut d) = fw::Drive::new(data) else {
+        return false;
     };
-    let mut f1 = Frame::<512, 2>::new(d.camera);
-    let mut f2 = Frame::<512, 2>::new(d.camera);
+    let mut f1 = Frame::<CAP, 2>::new(d.camera);
+    let mut f2 = Frame::<CAP, 2>::new(d.camera);
     let (Ok(_), Ok(Some(m))) = (d.next_frame(&mut f1), d.next_frame(&mut f2)) else {
-        fw::exit(false)
+        return false;
     };
     let _ = processor.process(&f1, None);
-    marker(1);
+    let tag = 2 * k as u32 + 1;
+    marker(tag);
     let ok = processor.process(black_box(&f2), Some(&m)).is_ok();
-    marker(2);
+    marker(tag + 1);
     let points: usize = f2.boundaries().iter().map(|b| b.points().len()).sum();
     defmt::info!(
-        "profile points={=usize} digest={=u32:08x}",
+        "profile window={=usize} name={=str} points={=usize} digest={=u32:08x} ok={=bool}",
+        k,
+        name,
         points,
-        processor.structure().digest()
+        processor.structure().digest(),
+        ok
     );
-    fw::exit(ok)
+    ok
 }

@@ -10,10 +10,12 @@
 //! * `bench`   — instruction counts, stage costs, stack, memory figures and
 //!   the link-time proofs (panic-never, no `f64`, no allocator), with the
 //!   budgets checked (see `--help` of the task).
-//! * `profile` — where one per-frame call's instructions go: the N = 256
-//!   bench frame traced instruction by instruction on QEMU, counted per
-//!   function and per source line, with an annotated disassembly written
-//!   to `target/profile/annotated.txt`.
+//! * `profile` — where a per-frame call's instructions go: each of the
+//!   profile firmware's windows (the N = 256 bench pair, the N = 256 stress
+//!   pair, ...) traced instruction by instruction on QEMU, counted per
+//!   function and per source line with an estimate of Cortex-M4F cycles
+//!   beside the instructions, and an annotated disassembly written to
+//!   `target/profile/annotated.txt`.
 //! * `figures` — re-render `docs/` (figures and the replay example).
 //! * `ci`      — what `.ci/run` runs: toolchain setup, formatting, clippy,
 //!   thumb builds with and without `defmt`, `test`, then `demo --check`,

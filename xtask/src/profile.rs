@@ -1,10 +1,13 @@
-//! `cargo xtask profile`: where one per-frame call's instructions go.
+//! `cargo xtask profile`: where a per-frame call's instructions go.
 //!
 //! Run the `profile` firmware on QEMU with an execution trace
-//! (`-singlestep -d exec,nochain`: one trace line per instruction), count
-//! the instructions executed at each address between the firmware's two
-//! `marker` calls (one per-frame call), and attribute them with
-//! `llvm-objdump -d -l` to functions and (innermost, inlined) source lines.
+//! (`-singlestep -d exec,nochain`: one trace line per instruction). The
+//! firmware processes a list of named windows (`src/bin/profile.rs`), each
+//! one per-frame call between two entries into `marker`; window `k` is the
+//! code between the entries `2k + 1` and `2k + 2`, and the firmware logs its
+//! name and point count. For each window, count the instructions executed
+//! at each address and attribute them with `llvm-objdump -d -l` to
+//! functions and (innermost, inlined) source lines.
 //! Beside the instructions it reports an estimate of Cortex-M4F cycles
 //! (the model and its sources: [`crate::cycles`]), priced instruction by
 //! instruction along the trace: the instruction sizes from the disassembly
@@ -15,11 +18,13 @@
 //! tables, annotation.
 
 use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use crate::cycles::{classify, Class, Model, Tally, SUMMARY};
-use crate::firmware::{build_firmware, num, records};
+use crate::firmware::{build_firmware, field, num, records};
 use crate::setup::setup_emulator;
 use crate::util::{capture, root, tool};
 
@@ -62,31 +67,58 @@ impl Cost {
 /// Executions and cycles per instruction address.
 type Counts = BTreeMap<u64, Cost>;
 
+/// One traced window: what the firmware logged about it, and what it
+/// executed.
+struct Window {
+    name: String,
+    points: u64,
+    digest: String,
+    counts: Counts,
+    tally: Tally,
+}
+
+impl Window {
+    fn per_point(&self, c: u64) -> f64 {
+        c as f64 / self.points.max(1) as f64
+    }
+}
+
+/// `cargo xtask profile`: trace the firmware, map its disassembly, count
+/// each window, print each window's summary and tables, the table of all
+/// windows and the cycle model, and write the annotated disassembly.
 pub fn profile() -> Result<(), String> {
     setup_emulator()?;
     let elf = build_firmware("profile")?;
     let dir = root().join("target").join("profile");
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let (log, trace_path) = trace(&elf, &dir)?;
-    let points = records(&log, "profile points=")
-        .first()
-        .map_or(0, |r| num(r, "points"))
-        .max(1);
     let dis = disassemble(&elf)?;
-    let (counts, tally) = count(&trace_path, &dis)?;
-    summary(&tally, points);
-    let funcs = function_table(&dis, &counts, points);
-    line_table(&dis, &counts, points);
+    let windows = count(&trace_path, &dis, &log)?;
+    let mut funcs = Vec::new();
+    for w in &windows {
+        summary(w);
+        for f in function_table(&dis, w) {
+            if !funcs.contains(&f) {
+                funcs.push(f);
+            }
+        }
+        line_table(&dis, w);
+    }
+    window_table(&windows);
     println!("\n{SUMMARY}");
-    annotate(&dis, &counts, &funcs, &dir.join("annotated.txt"))
+    annotate(&dis, &windows, &funcs, &dir.join("annotated.txt"))
 }
 
-/// The per-frame call's instructions and estimated cycles, in total and
-/// per point, and its mix per point.
-fn summary(t: &Tally, points: u64) {
-    let per = |c: u64| c as f64 / points as f64;
+/// A window's instructions and estimated cycles, in total and per point,
+/// and its mix per point.
+fn summary(w: &Window) {
+    let t = &w.tally;
+    let per = |c: u64| w.per_point(c);
     println!(
-        "\none per-frame call ({points} points): {} instructions, {:.1} per point; estimated {} Cortex-M4F cycles, {:.1} per point ({:.2} per instruction)",
+        "\nwindow `{}`: one per-frame call ({} points, digest {}): {} instructions, {:.1} per point; estimated {} Cortex-M4F cycles, {:.1} per point ({:.2} per instruction)",
+        w.name,
+        w.points,
+        w.digest,
         t.instructions,
         per(t.instructions),
         t.cycles,
@@ -100,6 +132,28 @@ fn summary(t: &Tally, points: u64) {
         per(t.loads),
         per(t.taken)
     );
+}
+
+/// Every window in one table, per point.
+fn window_table(windows: &[Window]) {
+    println!("\n| window | points | instructions | instr/point | est. cycles | cycles/point | cycles/instr | VDIV+VSQRT/point | loads/point | taken branches/point |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for w in windows {
+        let t = &w.tally;
+        println!(
+            "| {} | {} | {} | {:.1} | {} | {:.1} | {:.2} | {:.1} | {:.1} | {:.1} |",
+            w.name,
+            w.points,
+            t.instructions,
+            w.per_point(t.instructions),
+            t.cycles,
+            w.per_point(t.cycles),
+            t.cpi(),
+            w.per_point(t.div_sqrt),
+            w.per_point(t.loads),
+            w.per_point(t.taken)
+        );
+    }
 }
 
 /// Run the firmware on QEMU, one trace line per executed instruction into
@@ -193,56 +247,92 @@ fn trace_pc(line: &str) -> Option<u64> {
         .and_then(|h| u64::from_str_radix(h, 16).ok())
 }
 
-/// Executions and estimated cycles per address between the first and the
-/// second entry into `marker`, and their tally. An instruction is priced
-/// when the next one is traced: that says whether it was a taken branch.
-fn count(trace: &Path, dis: &Disassembly) -> Result<(Counts, Tally), String> {
-    let text = std::fs::read_to_string(trace).map_err(|e| format!("{}: {e}", trace.display()))?;
-    let mut counts = Counts::new();
-    let mut tally = Tally::default();
+/// The windows the firmware logged (`profile window=k name=… points=…`),
+/// in order, with nothing counted yet.
+fn logged_windows(log: &str) -> Result<Vec<Window>, String> {
+    let windows: Vec<Window> = records(log, "profile window=")
+        .iter()
+        .enumerate()
+        .map(|(k, r)| Window {
+            name: field(r, "name").map_or_else(|| format!("window {k}"), str::to_string),
+            points: num(r, "points"),
+            digest: field(r, "digest").unwrap_or("?").to_string(),
+            counts: Counts::new(),
+            tally: Tally::default(),
+        })
+        .collect();
+    if windows.is_empty() {
+        return Err("the profile firmware logged no window".into());
+    }
+    Ok(windows)
+}
+
+/// Executions and estimated cycles per address in each window, and their
+/// tally, reading the trace line by line (it holds every instruction the
+/// firmware ran). An instruction is priced when the next one is traced:
+/// that says whether it was a taken branch.
+fn count(trace: &Path, dis: &Disassembly, log: &str) -> Result<Vec<Window>, String> {
+    let mut windows = logged_windows(log)?;
+    let err = |e: std::io::Error| format!("{}: {e}", trace.display());
+    let mut reader = BufReader::new(File::open(trace).map_err(err)?);
+    let mut line = String::new();
     let mut model = Model::default();
+    // The window being traced, and its last instruction, not yet priced.
+    let mut inside: Option<usize> = None;
     let mut pending: Option<u64> = None;
-    let mut seen = 0;
-    for pc in text.lines().filter_map(trace_pc) {
-        if let Some(prev) = pending.take() {
+    let mut entries = 0;
+    while entries < 2 * windows.len() {
+        line.clear();
+        if reader.read_line(&mut line).map_err(err)? == 0 {
+            break;
+        }
+        let Some(pc) = trace_pc(&line) else {
+            continue;
+        };
+        if let (Some(k), Some(prev)) = (inside, pending.take()) {
             let (class, fall_through) = dis
                 .code
                 .get(&prev)
                 .map_or((Class::Other, prev + 2), |i| (i.class, i.fall_through));
             let taken = pc != fall_through;
             let cycles = model.step(class, taken);
-            tally.add(class, taken, cycles);
-            counts.entry(prev).or_default().add(Cost {
+            let w = &mut windows[k];
+            w.tally.add(class, taken, cycles);
+            w.counts.entry(prev).or_default().add(Cost {
                 instructions: 1,
                 cycles,
             });
         }
         if pc == dis.marker {
-            seen += 1;
-            if seen == 2 {
-                break;
-            }
-        } else if seen == 1 {
+            entries += 1;
+            // Odd entries open window (entries - 1) / 2, even ones close it.
+            inside = (entries % 2 == 1).then_some(entries / 2);
+            model = Model::default();
+        } else if inside.is_some() {
             pending = Some(pc);
         }
     }
-    if seen < 2 {
-        return Err("the trace does not hold both marker calls".into());
+    if entries < 2 * windows.len() {
+        return Err(format!(
+            "the trace holds {entries} marker calls, the {} logged windows need {}",
+            windows.len(),
+            2 * windows.len()
+        ));
     }
-    Ok((counts, tally))
+    Ok(windows)
 }
 
 /// Instructions and estimated cycles per (not inlined) function, most
 /// instructions first; returns the functions in that order.
-fn function_table<'a>(dis: &'a Disassembly, counts: &Counts, points: u64) -> Vec<&'a str> {
+fn function_table<'a>(dis: &'a Disassembly, w: &Window) -> Vec<&'a str> {
     let mut by_func = BTreeMap::<&str, Cost>::new();
-    for (a, c) in counts {
+    for (a, c) in &w.counts {
         let f = dis.code.get(a).map_or("?", |i| i.func.as_str());
         by_func.entry(f).or_default().add(*c);
     }
     let mut funcs: Vec<_> = by_func.into_iter().collect();
     funcs.sort_by_key(|f| std::cmp::Reverse(f.1.instructions));
-    let per = |c: u64| c as f64 / points as f64;
+    let per = |c: u64| w.per_point(c);
     println!(
         "\n| function (not inlined) | instructions | instr/point | est. cycles | cycles/point |"
     );
@@ -261,9 +351,9 @@ fn function_table<'a>(dis: &'a Disassembly, counts: &Counts, points: u64) -> Vec
 
 /// The 30 source lines with the most instructions (innermost, inlined code
 /// included), each with the function it was inlined into.
-fn line_table(dis: &Disassembly, counts: &Counts, points: u64) {
+fn line_table(dis: &Disassembly, w: &Window) {
     let mut by_line = BTreeMap::<(&str, &str), Cost>::new();
-    for (a, c) in counts {
+    for (a, c) in &w.counts {
         let (f, l) = dis
             .code
             .get(a)
@@ -272,7 +362,7 @@ fn line_table(dis: &Disassembly, counts: &Counts, points: u64) {
     }
     let mut lines: Vec<_> = by_line.into_iter().collect();
     lines.sort_by_key(|l| std::cmp::Reverse(l.1.instructions));
-    let per = |c: u64| c as f64 / points as f64;
+    let per = |c: u64| w.per_point(c);
     println!("\n| source line (innermost, inlined code included) | in function | instr/point | cycles/point |");
     println!("|---|---|---:|---:|");
     for ((l, f), c) in lines.iter().take(30) {
@@ -285,10 +375,19 @@ fn line_table(dis: &Disassembly, counts: &Counts, points: u64) {
 }
 
 /// Every executed function's disassembly with the executions and
-/// estimated cycles of each instruction, written to `path`.
-fn annotate(dis: &Disassembly, counts: &Counts, funcs: &[&str], path: &Path) -> Result<(), String> {
-    let mut ann =
-        String::from("# executions, estimated cycles, address: instruction, source line\n");
+/// estimated cycles of each instruction in each window, side by side,
+/// written to `path`.
+fn annotate(
+    dis: &Disassembly,
+    windows: &[Window],
+    funcs: &[&str],
+    path: &Path,
+) -> Result<(), String> {
+    let names: Vec<&str> = windows.iter().map(|w| w.name.as_str()).collect();
+    let mut ann = format!(
+        "# per window ({}): executions, estimated cycles; then address: instruction, source line\n",
+        names.join(", ")
+    );
     let mut current = "";
     for (a, i) in &dis.code {
         if !funcs.contains(&i.func.as_str()) {
@@ -298,15 +397,15 @@ fn annotate(dis: &Disassembly, counts: &Counts, funcs: &[&str], path: &Path) -> 
             ann.push_str(&format!("\n{}:\n", i.func));
             current = &i.func;
         }
-        let c = counts.get(a).copied().unwrap_or_default();
-        ann.push_str(&format!(
-            "{:8} {:8} {a:6x}: {:<44} {}\n",
-            c.instructions, c.cycles, i.text, i.line
-        ));
+        for w in windows {
+            let c = w.counts.get(a).copied().unwrap_or_default();
+            ann.push_str(&format!("{:8} {:8} ", c.instructions, c.cycles));
+        }
+        ann.push_str(&format!("{a:6x}: {:<44} {}\n", i.text, i.line));
     }
     std::fs::write(path, ann).map_err(|e| format!("{}: {e}", path.display()))?;
     println!(
-        "\nxtask: annotated disassembly (executions and estimated cycles per instruction): {}",
+        "\nxtask: annotated disassembly (executions and estimated cycles per instruction, per window): {}",
         path.display()
     );
     Ok(())

@@ -25,6 +25,7 @@ mod bench;
 mod ci;
 mod cycles;
 mod demo;
+mod disasm;
 mod firmware;
 mod profile;
 mod setup;

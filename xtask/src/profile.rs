@@ -23,31 +23,11 @@ use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::cycles::{classify, Class, Model, Tally, SUMMARY};
+use crate::cycles::{Class, Model, Tally, SUMMARY};
+use crate::disasm::{disassemble, Disassembly};
 use crate::firmware::{build_firmware, field, num, records};
 use crate::setup::setup_emulator;
-use crate::util::{capture, root, tool};
-
-/// One instruction of the firmware's disassembly.
-struct Insn {
-    /// The (not inlined) function it belongs to, without the hash.
-    func: String,
-    /// Its innermost source line (`file.rs:line`), inlined code included.
-    line: String,
-    /// Mnemonic and operands, single-spaced.
-    text: String,
-    /// Its class in the cycle model.
-    class: Class,
-    /// The address after it (where execution falls through).
-    fall_through: u64,
-}
-
-/// The firmware's code: every instruction by address, and the address of
-/// `profile::marker`.
-struct Disassembly {
-    code: BTreeMap<u64, Insn>,
-    marker: u64,
-}
+use crate::util::root;
 
 /// What one instruction address executed: how often, at what estimated
 /// cost.
@@ -184,59 +164,6 @@ fn trace(elf: &Path, dir: &Path) -> Result<(String, PathBuf), String> {
         return Err(format!("profile firmware failed ({})", out.status));
     }
     Ok((log, trace))
-}
-
-/// The disassembly (`llvm-objdump -d -l -C`): address -> (function, source
-/// line, instruction), and where `profile::marker` starts.
-fn disassemble(elf: &Path) -> Result<Disassembly, String> {
-    let text = capture(
-        &tool("llvm-objdump")?,
-        &[
-            "-d",
-            "-l",
-            "-C",
-            "--no-show-raw-insn",
-            &elf.to_string_lossy(),
-        ],
-    )?;
-    let mut code = BTreeMap::new();
-    let (mut func, mut line) = (String::new(), String::new());
-    let mut marker = None;
-    for l in text.lines() {
-        if let Some(name) = l.strip_suffix(">:").and_then(|h| h.split_once(" <")) {
-            func = strip_hash(name.1);
-            line.clear();
-            if func == "profile::marker" {
-                marker = u64::from_str_radix(name.0.trim(), 16).ok();
-            }
-        } else if let Some(src) = l.strip_prefix("; ").filter(|s| s.contains(".rs:")) {
-            line = short_path(src);
-        } else if let Some((a, insn)) = l.trim_start().split_once(':') {
-            if let Ok(addr) = u64::from_str_radix(a.trim(), 16) {
-                let text = insn.split_whitespace().collect::<Vec<_>>().join(" ");
-                code.insert(
-                    addr,
-                    Insn {
-                        func: func.clone(),
-                        line: line.clone(),
-                        class: classify(&text),
-                        text,
-                        // Thumb-2 instructions are 2 or 4 bytes: the next
-                        // address in the listing, filled in below.
-                        fall_through: addr + 4,
-                    },
-                );
-            }
-        }
-    }
-    let marker = marker.ok_or("no profile::marker in the disassembly")?;
-    let addrs: Vec<u64> = code.keys().copied().collect();
-    for w in addrs.windows(2) {
-        if let Some(i) = code.get_mut(&w[0]) {
-            i.fall_through = w[1];
-        }
-    }
-    Ok(Disassembly { code, marker })
 }
 
 /// The pc of a trace line `Trace 0: 0x… [flags/pc/…] symbol` (other lines:
@@ -411,28 +338,21 @@ fn annotate(
     Ok(())
 }
 
-/// A demangled symbol without its `::h…` hash (and the legacy mangling's
-/// `$LT$`/`$GT$` escapes undone).
-fn strip_hash(name: &str) -> String {
-    let name = match name.rsplit_once("::h") {
-        Some((head, hash)) if hash.len() == 16 && hash.chars().all(|c| c.is_ascii_hexdigit()) => {
-            head
-        }
-        _ => name,
-    };
-    name.replace("$LT$", "<").replace("$GT$", ">")
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-/// `…/src/x.rs:12` or `…/library/core/src/y.rs:34` without the prefix.
-fn short_path(src: &str) -> String {
-    for cut in ["/library/", "/src/bin/", "/src/"] {
-        if let Some((_, tail)) = src.rsplit_once(cut) {
-            return if cut == "/src/bin/" {
-                format!("bin/{tail}")
-            } else {
-                tail.to_string()
-            };
-        }
+    #[test]
+    fn trace_lines_give_their_pc() {
+        let l = "Trace 0: 0x7fa550000240 [00800408/0000b0ec/00000110/ff020201] DefaultPreInit";
+        assert_eq!(trace_pc(l), Some(0xb0ec));
+        assert_eq!(
+            trace_pc("cpu_io_recompile: rewound execution of TB to 00000428"),
+            None
+        );
+        assert_eq!(
+            trace_pc("Stopped execution of TB chain before 0x7fbbf000b100 [0000bd18] memcpy"),
+            None
+        );
     }
-    src.to_string()
 }

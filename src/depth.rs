@@ -1,5 +1,7 @@
-//! Triangulation (eqs. 2.1–2.3) and the error interval, the "stick" of
-//! Sec. 4.1, extended to a guaranteed bound.
+//! Where the localisation errors can put a point's true correspondent (its
+//! *error band*), the depth that a frame-2 crossing gives (eq. 2.3) and the
+//! interval of depths the band allows (the "stick" of Sec. 4.1, made a
+//! guaranteed bound).
 //!
 //! # Depth from the disparity (eq. 2.3, general `(U, V, W)`)
 //! With the notation of [`crate::epipolar`], the frame-2 point is
@@ -8,213 +10,500 @@
 //! `s = W' + 1/τ`,   `Z = s / q_z`,   `X = x₁ Z`, `Y = y₁ Z`
 //!
 //! where `(x₁, y₁)` are the normalised frame-1 coordinates. This is eq. 2.3
-//! solved in the least-squares sense along the disparity: `τ` is the
-//! projection `(d · a)/|a|²` of the full 2-D disparity `d` on the epipolar
-//! direction, so both components `d_x`, `d_y` contribute, each in proportion
-//! to its share of the line's direction, instead of picking the `x` or `y`
-//! form of eq. 2.3 (either of which is ill-conditioned when its component
-//! is small). Without rotation and with `f_x = f_y = f` it reduces to eq. 2.3
-//! exactly.
+//! solved along the disparity: `τ` is the position of the crossing on the
+//! epipolar line, so both components `d_x`, `d_y` contribute, each in
+//! proportion to its share of the line's direction, instead of picking the
+//! `x` or `y` form of eq. 2.3 (either of which is ill-conditioned when its
+//! component is small). Without rotation and with `f_x = f_y = f` it
+//! reduces to eq. 2.3 exactly. The processor evaluates it with
+//! `λ = τ |a|²` (the crossing's coordinate along `a`, see below) as
+//! `s = W' + |a|²/λ`, the form the stick's ends share.
 //!
-//! The processor evaluates it as `s = W' + |a|/D` with the disparity
-//! length `D = τ|a|` (the same value, one rounding more), because the
-//! stick's ends below are that expression with `|a| ± |W'|r₁` and `D ∓ …`:
-//! IEEE `+ − × ÷` are monotone in each argument, so the rounded stick
-//! holds the rounded depth with no clamp.
+//! # The error band
+//! The paper bounds the depth by a disparity error `e = e₁ + e₂` along `y`
+//! at the crossing it found. Here the model is: the true frame-1 point is
+//! within `e₁` pixels of the detected one (any direction), so after the
+//! rotation compensation within `r₁ = e₁ · stretch` of `p₁'` (plus the shift
+//! a rotation error can cause, [`crate::Config::with_rotation_error`]); the
+//! true frame-2 boundary is within `e₂` of the polyline; each translation
+//! component may be off by `δ` ([`crate::Config::with_translation_error`]).
+//! Write the true point as `p₁' + δ₁` (`|δ₁| ≤ r₁`), the true `W'` as
+//! `W'_t` (`|W'_t − W'| ≤ σ_w`), and the true epipolar vector as
+//! `a_t = a + δa + W'_t δ₁` (exact: `a` is affine in the point and linear in
+//! the translation; `|δa| ≤ σ_a` over the error box, [`crate::motion_error`]).
+//! The true correspondent is `p₂ = p₁' + δ₁ + τ a_t` with `τ > 0`. In the
+//! frame of the line, `λ = â·(p₂ − p₁')`, `μ = n̂·(p₂ − p₁')` (`â = a/|a|`,
+//! `n̂` its normal, pixels):
 //!
-//! # The stick, guaranteed
-//! The paper bounds the depth by a disparity error `e = e₁ + e₂` along `y`.
-//! Here both localisation errors are discs (any direction):
+//! `λ = (1 + τW'_t) ξ + τ(|a| + â·δa)`,   `μ = (1 + τW'_t) η + τ n̂·δa`
 //!
-//! * frame 1: the true point is within `e₁` pixels of `p₁`; after rotation
-//!   compensation within `r₁ = e₁ · stretch` of `p₁'` (the homography's
-//!   local stretch bound);
-//! * frame 2: the true boundary is within `e₂` pixels of the polyline.
+//! with `ξ = â·δ₁`, `η = n̂·δ₁`, `ξ² + η² ≤ r₁²`, and `1 + τW'_t > 0` (it is
+//! the ratio of the frame-2 to the frame-1 distance from the true FOE).
+//! Let `A₋ = |a| − σ_a − (|W'| + σ_w) r₁` (positive, else the point's error
+//! disc holds the FOE) and `A₊ = |a| + σ_a + (|W'| + σ_w) r₁`. Then
 //!
-//! Let `D = τ|a|` be the disparity length, `φ` the angle between the
-//! epipolar line and the boundary at the intersection. Moving `p₁'` by at
-//! most `r₁` moves the start of the disparity along the line by at most
-//! `r₁`, changes `|a|` by at most `|W'| r₁`, and tilts the line about the FOE
-//! so that at `p₂` it is displaced sideways by at most
-//! `h₁ = r₁ (1 + W' τ)` (the ratio of the distances of `p₂` and `p₁'` from
-//! the FOE; `r₁` when `W' = 0`). The true intersection lies where a line
-//! within `h₁` of ours meets a curve within `e₂` of the polyline: a
-//! parallelogram whose extent along the line is
+//! * `τ = (λ − ξ)/(|a| + â·δa + W'_t ξ)`, the denominator in `[A₋, A₊]`, so
+//!   `λ > −r₁` and `τ ≤ (λ + r₁)/A₋`;
+//! * `|μ| ≤ r₁ + τ c` with `c = (W' + σ_w) r₁ + σ_a`, hence
+//!   `|μ| ≤ r₁ + |h| r₁ + h λ` with the slope `h = c/A₋` when `c > 0`
+//!   (`τ ≤ (λ + r₁)/A₋`) and `h = c/A₊` when `c < 0` (`τ ≥ (λ − r₁)/A₊`):
+//!   the band is a thin wedge from `p₁'` outwards, widening away from the
+//!   FOE when `W' > 0` and narrowing towards it when `W' < 0`;
+//! * for `W'_t < 0` also `τ < 1/|W'_t|`: `λ < r₁ + A₊/(|W'| − σ_w)`, the
+//!   FOE end of the paper's segment.
 //!
-//! `δ₂ = (e₂ + h₁ |cos φ|) / sin φ`.
+//! A polyline point `q` within `e₂` of `p₂` lies in the band widened by `e₂`:
+//! `λ_q > −(r₁ + e₂)` and `|μ_q| ≤ (r₁ + e₂)(1 + |h|) + h λ_q` (the bound on
+//! `|μ|` changes with `λ` at slope `h`, and `|λ_q − λ| ≤ e₂`). So the search looks for every
+//! polyline segment meeting that region, the **whole** band and not only
+//! the exact line, including the part behind `p₁'` down to `r₁ + e₂`. Each
+//! segment is clipped to the region (a convex set: four half-planes), which
+//! gives the range `[λ_lo, λ_hi]` of its points in the band. Consecutive
+//! segments in the band form one *piece*; if the band meets the boundary in
+//! more than one piece the point is [`crate::Status::Ambiguous`], and its
+//! stick covers every piece.
 //!
-//! This is the `1/sin φ` growth of the frame-2 error: a boundary crossed at
-//! a flat angle localises the intersection poorly. The disparity thus lies
-//! in `D ± ε` with `ε = r₁ + δ₂`, and since
-//! `s = W' + (|a| ± |W'| r₁)/(D ∓ ε)` is monotone in both (for the sign of
-//! `W'` at hand the extremes fall on the corners, which coincide with the
-//! exact extremes of `s = W' ρ₂/(ρ₂ − ρ₁)` over the box of radial distances
-//! from the FOE):
+//! # The stick
+//! With `L₋ = λ_lo − e₂` and `L₊ = λ_hi + e₂` over all pieces (the true
+//! `p₂` is within `e₂` of some band point of the polyline), `1/τ` lies in
+//! `[A₋/(L₊ + r₁), A₊/(L₋ − r₁)]`, so
 //!
-//! `s_far = W' + (1 + |W'| r₁/|a|) / (τ − ε/|a|)`,
-//! `s_near = W' + (1 − |W'| r₁/|a|) / (τ + ε/|a|)`.
+//! `s_far = W' + σ_w + A₊/(L₋ − r₁)`,   `s_near = W' − σ_w + A₋/(L₊ + r₁)`
 //!
-//! A sideways offset `h` of the true line also lengthens the true disparity,
-//! by at most `h²/2(D − ε)`, which the near end allows for. When
-//! `τ ≤ ε/|a|` the disparity is not larger than its error and the far end is
-//! unbounded ([`crate::Status::Unbounded`]). The boundary direction
-//! is measured over a chord of up to `2·CHORD_HALF_WINDOW + 1` points; the
-//! error of that chord's direction (at most `2 e₂ / L` for a chord of length
-//! `L`) is taken off `sin φ` before it is used, so the stick stays a bound;
-//! an intersection with `sin φ` below the configured minimum is
-//! [`crate::Status::Grazing`] and gets no depth. Without errors
-//! (`e₁ = e₂ = 0`) the stick collapses to the point. For `e₂ ≪ D` and
-//! `φ = 90°` the relative half-length is `≈ (e₁ + e₂)/D`: the paper's
-//! `|ΔZ/Z| ≈ e/d` (Sec. 4.1.1).
+//! and `Z = s/q_z` with `q_z` itself within `Δ` of ours when the point
+//! moves by `e₁` ([`crate::epipolar::PairGeometry::depth_scale_error`]).
+//! When `L₋ ≤ r₁` the disparity is not larger than its error and the far
+//! end is unbounded ([`crate::Status::Unbounded`], also when the near end
+//! reaches 0). This is the paper's interval with both errors as discs: for
+//! a crossing at right angles the band's piece is a point and the relative
+//! half-length is `≈ (r₁ + e₂)/D`, the paper's `|ΔZ/Z| ≈ e/d`
+//! (Sec. 4.1.1). A crossing at an angle `φ` gives a piece of length about
+//! `w/tan φ` (`w` the band's width): flatter than the configured minimum
+//! angle it is [`crate::Status::Grazing`], which keeps the sticks useful;
+//! the bound holds at every angle.
+//!
+//! All of this is computed in `f32`. The band is widened by the rounding of
+//! the coordinates involved, `2⁻²⁰ S` pixels for coordinates below `S`
+//! ([`crate::epipolar::PairGeometry::coordinate_scale`], about 10⁻³ px for
+//! the paper's camera), and the estimate `s = W' + |a|²/λ` shares the form
+//! of the stick's ends with smaller numerators and larger denominators at
+//! `s_far` (the reverse at `s_near`): IEEE `+ − × ÷` are monotone in each
+//! argument, so the rounded stick holds the rounded depth with no clamp.
 
-use crate::camera::Pixel;
-use crate::math::{cross, dot, fmax, sqrt_pos, sub};
-
-/// Half-width, in points, of the chord used to measure the boundary direction.
-pub const CHORD_HALF_WINDOW: usize = 4;
+use crate::math::{cross, dot, fmax, fmin, sqrt_pos};
 
 /// Depth interval along the frame-1 ray: every depth consistent with the
 /// localisation errors lies in `[z_near, z_far]` (length unit of the motion).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct DepthInterval {
-    /// Nearest consistent depth `Z_near` (≥ 0).
+    /// Nearest consistent depth `Z_near` (> 0).
     pub z_near: f32,
     /// Farthest consistent depth `Z_far`.
     pub z_far: f32,
 }
 
-/// Direction of the boundary around segment `j`: the chord between the
-/// points `CHORD_HALF_WINDOW` before `j` and after `j + 1` (clamped).
+/// The error terms of one point (pixels, and the translation spreads).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PointErrors {
+    /// `r₁`: radius of the compensated frame-1 error disc, with slack.
+    pub(crate) r1: f32,
+    /// `e₂`, with slack.
+    pub(crate) e2: f32,
+    /// `σ_a`: how far a translation error can move `a` at this point.
+    pub(crate) spread_a: f32,
+    /// `σ_w`: how far a translation error can move `W'`.
+    pub(crate) spread_w: f32,
+}
+
+/// Why a point has no band.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum NoBand {
+    /// The error disc holds the FOE, or the point is too close to it for
+    /// its band to be told from the FOE's (see [`Band::new`]).
+    AtFoe,
+}
+
+/// One point's error band, in the coordinates of its epipolar line scaled
+/// by `|a|` (`λ' = a·(q − p₁') = |a| λ`, `μ' = a × (q − p₁') = |a| μ`), and
+/// the terms of its stick.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Band {
+    /// `p₁'`.
+    pub(crate) p: [f32; 2],
+    /// The epipolar vector `a`.
+    pub(crate) a: [f32; 2],
+    /// `|a|²`, `|a|`.
+    pub(crate) a2: f32,
+    pub(crate) a_len: f32,
+    /// The region: `|μ'| ≤ k0 + h λ'` for `lam_lo ≤ λ' ≤ lam_hi`.
+    pub(crate) k0: f32,
+    pub(crate) h: f32,
+    pub(crate) lam_lo: f32,
+    pub(crate) lam_hi: f32,
+    /// The stick: `s_far = w_hi + num_hi/(L₋' − r1a)`,
+    /// `s_near = w_lo + num_lo/(L₊' + r1a)`; `e2a = e₂|a|`.
+    w: f32,
+    w_hi: f32,
+    w_lo: f32,
+    num_hi: f32,
+    num_lo: f32,
+    r1a: f32,
+    e2a: f32,
+    /// The tangent of the band's angular half-width as seen from the FOE,
+    /// and `1/(ρ₁ − r₁ − e₂)` (for `W' > 0`; see [`Band::key_half_width`]).
+    half_angle: f32,
+    foe_inv: f32,
+}
+
+/// How the band stands to the FOE, for the key interval.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Reach {
+    /// The band's rays from the FOE are within `atan(t)` of the point's
+    /// own, whose key is known to the second value.
+    Within(f32, f32),
+    /// Every key (the search is exhaustive).
+    Everything,
+}
+
+impl Band {
+    /// The band of a compensated point `p` with epipolar vector `a` (see
+    /// the module docs); `w` is `W'`.
+    ///
+    /// `near_foe` is the radius `m` about the FOE left to the FOE-near list
+    /// when `W' < 0` (see [`crate::search`]); the band's key interval then
+    /// covers the part at least `m` from the FOE. A point whose error disc
+    /// holds the FOE (`A₋ ≤ 0`), or with `W' > 0` closer to it than
+    /// `3(r₁ + e₂)`, or with `W' < 0` closer than `m + r₁ + e₂`, has no band:
+    /// its disparity could not exceed its error in any case worth a stick.
+    #[inline(always)]
+    pub(crate) fn new(
+        p: [f32; 2],
+        a: [f32; 2],
+        w: f32,
+        err: &PointErrors,
+        near_foe: f32,
+    ) -> Result<Self, NoBand> {
+        let a2 = dot(a, a);
+        // `a2 > 1e-30` keeps the square root's input in its range (and
+        // refuses NaN).
+        if !(a2 > 1.0e-30) {
+            return Err(NoBand::AtFoe);
+        }
+        let a_len = sqrt_pos(a2);
+        let PointErrors {
+            r1,
+            e2,
+            spread_a,
+            spread_w,
+        } = *err;
+        let wa = w.abs();
+        let wt = wa + spread_w;
+        let re = r1 + e2;
+        let mv = spread_a + wt * r1;
+        let a_minus = a_len - mv;
+        // ρ₁ = |a|/|W'|: the guards compare |a| with |W'| × distance.
+        let guard = if w > 0.0 {
+            3.0 * wa * re
+        } else if w < 0.0 {
+            wa * (near_foe + re)
+        } else {
+            0.0
+        };
+        // (A NaN fails both.)
+        if !(a_minus > 0.0 && a_len > guard) {
+            return Err(NoBand::AtFoe);
+        }
+        // The slope: |μ| ≤ r₁ + τ c with τ ≤ (λ + r₁)/A₋ when c > 0, and
+        // τ ≥ (λ − r₁)/A₊ when c < 0 (the band narrows towards the FOE).
+        let c = (w + spread_w) * r1 + spread_a;
+        let h = if c > 0.0 {
+            c / a_minus
+        } else {
+            c / (a_len + mv)
+        };
+        let far = w + spread_w < 0.0;
+        let lam_hi = if far {
+            // r₁ + A₊/(|W'| − σ_w) + e₂, scaled by |a|.
+            (re + (a_len + mv) / (wa - spread_w)) * a_len
+        } else {
+            f32::INFINITY
+        };
+        // 1/(ρ₁ − r₁ − e₂) = |W'|/(|a| − |W'|(r₁ + e₂)) (for W' > 0).
+        let foe_inv = if w > 0.0 { wa / (a_len - wa * re) } else { 0.0 };
+        // The maximum over the band of |μ|/(ρ₁ + λ): at its near end
+        // (r₁ + e₂)/(ρ₁ − r₁ − e₂), or its slope h far out.
+        let half_angle = fmax(re * foe_inv, h);
+        Ok(Self {
+            p,
+            a,
+            a2,
+            a_len,
+            k0: re * (1.0 + h.abs()) * a_len,
+            h,
+            lam_lo: -re * a_len,
+            lam_hi,
+            w,
+            w_hi: w + spread_w,
+            w_lo: w - spread_w,
+            num_hi: a2 + a_len * mv,
+            num_lo: a2 - a_len * mv,
+            r1a: r1 * a_len,
+            e2a: e2 * a_len,
+            half_angle,
+            foe_inv,
+        })
+    }
+
+    /// How wide the band's key interval is (for direction keys): its rays
+    /// lie within `atan(t)` of the point's own, and `m` is the rounding
+    /// margin of the point's own key (whose distance from the FOE is at
+    /// least `ρ₁ − r₁ − e₂`; `key_scale` as in [`crate::pencil::Keying`]):
+    /// `Within(t, m)`. `near_foe` as in [`Band::new`]; `exhaustive` when the
+    /// FOE's position is uncertain and `W' < 0` (a translation error with
+    /// backward motion: the band runs into an uncertain FOE, and every key
+    /// is searched).
+    #[inline(always)]
+    pub(crate) fn key_half_width(&self, near_foe: f32, exhaustive: bool, key_scale: f32) -> Reach {
+        const FLOOR: f32 = 4.0 * 9.536_743e-7;
+        if self.w > 0.0 {
+            Reach::Within(
+                self.half_angle * (1.0 + 1.0e-5),
+                key_scale * self.foe_inv * (1.0 + 1.0e-5) + FLOOR,
+            )
+        } else if self.w < 0.0 && !exhaustive {
+            // The part at least `near_foe` from the FOE: |μ| ≤ K₀ + h λ
+            // (h ≤ 0 here) is largest against the axis distance ρ₁ − λ at
+            // λ = ρ₁ − near_foe (the derivative of the ratio has the sign
+            // of K₀ + h ρ₁ ≥ e₂ > 0); the point itself is farther.
+            let rho1 = self.a_len / self.w.abs();
+            let k0 = self.k0 / self.a_len;
+            Reach::Within(
+                (k0 + self.h * (rho1 - near_foe)) / near_foe * (1.0 + 1.0e-5),
+                key_scale / near_foe + FLOOR,
+            )
+        } else {
+            Reach::Everything
+        }
+    }
+
+    /// The four corners of the band's region (pixels), its near end at
+    /// `λ = −(r₁ + e₂)` and its far end at `λ = far` (`far` bounded by the
+    /// image's reach when the band is unbounded): for keys that are not
+    /// direction keys, whose interval is the hull of the corners' keys.
+    pub(crate) fn corners(&self, reach_from_p: f32) -> [[f32; 2]; 4] {
+        let inv = 1.0 / self.a_len;
+        let u = [self.a[0] * inv, self.a[1] * inv];
+        let n = [-u[1], u[0]];
+        let near = self.lam_lo * inv;
+        let far = fmin(self.lam_hi * inv, reach_from_p);
+        let at = |l: f32, s: f32| {
+            let half = (self.k0 + self.h * l * self.a_len) * inv;
+            [
+                self.p[0] + l * u[0] + s * half * n[0],
+                self.p[1] + l * u[1] + s * half * n[1],
+            ]
+        };
+        [at(near, 1.0), at(near, -1.0), at(far, 1.0), at(far, -1.0)]
+    }
+
+    /// `(λ', μ')` of a frame-2 vertex.
+    #[inline(always)]
+    pub(crate) fn coords(&self, v: [f32; 2]) -> Coords {
+        let d = [v[0] - self.p[0], v[1] - self.p[1]];
+        Coords {
+            lam: dot(self.a, d),
+            mu: cross(self.a, d),
+        }
+    }
+
+    /// The part of the segment between two vertices (with their
+    /// [`Band::coords`]) that lies in the band's region, as its range of
+    /// `λ'`, and the exact line's crossing of the segment if it is in the
+    /// band: `None` when the segment misses the region.
+    #[inline(always)]
+    pub(crate) fn clip(&self, c0: Coords, c1: Coords) -> Option<Clipped> {
+        // The two edges: g± = k0 + h λ' ∓ μ' ≥ 0 (linear along the segment).
+        let base0 = self.k0 + self.h * c0.lam;
+        let base1 = self.k0 + self.h * c1.lam;
+        let (gp0, gp1) = (base0 - c0.mu, base1 - c1.mu);
+        let (gm0, gm1) = (base0 + c0.mu, base1 + c1.mu);
+        // Outside one edge entirely (NaN fails `>=` below and is outside).
+        if (gp0 < 0.0 && gp1 < 0.0) || (gm0 < 0.0 && gm1 < 0.0) {
+            return None;
+        }
+        let (mut t0, mut t1) = (0.0f32, 1.0f32);
+        for (g0, g1) in [(gp0, gp1), (gm0, gm1)] {
+            if g0 < 0.0 {
+                t0 = fmax(t0, g0 / (g0 - g1));
+            } else if g1 < 0.0 {
+                t1 = fmin(t1, g0 / (g0 - g1));
+            } else if !(g0 >= 0.0 && g1 >= 0.0) {
+                return None;
+            }
+        }
+        if t0 > t1 {
+            return None;
+        }
+        let dl = c1.lam - c0.lam;
+        let (la, lb) = (c0.lam + t0 * dl, c0.lam + t1 * dl);
+        let (lo, hi) = if la <= lb { (la, lb) } else { (lb, la) };
+        let (lo, hi) = (fmax(lo, self.lam_lo), fmin(hi, self.lam_hi));
+        // (A NaN fails.)
+        if !(lo <= hi) {
+            return None;
+        }
+        // The exact line μ' = 0 between the vertices: a sign change (a
+        // vertex on the line counts as on the positive side).
+        let crossing = if side_bit(c0.mu) != side_bit(c1.mu) {
+            let t = c0.mu / (c0.mu - c1.mu);
+            let lam = c0.lam + t * dl;
+            (lam > self.lam_lo && lam < self.lam_hi).then_some((t, fmin(fmax(lam, lo), hi)))
+        } else {
+            None
+        };
+        Some(Clipped { lo, hi, crossing })
+    }
+
+    /// Whether a vertex (its [`Band::coords`]) lies in the band's region.
+    #[inline(always)]
+    pub(crate) fn contains(&self, c: Coords) -> bool {
+        let half = self.k0 + self.h * c.lam;
+        c.mu.abs() <= half && c.lam >= self.lam_lo && c.lam <= self.lam_hi
+    }
+
+    /// Whether a piece of the band from `lo` to `hi` (`λ'`) is longer than
+    /// the band's width there times `cot_twice = 2 cot(φ_min)`: the
+    /// boundary crosses the line flatter than the minimum angle.
+    #[inline(always)]
+    pub(crate) fn grazing(&self, lo: f32, hi: f32, cot_twice: f32) -> bool {
+        hi - lo > (self.k0 + self.h * hi) * cot_twice
+    }
+
+    /// The depth estimate and the stick in the compensated frame, `(s,
+    /// s_near, s_far)`, for the exact crossing at `lam` (`λ'`, within
+    /// `[lo, hi]`) and the hull `[lo, hi]` of all pieces (`λ'`); `None` when
+    /// the far end is unbounded.
+    #[inline(always)]
+    pub(crate) fn depths(&self, lam: f32, lo: f32, hi: f32) -> Option<(f32, f32, f32)> {
+        let den_far = (lo - self.e2a) - self.r1a;
+        // (A NaN fails.)
+        if !(den_far > 0.0) {
+            return None;
+        }
+        let s = self.w + self.a2 / lam;
+        let s_far = self.w_hi + self.num_hi / den_far;
+        let s_near = self.w_lo + self.num_lo / ((hi + self.e2a) + self.r1a);
+        Some((s, s_near, s_far))
+    }
+
+    /// The frame-2 point at `t` along the segment `v0 → v1`.
+    #[inline(always)]
+    pub(crate) fn point_on(v0: [f32; 2], v1: [f32; 2], t: f32) -> [f32; 2] {
+        [v0[0] + t * (v1[0] - v0[0]), v0[1] + t * (v1[1] - v0[1])]
+    }
+}
+
+/// A vertex's coordinates in a band's frame (see [`Band::coords`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Coords {
+    pub(crate) lam: f32,
+    pub(crate) mu: f32,
+}
+
+/// What [`Band::clip`] found: the `λ'` range of the segment's part in the
+/// band, and the exact line's crossing `(t along the segment, λ')`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Clipped {
+    pub(crate) lo: f32,
+    pub(crate) hi: f32,
+    pub(crate) crossing: Option<(f32, f32)>,
+}
+
+/// The side of a vertex from its `μ'`: 0 for `μ' ≥ 0`, 1 for `μ' < 0`. The
+/// sign bit once −0 is made +0 (`+ 0.0`), so a vertex on the line counts as
+/// on the positive side and two adjacent segments never both report a
+/// crossing through their shared vertex.
 #[inline(always)]
-pub(crate) fn chord(boundary: &[Pixel], j: usize) -> [f32; 2] {
-    // Away from the ends (the usual case): one bounds check for the window.
-    if let Some(&[a, .., b]) = j
-        .checked_sub(CHORD_HALF_WINDOW)
-        .and_then(|i0| boundary.get(i0..i0 + 2 * CHORD_HALF_WINDOW + 2))
-    {
-        return sub(b.arr(), a.arr());
-    }
-    let last = boundary.len().saturating_sub(1);
-    let i0 = j.saturating_sub(CHORD_HALF_WINDOW);
-    let i1 = (j + 1 + CHORD_HALF_WINDOW).min(last);
-    match (boundary.get(i0), boundary.get(i1)) {
-        (Some(a), Some(b)) => sub(b.arr(), a.arr()),
-        _ => [0.0, 0.0],
-    }
+pub(crate) fn side_bit(mu: f32) -> u32 {
+    (mu + 0.0).to_bits() >> 31
 }
 
-/// Angle terms of an intersection: `(sin φ_low, |cos φ|)`, where `φ_low`
-/// is the smallest angle consistent with the chord's own error.
-///
-/// `|cos φ|` may round above 1 only when `sin φ` is below 1.001e-3 (the
-/// two are computed from the same `1/(|a| l)` with a few roundings each),
-/// which is under the sine of the smallest minimum angle a [`crate::Config`]
-/// accepts (0.1°, 1.745e-3): such a crossing is grazing, and its `cos` is
-/// never used.
-pub(crate) fn crossing_angle(a: [f32; 2], a_len: f32, chord: [f32; 2], e2: f32) -> (f32, f32) {
-    let l2 = dot(chord, chord);
-    // The chord of a validated boundary has l2 > 0 and a point away from
-    // the FOE has a_len > 0. Anything else (l2 or a_len zero or not
-    // finite) cannot pass the grazing test below: 0 · ∞ and ∞ − ∞ give a
-    // NaN sin, and a zero chord gives `sin_low` ≤ 0; the processor flags
-    // both `Grazing` (a NaN by its negated comparison).
-    let l = sqrt_pos(l2);
-    let inv = 1.0 / (a_len * l);
-    let sin = cross(a, chord).abs() * inv;
-    let cos = dot(a, chord).abs() * inv;
-    (sin - 2.0 * e2 / l, cos)
+/// The depth interval of `(s_near, s_far)` for a point whose `1/q_z` is
+/// `iz`, known to a relative `kappa` (`κ = 2Δ/q_z`, see
+/// [`crate::epipolar::PairGeometry::depth_scale_error`]); `None` when the
+/// far end is not finite or the near end not above 0.
+#[inline(always)]
+pub(crate) fn interval(s_near: f32, s_far: f32, iz: f32, kappa: f32) -> Option<DepthInterval> {
+    let z_far = s_far * (iz * (1.0 + kappa));
+    let z_near = s_near * (iz * (1.0 - kappa));
+    (z_far.is_finite() && z_near > 0.0).then_some(DepthInterval { z_near, z_far })
 }
 
-/// The stick for a match at `tau` (see the module docs), also when each
-/// component of the translation used may be off by up to `delta` (see
-/// [`crate::Config::with_translation_error`]; `spread_a = spread_w = 0`
-/// without translation error).
-///
-/// With the true translation anywhere in that box, `|a|` may differ from
-/// ours by `spread_a` and `W'` by `spread_w`
-/// ([`crate::motion_error`]); the true epipolar line is turned from ours by
-/// an angle with `sin Δθ ≤ spread_a / |a|`, which at the intersection
-/// displaces it sideways by up to `D_true sin Δθ`. With
-/// `h = h₁ + (D + ε) sin Δθ` the along-line error is
-/// `ε = r₁ + (e₂ + h |cos φ|)/sin φ`, solved for `ε` in closed form, and
-///
-/// `s_far = W'₊ + (|a| + |W'|₊ r₁ + spread_a) / (D − ε)`,
-/// `s_near = W'₋ + (|a| − |W'|₊ r₁ − spread_a) / (D + ε + h²/2(D − ε))`
-///
-/// (the last term: a sideways offset lengthens the true disparity at most by
-/// that much). `None` when the far end is unbounded.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn stick(
-    w: f32,
-    tau: f32,
-    a_len: f32,
-    r1: f32,
-    e2: f32,
-    sin_low: f32,
-    cos: f32,
-    depth_scale: f32,
-    spread_a: f32,
-    spread_w: f32,
-) -> Option<DepthInterval> {
-    if spread_a == 0.0 && spread_w == 0.0 {
-        return stick_exact(w, tau, a_len, r1, e2, sin_low, cos, depth_scale);
-    }
-    let d = tau * a_len;
-    let turn = spread_a / a_len; // ≥ sin of the angle between the lines
-    if turn.is_nan() || turn >= 1.0 || turn * cos >= sin_low {
-        return None;
-    }
-    let h1 = r1 * fmax(1.0 + (w + spread_w) * tau, 1.0 + (w - spread_w) * tau);
-    let h1 = fmax(h1, 0.0);
-    let eps = (r1 + (e2 + (h1 + d * turn) * cos) / sin_low) / (1.0 - turn * cos / sin_low);
-    if d - eps <= 0.0 {
-        return None;
-    }
-    let h = h1 + (d + eps) * turn;
-    let w_abs = w.abs() + spread_w;
-    let a_hi = a_len + w_abs * r1 + spread_a;
-    let a_lo = fmax(a_len - w_abs * r1 - spread_a, 0.0);
-    let s_far = (w + spread_w) + a_hi / (d - eps);
-    let s_near = (w - spread_w) + a_lo / (d + eps + h * h / (2.0 * (d - eps)));
-    interval(s_near, s_far, depth_scale)
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_rng::Rng;
 
-/// [`stick`] without translation error: the same formulas with the
-/// spreads at zero (the same bits), without the terms that vanish.
-#[allow(clippy::too_many_arguments)]
-#[inline]
-pub(crate) fn stick_exact(
-    w: f32,
-    tau: f32,
-    a_len: f32,
-    r1: f32,
-    e2: f32,
-    sin_low: f32,
-    cos: f32,
-    depth_scale: f32,
-) -> Option<DepthInterval> {
-    let d = tau * a_len;
-    let h1 = fmax(r1 * (1.0 + w * tau), 0.0);
-    let eps = r1 + (e2 + h1 * cos) / sin_low;
-    if d - eps <= 0.0 {
-        return None;
+    /// The band's region holds every frame-2 point the error model allows:
+    /// random true frame-1 points within `r₁`, translation errors within
+    /// the spreads, depths anywhere along the ray, and polyline points
+    /// within `e₂` of the true correspondent (computed in `f64`).
+    #[test]
+    fn band_holds_every_consistent_point() {
+        let mut rng = Rng(0xba4d_0001);
+        let mut inside = 0;
+        for case in 0..20_000 {
+            let w = match case % 3 {
+                0 => 0.3 + rng.next(),
+                1 => -(0.3 + rng.next()),
+                _ => 0.0,
+            };
+            let g = [(rng.next() - 0.5) * 300.0, (rng.next() - 0.5) * 300.0];
+            let c2 = [255.5f32, 239.5];
+            let p = [512.0 * rng.next(), 480.0 * rng.next()];
+            let a = [w * (p[0] - c2[0]) - g[0], w * (p[1] - c2[1]) - g[1]];
+            let err = PointErrors {
+                r1: 0.1 + rng.next(),
+                e2: 0.1 + rng.next(),
+                spread_a: 0.0,
+                spread_w: 0.0,
+            };
+            let Ok(band) = Band::new(p, a, w, &err, 20.0) else {
+                continue;
+            };
+            // A true point and depth.
+            let ang = rng.next() * 6.283;
+            let rad = f64::from(err.r1) * f64::from(rng.next());
+            let pt = [
+                f64::from(p[0]) + rad * f64::from(libm::cosf(ang)),
+                f64::from(p[1]) + rad * f64::from(libm::sinf(ang)),
+            ];
+            let wf = f64::from(w);
+            let at = [
+                wf * (pt[0] - f64::from(c2[0])) - f64::from(g[0]),
+                wf * (pt[1] - f64::from(c2[1])) - f64::from(g[1]),
+            ];
+            let s = 0.5 + 40.0 * f64::from(rng.next());
+            if s - wf <= 0.0 {
+                continue;
+            }
+            let tau = 1.0 / (s - wf);
+            let p2 = [pt[0] + tau * at[0], pt[1] + tau * at[1]];
+            // A polyline point within e2 of it.
+            let ang2 = rng.next() * 6.283;
+            let rad2 = f64::from(err.e2) * f64::from(rng.next());
+            let q = [
+                (p2[0] + rad2 * f64::from(libm::cosf(ang2))) as f32,
+                (p2[1] + rad2 * f64::from(libm::sinf(ang2))) as f32,
+            ];
+            let c = band.coords(q);
+            assert!(
+                band.clip(c, c).is_some(),
+                "case {case}: q {q:?} outside the band of {p:?} (w {w})"
+            );
+            inside += 1;
+        }
+        assert!(inside > 10_000, "{inside}");
     }
-    let wr = w.abs() * r1;
-    let s_far = w + (a_len + wr) / (d - eps);
-    // `|a| > |W'| r₁` here: the processor flags a point whose disc holds the
-    // FOE (`|a|² ≤ (|W'| max(r₁, 10⁻³))²`, `AtFoe`) before this. Within an
-    // ulp of that guard `|a| − |W'| r₁` may round below zero; that only
-    // lowers `s_near`, a longer stick, still a bound. (`stick` keeps the
-    // clamp: its spreads can exceed the guard's margin.)
-    let s_near = w + (a_len - wr) / (d + eps + h1 * h1 / (2.0 * (d - eps)));
-    interval(s_near, s_far, depth_scale)
-}
-
-/// The stick from the ends in the compensated frame (`Z = s / q_z`).
-#[inline]
-fn interval(s_near: f32, s_far: f32, depth_scale: f32) -> Option<DepthInterval> {
-    let z_far = s_far / depth_scale;
-    let z_near = fmax(s_near / depth_scale, 0.0);
-    (z_far.is_finite() && z_far >= z_near).then_some(DepthInterval { z_near, z_far })
 }

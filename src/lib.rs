@@ -38,25 +38,31 @@ pub mod boundary;
 mod buffer;
 pub mod calibration;
 pub mod camera;
+mod config;
 pub mod depth;
 pub mod epipolar;
 pub mod geometry;
+mod matching;
 mod math;
 pub mod motion;
 pub mod motion_error;
+mod pencil;
 pub mod processor;
+mod search;
+#[cfg(feature = "_reference")]
+#[doc(hidden)]
+pub use search::probe;
+mod structure;
 
 pub use boundary::{Boundary, BoundaryError, Frame};
 pub use camera::{Camera, CameraError, Pixel, IMAGE_MARGIN_PX};
+pub use config::{Config, ConfigError};
 pub use depth::DepthInterval;
-pub use epipolar::{
-    Crossing, CrossingSearch, Crossings, EpipolarLine, PairGeometry, MAX_CROSSINGS,
-    MAX_RAY_CROSSINGS,
-};
+pub use epipolar::PairGeometry;
 pub use motion::{Motion, MotionError};
-pub use processor::{
-    BoundaryStructure, Config, ConfigError, PointResult, ProcessError, Processor, Status, Step,
-    Structure,
+pub use processor::Processor;
+pub use structure::{
+    BoundaryStructure, PointResult, ProcessError, Status, Step, Structure, FOLD_WINDOW, MAX_PIECES,
 };
 
 // The README's Rust examples are compiled and run as doc tests.

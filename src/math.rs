@@ -61,7 +61,7 @@ fn sqrt_estimate(x: f32) -> f32 {
 /// `|x| ≤ π/2` the Taylor series to x¹³ is exact to ~6e-11 before rounding;
 /// evaluated in Horner form in `f32`. The test `sin_cos_match_libm` pins
 /// the error at 3e-7.
-pub(crate) fn sin_cos(x: f32) -> (f32, f32) {
+pub(crate) const fn sin_cos(x: f32) -> (f32, f32) {
     let x2 = x * x;
     let s = x
         * (1.0
@@ -161,27 +161,6 @@ pub(crate) fn fmin(a: f32, b: f32) -> f32 {
     }
 }
 
-/// Smallest integer ≥ `x`, for `|x| < 2³¹` (no `libm` call).
-#[inline]
-pub(crate) fn ceil_i32(x: f32) -> i32 {
-    let t = x as i32;
-    if (t as f32) < x {
-        t + 1
-    } else {
-        t
-    }
-}
-
-/// The smallest `f32` greater than `x` (finite `x`).
-#[inline]
-pub(crate) fn next_up(x: f32) -> f32 {
-    if x == 0.0 {
-        return f32::from_bits(1);
-    }
-    let b = x.to_bits();
-    f32::from_bits(if x > 0.0 { b + 1 } else { b - 1 })
-}
-
 /// 2-D cross product `a.x*b.y - a.y*b.x`.
 #[inline]
 pub(crate) fn cross(a: [f32; 2], b: [f32; 2]) -> f32 {
@@ -198,39 +177,6 @@ pub(crate) fn dot(a: [f32; 2], b: [f32; 2]) -> f32 {
 #[inline]
 pub(crate) fn sub(a: [f32; 2], b: [f32; 2]) -> [f32; 2] {
     [a[0] - b[0], a[1] - b[1]]
-}
-
-/// A "pseudo-angle" of a direction: a number in `[0, 4)` that increases
-/// strictly with the true angle, starting at straight up in the image
-/// (`-y`, since `y` points down) and turning clockwise on screen
-/// (up → right → down → left). One division, no trigonometry.
-/// The zero vector maps to 0 (callers treat that case separately).
-#[inline]
-pub(crate) fn pseudo_angle(d: [f32; 2]) -> f32 {
-    if d[0].abs() + d[1].abs() <= 0.0 {
-        return 0.0;
-    }
-    pseudo_angle_nonzero(d)
-}
-
-/// [`pseudo_angle`] of a vector the caller knows not to be zero (the same
-/// bits without the check).
-#[inline]
-pub(crate) fn pseudo_angle_nonzero(d: [f32; 2]) -> f32 {
-    // Rotate so that "up" (0,-1) becomes the +x axis: (x, y) -> (-y, x).
-    let x = -d[1];
-    let y = d[0];
-    let l1 = x.abs() + y.abs();
-    let p = y / l1; // in [-1, 1]
-    if x >= 0.0 {
-        if y >= 0.0 {
-            p // [0, 1]
-        } else {
-            4.0 + p // (3, 4)
-        }
-    } else {
-        2.0 - p // (1, 3]
-    }
 }
 
 /// A 3×3 matrix, row major.
@@ -265,20 +211,6 @@ pub(crate) const MAX_TRANSLATION: f32 = 1.0e6;
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn pseudo_angle_is_monotone_in_the_true_angle() {
-        let mut last = -1.0;
-        for i in 0..3600 {
-            // True angle measured from "up", clockwise on screen.
-            let t = (i as f32) * core::f32::consts::PI * 2.0 / 3600.0;
-            let d = [libm::sinf(t), -libm::cosf(t)];
-            let p = pseudo_angle(d);
-            assert!(p > last, "not increasing at step {i}: {p} <= {last}");
-            assert!((0.0..4.0).contains(&p));
-            last = p;
-        }
-    }
 
     #[test]
     fn sqrt_estimate_is_micromaths() {
@@ -348,21 +280,5 @@ mod tests {
             let x = i as f32 * 0.01;
             assert!((asin(x) - libm::asinf(x)).abs() <= 1.0e-6, "asin({x})");
         }
-    }
-
-    #[test]
-    fn integer_rounding() {
-        for (x, c, f) in [(1.5f32, 2, 1), (-1.5, -1, -2), (2.0, 2, 2), (-0.0, 0, 0)] {
-            assert_eq!(ceil_i32(x), c);
-            assert_eq!(-ceil_i32(-x), f);
-        }
-    }
-
-    #[test]
-    fn pseudo_angle_cardinal_directions() {
-        assert_eq!(pseudo_angle([0.0, -1.0]), 0.0);
-        assert_eq!(pseudo_angle([1.0, 0.0]), 1.0);
-        assert_eq!(pseudo_angle([0.0, 1.0]), 2.0);
-        assert_eq!(pseudo_angle([-1.0, 0.0]), 3.0);
     }
 }

@@ -59,14 +59,15 @@ pub fn depth_of_correspondence(
 ) -> Option<f32> {
     let g = PairGeometry::new(cam1, cam2, motion);
     let c = g.compensate(p1)?;
-    let line = g.line(&c);
+    let a = g.epipolar_vector(c.pixel);
+    let a2 = dot(a, a);
     let d = [p2.u - c.pixel[0], p2.v - c.pixel[1]];
-    let ad = dot(line.a, d);
-    if ad.is_nan() || ad <= 0.0 || line.a2 <= 0.0 {
+    let ad = dot(a, d);
+    if ad.is_nan() || ad <= 0.0 || a2 <= 0.0 {
         return None;
     }
-    let s = g.w() + line.a2 / ad;
-    let z = s / c.depth_scale;
+    let s = g.w() + a2 / ad;
+    let z = s * c.inv_depth_scale;
     z.is_finite().then_some(z)
 }
 
@@ -83,10 +84,9 @@ pub fn depth_sensitivity(
 ) -> Option<[f32; 3]> {
     let g = PairGeometry::new(cam1, cam2, motion);
     let c = g.compensate(p1)?;
-    let line = g.line(&c);
-    let a = line.a;
+    let a = g.epipolar_vector(c.pixel);
     let d = [p2.u - c.pixel[0], p2.v - c.pixel[1]];
-    let (aa, ad) = (line.a2, dot(a, d));
+    let (aa, ad) = (dot(a, a), dot(a, d));
     if ad.is_nan() || ad <= 0.0 || aa <= 0.0 {
         return None;
     }
@@ -101,7 +101,7 @@ pub fn depth_sensitivity(
     // ∂s/∂T = R ∂s/∂T' (T' = Rᵀ T), then Z = s / q_z.
     let r = motion.rotation_matrix();
     let grad = mat3_vec(&r, grad_tp);
-    let inv = 1.0 / c.depth_scale;
+    let inv = c.inv_depth_scale;
     let out = grad.map(|x| x * inv);
     out.iter().all(|x| x.is_finite()).then_some(out)
 }
@@ -176,8 +176,8 @@ pub fn depth_on_boundary(
 ) -> Option<f32> {
     let g = PairGeometry::new(cam1, cam2, motion);
     let c = g.compensate(p1)?;
-    let line = g.line(&c);
-    let den = crate::math::cross(line.a, dir);
+    let a = g.epipolar_vector(c.pixel);
+    let den = crate::math::cross(a, dir);
     if den == 0.0 || den.is_nan() {
         return None;
     }
@@ -185,7 +185,7 @@ pub fn depth_on_boundary(
     if tau.is_nan() || tau <= 0.0 {
         return None;
     }
-    let z = (g.w() + 1.0 / tau) / c.depth_scale;
+    let z = (g.w() + 1.0 / tau) * c.inv_depth_scale;
     (z.is_finite() && z > 0.0).then_some(z)
 }
 

@@ -1,6 +1,6 @@
 //! Host-side support for testing roadstereo: the synthetic road generator
-//! (independent `f64` geometry), scenario sets, a brute-force crossing
-//! search, and helpers shared by the tests and the host tools.
+//! (independent `f64` geometry), scenario sets, and helpers shared by the
+//! tests and the host tools.
 
 pub mod calib;
 pub mod drive;
@@ -8,34 +8,12 @@ pub mod jsonl;
 pub mod scenarios;
 pub mod synth;
 
-use roadstereo::{Crossing, CrossingSearch, EpipolarLine, Frame, Pixel, Processor};
+use roadstereo::{Frame, Pixel, Processor};
 
 /// Capacity used by the host tests: one point per row of a 480-row image fits.
 pub const N: usize = 512;
 /// Boundaries per frame (left, right).
 pub const B: usize = 2;
-
-/// The reference matcher: every segment against the line.
-#[derive(Debug, Default)]
-pub struct BruteForce;
-
-impl CrossingSearch for BruteForce {
-    fn prepare(&mut self, _boundary: &[Pixel], _key: &roadstereo::epipolar::PencilKey) {}
-    fn search<F: FnMut(Crossing) -> bool>(
-        &mut self,
-        line: &EpipolarLine,
-        boundary: &[Pixel],
-        mut visit: F,
-    ) {
-        for j in 0..boundary.len().saturating_sub(1) {
-            if let Some(c) = line.crossing(j, boundary[j], boundary[j + 1]) {
-                if !visit(c) {
-                    return;
-                }
-            }
-        }
-    }
-}
 
 /// Build a frame from pixel polylines (panics on invalid input: test helper).
 pub fn frame(camera: roadstereo::Camera, boundaries: &[Vec<Pixel>]) -> Frame<N, B> {

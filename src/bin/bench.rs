@@ -17,10 +17,7 @@ use core::hint::black_box;
 
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
-use roadstereo::{
-    epipolar::IndexedSearch, Config, CrossingSearch, Crossings, Frame, PairGeometry, Processor,
-    Structure,
-};
+use roadstereo::{Config, Frame, Processor, Structure};
 
 static BENCH: [(u32, &[u8]); 5] = [
     (32, include_bytes!("data/bench_32.bin")),
@@ -152,7 +149,6 @@ fn main() -> ! {
             r.processed
         );
         if *n == 256 {
-            stages(&f1, &f2, &m);
             processor.reset();
             let _ = processor.process(&f1, None);
             let bytes = stack::high_water(|| {
@@ -177,80 +173,17 @@ fn main() -> ! {
             r.processed
         );
     }
-    defmt::info!(
-        "sizes processor_256_2={=u32} frame_256_2={=u32} structure_256_2={=u32} search_256={=u32}",
+    let (p, f, s) = (
         core::mem::size_of::<Processor<256, 2>>() as u32,
         core::mem::size_of::<Frame<256, 2>>() as u32,
         core::mem::size_of::<Structure<256, 2>>() as u32,
-        core::mem::size_of::<IndexedSearch<256>>() as u32
+    );
+    defmt::info!(
+        "sizes processor_256_2={=u32} frame_256_2={=u32} structure_256_2={=u32} search_256={=u32}",
+        p,
+        f,
+        s,
+        p - f - s
     );
     fw::exit(true)
-}
-
-/// Cost of each stage at N = 256, through the public API.
-fn stages(f1: &Frame<CAP, 2>, f2: &Frame<CAP, 2>, m: &roadstereo::Motion) {
-    let pts = f1
-        .boundaries()
-        .iter()
-        .map(|b| b.points().len())
-        .sum::<usize>() as u32;
-    let (geom, g_instr) = fw::measure(|| PairGeometry::new(f1.camera(), f2.camera(), black_box(m)));
-    defmt::info!(
-        "stage name=geometry instr={=u32} per_point={=u32}",
-        g_instr,
-        g_instr / pts
-    );
-    let (_, c_instr) = fw::measure(|| {
-        for b in f1.boundaries() {
-            for p in b.points() {
-                if let Some(c) = geom.compensate(black_box(*p)) {
-                    black_box(geom.line(&c));
-                }
-            }
-        }
-    });
-    defmt::info!(
-        "stage name=compensate_and_line instr={=u32} per_point={=u32}",
-        c_instr,
-        c_instr / pts
-    );
-    // The key the processor uses for a boundary (half-plane when it can).
-    let key_for = |b: &[roadstereo::Pixel]| match (b.first(), b.last()) {
-        (Some(f), Some(l)) => geom.half_key(f.v, l.v).unwrap_or(*geom.key()),
-        _ => *geom.key(),
-    };
-    let mut index = IndexedSearch::<CAP>::new();
-    let (_, p_instr) = fw::measure(|| {
-        for b in f2.boundaries() {
-            index.prepare(black_box(b.points()), &key_for(b.points()));
-        }
-    });
-    defmt::info!(
-        "stage name=index_build instr={=u32} per_point={=u32}",
-        p_instr,
-        p_instr / pts
-    );
-    let mut found = 0u32;
-    let (_, s_instr) = fw::measure(|| {
-        for (b1, b2) in f1.boundaries().iter().zip(f2.boundaries()) {
-            index.prepare(b2.points(), &key_for(b2.points()));
-            for p in b1.points() {
-                if let Some(c) = geom.compensate(*p) {
-                    let line = geom.line(&c);
-                    if line.a2 > 0.0 {
-                        let mut out = Crossings::new();
-                        index.collect(black_box(&line), b2.points(), &mut out);
-                        found += out.len() as u32;
-                    }
-                }
-            }
-        }
-    });
-    let search = s_instr.saturating_sub(c_instr + p_instr);
-    defmt::info!(
-        "stage name=search instr={=u32} per_point={=u32} crossings={=u32}",
-        search,
-        search / pts,
-        found
-    );
 }

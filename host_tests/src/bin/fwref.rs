@@ -39,7 +39,7 @@ fn main() -> std::process::ExitCode {
                 let c = s.status_counts();
                 let g = |st: Status| c[st as usize];
                 println!(
-                    "frame={} points={} ok={} ambiguous={} at_foe={} behind={} no_intersection={} tangled={} grazing={} nonpositive={} beyond={} unbounded={} folded={} digest={:08x}",
+                    "frame={} points={} ok={} ambiguous={} at_foe={} behind={} no_intersection={} tangled={} grazing={} nonpositive={} beyond={} unbounded={} folded={} out_of_view={} boundary_end={} over_budget={} digest={:08x}",
                     i,
                     c.iter().sum::<usize>(),
                     g(Status::Ok),
@@ -53,6 +53,9 @@ fn main() -> std::process::ExitCode {
                     g(Status::BeyondMaxDepth),
                     g(Status::Unbounded),
                     g(Status::Folded),
+                    g(Status::OutOfView),
+                    g(Status::BoundaryEnd),
+                    g(Status::OverBudget),
                     s.digest()
                 );
             }

@@ -1,0 +1,356 @@
+//! What the processor gives back: per point a status, the matched frame-2
+//! pixel, the depth and its stick; per frame the structure of every
+//! boundary, in frame-1 camera coordinates.
+
+use core::fmt;
+
+use crate::buffer::Buffer;
+use crate::camera::{Camera, Pixel};
+use crate::depth::DepthInterval;
+
+/// At most this many separate pieces of a boundary in one point's error
+/// band are told apart ([`Status::Ambiguous`]); more is [`Status::Tangled`].
+pub const MAX_PIECES: usize = 8;
+
+/// Outcome for one frame-1 boundary point. Only [`Status::Ok`] is unflagged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u8)]
+pub enum Status {
+    /// Matched; depth and stick given. The band of the point's error
+    /// meets the corresponding frame-2 boundary in one piece, the exact
+    /// epipolar line crosses it there, and the stick is bounded.
+    Ok,
+    /// The band meets the boundary in 2 to [`MAX_PIECES`] separate pieces:
+    /// the correspondence is not unique. Depth from the crossing nearest
+    /// the rotated point along the epipolar line (smallest disparity), and
+    /// a stick covering every piece; flagged.
+    Ambiguous,
+    /// The point's error disc holds the focus of expansion, or the point is
+    /// too close to it for its band to be told from the FOE's: no disparity.
+    AtFoe,
+    /// After rotation compensation the ray points behind the frame-2 camera,
+    /// or the depth scale `q_z` is not known to better than half its value.
+    BehindCamera,
+    /// The band does not meet the corresponding frame-2 boundary, or the
+    /// exact epipolar line does not cross it within the band (or frame 2
+    /// has no boundary with this index).
+    #[default]
+    NoIntersection,
+    /// The band meets the boundary in more than [`MAX_PIECES`] pieces.
+    Tangled,
+    /// A piece of the boundary in the band is longer than the band's width
+    /// over the tangent of the minimum angle: the boundary crosses the
+    /// epipolar line flatter than the minimum angle (or runs along it).
+    Grazing,
+    /// The triangulated depth is not positive (numerically degenerate).
+    NonPositiveDepth,
+    /// The depth exceeds [`crate::Config::max_depth`].
+    BeyondMaxDepth,
+    /// The stick says nothing: the disparity is not larger than its error
+    /// (no far end), or the near end is not above zero.
+    Unbounded,
+    /// The point's epipolar line meets the frame-1 boundary again, more
+    /// than [`FOLD_WINDOW`] points away: the boundary folds across the
+    /// epipolar lines, so a frame-2 crossing may be the image of another
+    /// part of the curve (one possibly not visible in frame 2). Not
+    /// searched; no depth.
+    Folded,
+    /// After rotation compensation the point lies far outside the frame-2
+    /// image (beyond one image size from its edges): no plausible
+    /// correspondence (see [`crate::epipolar::PairGeometry`]).
+    OutOfView,
+    /// The band reaches past an end of the frame-2 boundary (its first or
+    /// last point lies in the band): the true crossing may lie beyond what
+    /// frame 2 detected, so no stick can be guaranteed.
+    BoundaryEnd,
+    /// The frame's work budget ([`crate::Config::with_work_budget`]) was
+    /// spent before this point's search could finish: no depth, and the
+    /// frame did not run late.
+    OverBudget,
+}
+
+/// Points on either side of a point whose segments the fold test skips.
+pub const FOLD_WINDOW: usize = 4;
+
+impl Status {
+    /// Whether a depth, 3-D point and stick are given.
+    pub fn has_depth(self) -> bool {
+        matches!(self, Status::Ok | Status::Ambiguous)
+    }
+    /// Whether a frame-2 crossing was chosen.
+    pub fn has_match(self) -> bool {
+        matches!(
+            self,
+            Status::Ok
+                | Status::Ambiguous
+                | Status::NonPositiveDepth
+                | Status::BeyondMaxDepth
+                | Status::Unbounded
+        )
+    }
+    /// Whether the point is flagged (anything but [`Status::Ok`]).
+    pub fn is_flagged(self) -> bool {
+        self != Status::Ok
+    }
+    /// Short lower-case name, as used in the replay output.
+    pub fn name(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Ambiguous => "ambiguous",
+            Status::AtFoe => "at_foe",
+            Status::BehindCamera => "behind_camera",
+            Status::NoIntersection => "no_intersection",
+            Status::Tangled => "tangled",
+            Status::Grazing => "grazing",
+            Status::NonPositiveDepth => "non_positive_depth",
+            Status::BeyondMaxDepth => "beyond_max_depth",
+            Status::Unbounded => "unbounded",
+            Status::Folded => "folded",
+            Status::OutOfView => "out_of_view",
+            Status::BoundaryEnd => "boundary_end",
+            Status::OverBudget => "over_budget",
+        }
+    }
+    /// Every status, in declaration order.
+    pub const ALL: [Status; 14] = [
+        Status::Ok,
+        Status::Ambiguous,
+        Status::AtFoe,
+        Status::BehindCamera,
+        Status::NoIntersection,
+        Status::Tangled,
+        Status::Grazing,
+        Status::NonPositiveDepth,
+        Status::BeyondMaxDepth,
+        Status::Unbounded,
+        Status::Folded,
+        Status::OutOfView,
+        Status::BoundaryEnd,
+        Status::OverBudget,
+    ];
+}
+
+impl fmt::Display for Status {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Result for one frame-1 boundary point (32 bytes).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PointResult {
+    pub(crate) pixel1: Pixel,
+    pub(crate) pixel2: Pixel,
+    pub(crate) z: f32,
+    pub(crate) z_near: f32,
+    pub(crate) z_far: f32,
+    pub(crate) status: Status,
+}
+
+impl PointResult {
+    /// No result (what unused output entries hold).
+    pub(crate) const EMPTY: Self = Self {
+        pixel1: Pixel::new(0.0, 0.0),
+        pixel2: Pixel::new(0.0, 0.0),
+        z: 0.0,
+        z_near: 0.0,
+        z_far: 0.0,
+        status: Status::NoIntersection,
+    };
+
+    /// A flagged result for `pixel1`.
+    #[inline(always)]
+    pub(crate) fn flagged(pixel1: Pixel, status: Status) -> Self {
+        Self {
+            pixel1,
+            status,
+            ..Self::EMPTY
+        }
+    }
+
+    /// The outcome.
+    pub fn status(&self) -> Status {
+        self.status
+    }
+    /// The frame-1 pixel (as given, before rotation compensation).
+    pub fn pixel1(&self) -> Pixel {
+        self.pixel1
+    }
+    /// The matched frame-2 pixel (on the frame-2 polyline), if a crossing
+    /// was chosen.
+    pub fn pixel2(&self) -> Option<Pixel> {
+        self.status.has_match().then_some(self.pixel2)
+    }
+    /// Depth `Z` in frame-1 camera coordinates, if given.
+    pub fn depth(&self) -> Option<f32> {
+        self.status.has_depth().then_some(self.z)
+    }
+    /// The stick `[Z_near, Z_far]`, if given.
+    pub fn interval(&self) -> Option<DepthInterval> {
+        self.status.has_depth().then_some(DepthInterval {
+            z_near: self.z_near,
+            z_far: self.z_far,
+        })
+    }
+}
+
+/// Per-point results of one boundary, in the order of its frame-1 points.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct BoundaryStructure<const N: usize> {
+    pub(crate) points: Buffer<PointResult, N>,
+}
+
+impl<const N: usize> BoundaryStructure<N> {
+    pub(crate) const EMPTY: Self = Self {
+        points: Buffer::new(PointResult::EMPTY),
+    };
+
+    /// The per-point results.
+    pub fn points(&self) -> &[PointResult] {
+        self.points.as_slice()
+    }
+}
+
+/// The 3-D road structure recovered from one frame pair, in frame-1 camera
+/// coordinates.
+///
+/// Its storage is `B` slots of `N` results, filled once when the processor
+/// is made; each frame only sets how many are live.
+#[derive(Clone)]
+pub struct Structure<const N: usize, const B: usize> {
+    pub(crate) camera1: Camera,
+    pub(crate) slots: [BoundaryStructure<N>; B],
+    pub(crate) count: usize,
+}
+
+impl<const N: usize, const B: usize> PartialEq for Structure<N, B> {
+    fn eq(&self, other: &Self) -> bool {
+        self.camera1 == other.camera1 && self.boundaries() == other.boundaries()
+    }
+}
+
+impl<const N: usize, const B: usize> fmt::Debug for Structure<N, B> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Structure")
+            .field("camera1", &self.camera1)
+            .field("boundaries", &self.boundaries())
+            .finish()
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl<const N: usize, const B: usize> defmt::Format for Structure<N, B> {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "Structure {{ camera1: {}, boundaries: {} }}",
+            self.camera1,
+            self.boundaries()
+        )
+    }
+}
+
+impl<const N: usize, const B: usize> Structure<N, B> {
+    pub(crate) const EMPTY: Self = Self {
+        camera1: Camera::PLACEHOLDER,
+        slots: [BoundaryStructure::EMPTY; B],
+        count: 0,
+    };
+
+    /// Per-boundary results (index as in frame 1).
+    pub fn boundaries(&self) -> &[BoundaryStructure<N>] {
+        self.slots.get(..self.count).unwrap_or(&[])
+    }
+
+    /// The camera of frame 1, in whose coordinates the points are given.
+    pub fn camera1(&self) -> &Camera {
+        &self.camera1
+    }
+
+    /// 3-D point `(X, Y, Z)` of a result: `X = x₁ Z`, `Y = y₁ Z` (eq. 2.3).
+    pub fn point(&self, r: &PointResult) -> Option<[f32; 3]> {
+        let z = r.depth()?;
+        let (x, y) = self.camera1.normalise(r.pixel1);
+        Some([x * z, y * z, z])
+    }
+
+    /// The stick's two 3-D end points (near, far) on the frame-1 ray.
+    pub fn stick(&self, r: &PointResult) -> Option<([f32; 3], [f32; 3])> {
+        let i = r.interval()?;
+        let (x, y) = self.camera1.normalise(r.pixel1);
+        Some((
+            [x * i.z_near, y * i.z_near, i.z_near],
+            [x * i.z_far, y * i.z_far, i.z_far],
+        ))
+    }
+
+    /// A 32-bit FNV-1a digest of every result, bit for bit (status, both
+    /// pixels, depth and stick of every point, boundary by boundary): two
+    /// runs agree exactly iff their digests agree (up to hash collisions).
+    /// Used to check that the firmware computes what the host computes.
+    pub fn digest(&self) -> u32 {
+        let mut h: u32 = 0x811c_9dc5;
+        let mut eat = |x: u32| {
+            for b in x.to_le_bytes() {
+                h = (h ^ u32::from(b)).wrapping_mul(0x0100_0193);
+            }
+        };
+        for b in self.boundaries() {
+            eat(0xB0B0_B0B0);
+            for r in b.points() {
+                eat(r.status as u32);
+                for x in [
+                    r.pixel1.u, r.pixel1.v, r.pixel2.u, r.pixel2.v, r.z, r.z_near, r.z_far,
+                ] {
+                    eat(x.to_bits());
+                }
+            }
+        }
+        h
+    }
+
+    /// How many points have each status, indexed like [`Status::ALL`].
+    pub fn status_counts(&self) -> [usize; Status::ALL.len()] {
+        let mut c = [0usize; Status::ALL.len()];
+        for r in self.boundaries().iter().flat_map(|b| b.points()) {
+            if let Some(slot) = c.get_mut(r.status as usize) {
+                *slot += 1;
+            }
+        }
+        c
+    }
+}
+
+/// What [`crate::Processor::process`] produced.
+#[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Step<'a, const N: usize, const B: usize> {
+    /// There was no previous frame: this one is kept, nothing reconstructed.
+    First,
+    /// The structure recovered from the previous frame and this one.
+    Structure(&'a Structure<N, B>),
+}
+
+/// Why a frame was rejected. The kept state is unchanged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ProcessError {
+    /// A previous frame exists but no motion was given.
+    MissingMotion,
+    /// [`crate::Processor::process_against_kept`] was called with no kept frame.
+    NoKeptFrame,
+}
+
+impl core::error::Error for ProcessError {}
+
+impl fmt::Display for ProcessError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::MissingMotion => "a motion from the previous frame is required",
+            Self::NoKeptFrame => "there is no kept frame to reconstruct against",
+        })
+    }
+}

@@ -125,8 +125,9 @@ pub(crate) enum NoBand {
 }
 
 /// One point's error band, in the coordinates of its epipolar line scaled
-/// by `|a|` (`λ' = a·(q − p₁') = |a| λ`, `μ' = a × (q − p₁') = |a| μ`), and
-/// the terms of its stick.
+/// by `|a|` (`λ' = a·(q − p₁') = |a| λ`, `μ' = a × (q − p₁') = |a| μ`): the
+/// region `|μ'| ≤ k0 + h λ'`, `lam_lo ≤ λ' ≤ lam_hi`. The stick's terms are
+/// worked out only for a point that gets a match ([`Band::depths`]).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Band {
     /// `p₁'`.
@@ -136,20 +137,11 @@ pub(crate) struct Band {
     /// `|a|²`, `|a|`.
     pub(crate) a2: f32,
     pub(crate) a_len: f32,
-    /// The region: `|μ'| ≤ k0 + h λ'` for `lam_lo ≤ λ' ≤ lam_hi`.
     pub(crate) k0: f32,
     pub(crate) h: f32,
     pub(crate) lam_lo: f32,
     pub(crate) lam_hi: f32,
-    /// The stick: `s_far = w_hi + num_hi/(L₋' − r1a)`,
-    /// `s_near = w_lo + num_lo/(L₊' + r1a)`; `e2a = e₂|a|`.
     w: f32,
-    w_hi: f32,
-    w_lo: f32,
-    num_hi: f32,
-    num_lo: f32,
-    r1a: f32,
-    e2a: f32,
     /// The tangent of the band's angular half-width as seen from the FOE,
     /// and `1/(ρ₁ − r₁ − e₂)` (for `W' > 0`; see [`Band::key_half_width`]).
     half_angle: f32,
@@ -171,7 +163,7 @@ impl Band {
     /// the module docs); `w` is `W'`.
     ///
     /// `near_foe` is the radius `m` about the FOE left to the FOE-near list
-    /// when `W' < 0` (see [`crate::search`]); the band's key interval then
+    /// when `W' < 0` (see `crate::search`); the band's key interval then
     /// covers the part at least `m` from the FOE. A point whose error disc
     /// holds the FOE (`A₋ ≤ 0`), or with `W' > 0` closer to it than
     /// `3(r₁ + e₂)`, or with `W' < 0` closer than `m + r₁ + e₂`, has no band:
@@ -198,42 +190,43 @@ impl Band {
             spread_w,
         } = *err;
         let wa = w.abs();
-        let wt = wa + spread_w;
         let re = r1 + e2;
-        let mv = spread_a + wt * r1;
+        let mv = spread_a + (wa + spread_w) * r1;
         let a_minus = a_len - mv;
-        // ρ₁ = |a|/|W'|: the guards compare |a| with |W'| × distance.
-        let guard = if w > 0.0 {
-            3.0 * wa * re
-        } else if w < 0.0 {
-            wa * (near_foe + re)
+        let (h, foe_inv, lam_hi) = if w > 0.0 && spread_a == 0.0 && spread_w == 0.0 {
+            // The usual case. 1/(ρ₁ − r₁ − e₂) = W'/(|a| − W'(r₁ + e₂)), and
+            // h = W' r₁ / A₋ ≤ r₁ W'/(|a| − W'(r₁ + e₂)): one division.
+            let d = a_len - 3.0 * wa * re;
+            // (A NaN fails.)
+            if !(d > 0.0) {
+                return Err(NoBand::AtFoe);
+            }
+            let foe_inv = wa / (a_len - wa * re);
+            (r1 * foe_inv, foe_inv, f32::INFINITY)
         } else {
-            0.0
+            let guard = if w < 0.0 { wa * (near_foe + re) } else { 0.0 };
+            // (A NaN fails both.)
+            if !(a_minus > 0.0 && a_len > guard) {
+                return Err(NoBand::AtFoe);
+            }
+            // The slope: |μ| ≤ r₁ + τ c with τ ≤ (λ + r₁)/A₋ when c > 0,
+            // and τ ≥ (λ − r₁)/A₊ when c < 0 (the band narrows towards the
+            // FOE).
+            let c = (w + spread_w) * r1 + spread_a;
+            let h = if c > 0.0 {
+                c / a_minus
+            } else {
+                c / (a_len + mv)
+            };
+            let foe_inv = if w > 0.0 { wa / (a_len - wa * re) } else { 0.0 };
+            let lam_hi = if w + spread_w < 0.0 {
+                // r₁ + A₊/(|W'| − σ_w) + e₂, scaled by |a|.
+                (re + (a_len + mv) / (wa - spread_w)) * a_len
+            } else {
+                f32::INFINITY
+            };
+            (h, foe_inv, lam_hi)
         };
-        // (A NaN fails both.)
-        if !(a_minus > 0.0 && a_len > guard) {
-            return Err(NoBand::AtFoe);
-        }
-        // The slope: |μ| ≤ r₁ + τ c with τ ≤ (λ + r₁)/A₋ when c > 0, and
-        // τ ≥ (λ − r₁)/A₊ when c < 0 (the band narrows towards the FOE).
-        let c = (w + spread_w) * r1 + spread_a;
-        let h = if c > 0.0 {
-            c / a_minus
-        } else {
-            c / (a_len + mv)
-        };
-        let far = w + spread_w < 0.0;
-        let lam_hi = if far {
-            // r₁ + A₊/(|W'| − σ_w) + e₂, scaled by |a|.
-            (re + (a_len + mv) / (wa - spread_w)) * a_len
-        } else {
-            f32::INFINITY
-        };
-        // 1/(ρ₁ − r₁ − e₂) = |W'|/(|a| − |W'|(r₁ + e₂)) (for W' > 0).
-        let foe_inv = if w > 0.0 { wa / (a_len - wa * re) } else { 0.0 };
-        // The maximum over the band of |μ|/(ρ₁ + λ): at its near end
-        // (r₁ + e₂)/(ρ₁ − r₁ − e₂), or its slope h far out.
-        let half_angle = fmax(re * foe_inv, h);
         Ok(Self {
             p,
             a,
@@ -244,13 +237,9 @@ impl Band {
             lam_lo: -re * a_len,
             lam_hi,
             w,
-            w_hi: w + spread_w,
-            w_lo: w - spread_w,
-            num_hi: a2 + a_len * mv,
-            num_lo: a2 - a_len * mv,
-            r1a: r1 * a_len,
-            e2a: e2 * a_len,
-            half_angle,
+            // The maximum over the band of |μ|/(ρ₁ + λ): at its near end
+            // (r₁ + e₂)/(ρ₁ − r₁ − e₂), or its slope h far out.
+            half_angle: fmax(re * foe_inv, h),
             foe_inv,
         })
     }
@@ -258,7 +247,7 @@ impl Band {
     /// How wide the band's key interval is (for direction keys): its rays
     /// lie within `atan(t)` of the point's own, and `m` is the rounding
     /// margin of the point's own key (whose distance from the FOE is at
-    /// least `ρ₁ − r₁ − e₂`; `key_scale` as in [`crate::pencil::Keying`]):
+    /// least `ρ₁ − r₁ − e₂`; `key_scale` as in `crate::pencil::Keying`):
     /// `Within(t, m)`. `near_foe` as in [`Band::new`]; `exhaustive` when the
     /// FOE's position is uncertain and `W' < 0` (a translation error with
     /// backward motion: the band runs into an uncertain FOE, and every key
@@ -307,69 +296,82 @@ impl Band {
         [at(near, 1.0), at(near, -1.0), at(far, 1.0), at(far, -1.0)]
     }
 
-    /// `(λ', μ')` of a frame-2 vertex.
+    /// A frame-2 vertex in the band's frame: `(λ', μ')`, the values of the
+    /// two edge functions `g± = k0 + h λ' ∓ μ'` (inside the wedge when both
+    /// are ≥ 0) and its outcode: bit 0 beyond the `+` edge, bit 1 beyond
+    /// the `−` edge, bit 2 before `lam_lo`, bit 3 after `lam_hi`.
     #[inline(always)]
-    pub(crate) fn coords(&self, v: [f32; 2]) -> Coords {
+    pub(crate) fn vertex(&self, v: [f32; 2]) -> Vertex {
         let d = [v[0] - self.p[0], v[1] - self.p[1]];
-        Coords {
-            lam: dot(self.a, d),
-            mu: cross(self.a, d),
+        let lam = dot(self.a, d);
+        let mu = cross(self.a, d);
+        let base = self.k0 + self.h * lam;
+        let (gp, gm) = (base - mu, base + mu);
+        // Sign bits (−0 made +0: a vertex on an edge is inside).
+        let out = ((gp + 0.0).to_bits() >> 31)
+            | (((gm + 0.0).to_bits() >> 31) << 1)
+            | (u32::from(lam < self.lam_lo) << 2)
+            | (u32::from(lam > self.lam_hi) << 3);
+        Vertex {
+            lam,
+            mu,
+            gp,
+            gm,
+            out,
         }
     }
 
-    /// The part of the segment between two vertices (with their
-    /// [`Band::coords`]) that lies in the band's region, as its range of
-    /// `λ'`, and the exact line's crossing of the segment if it is in the
-    /// band: `None` when the segment misses the region.
+    /// The part of the segment `a → b` (two [`Band::vertex`]es) in the
+    /// band's region, as its range of `λ'`, and the exact line's crossing
+    /// of the segment, `(t along it, λ')`; `None` when the segment misses
+    /// the region. Cohen–Sutherland by the outcodes: both ends beyond one
+    /// edge is a miss at once; a segment wholly inside needs no division;
+    /// each edge one end crosses costs one (where the segment meets it).
     #[inline(always)]
-    pub(crate) fn clip(&self, c0: Coords, c1: Coords) -> Option<Clipped> {
-        // The two edges: g± = k0 + h λ' ∓ μ' ≥ 0 (linear along the segment).
-        let base0 = self.k0 + self.h * c0.lam;
-        let base1 = self.k0 + self.h * c1.lam;
-        let (gp0, gp1) = (base0 - c0.mu, base1 - c1.mu);
-        let (gm0, gm1) = (base0 + c0.mu, base1 + c1.mu);
-        // Outside one edge entirely (NaN fails `>=` below and is outside).
-        if (gp0 < 0.0 && gp1 < 0.0) || (gm0 < 0.0 && gm1 < 0.0) {
+    pub(crate) fn segment(&self, a: &Vertex, b: &Vertex) -> Option<Clipped> {
+        if a.out & b.out != 0 {
             return None;
         }
+        let dl = b.lam - a.lam;
         let (mut t0, mut t1) = (0.0f32, 1.0f32);
-        for (g0, g1) in [(gp0, gp1), (gm0, gm1)] {
-            if g0 < 0.0 {
-                t0 = fmax(t0, g0 / (g0 - g1));
-            } else if g1 < 0.0 {
-                t1 = fmin(t1, g0 / (g0 - g1));
-            } else if !(g0 >= 0.0 && g1 >= 0.0) {
+        let crossed = (a.out | b.out) & 3;
+        if crossed != 0 {
+            // The wedge's edges, each a line: where the segment crosses one
+            // that an end lies beyond, it enters or leaves the region.
+            for (bit, ga, gb) in [(1u32, a.gp, b.gp), (2u32, a.gm, b.gm)] {
+                if crossed & bit != 0 {
+                    let t = ga / (ga - gb);
+                    if ga < 0.0 {
+                        t0 = fmax(t0, t);
+                    } else {
+                        t1 = fmin(t1, t);
+                    }
+                }
+            }
+            // (A NaN fails.)
+            if !(t0 <= t1) {
                 return None;
             }
         }
-        if t0 > t1 {
-            return None;
+        let (la, lb) = (a.lam + t0 * dl, a.lam + t1 * dl);
+        let (mut lo, mut hi) = if dl >= 0.0 { (la, lb) } else { (lb, la) };
+        if (a.out | b.out) & 12 != 0 {
+            (lo, hi) = (fmax(lo, self.lam_lo), fmin(hi, self.lam_hi));
+            if !(lo <= hi) {
+                return None;
+            }
         }
-        let dl = c1.lam - c0.lam;
-        let (la, lb) = (c0.lam + t0 * dl, c0.lam + t1 * dl);
-        let (lo, hi) = if la <= lb { (la, lb) } else { (lb, la) };
-        let (lo, hi) = (fmax(lo, self.lam_lo), fmin(hi, self.lam_hi));
-        // (A NaN fails.)
-        if !(lo <= hi) {
-            return None;
-        }
-        // The exact line μ' = 0 between the vertices: a sign change (a
-        // vertex on the line counts as on the positive side).
-        let crossing = if side_bit(c0.mu) != side_bit(c1.mu) {
-            let t = c0.mu / (c0.mu - c1.mu);
-            let lam = c0.lam + t * dl;
-            (lam > self.lam_lo && lam < self.lam_hi).then_some((t, fmin(fmax(lam, lo), hi)))
-        } else {
-            None
-        };
+        let crossing = (side_bit(a.mu) != side_bit(b.mu)).then(|| {
+            let t = a.mu / (a.mu - b.mu);
+            (t, a.lam + t * dl)
+        });
         Some(Clipped { lo, hi, crossing })
     }
 
-    /// Whether a vertex (its [`Band::coords`]) lies in the band's region.
+    /// Whether a vertex lies in the band's region.
     #[inline(always)]
-    pub(crate) fn contains(&self, c: Coords) -> bool {
-        let half = self.k0 + self.h * c.lam;
-        c.mu.abs() <= half && c.lam >= self.lam_lo && c.lam <= self.lam_hi
+    pub(crate) fn contains(v: &Vertex) -> bool {
+        v.out == 0
     }
 
     /// Whether a piece of the band from `lo` to `hi` (`λ'`) is longer than
@@ -383,17 +385,27 @@ impl Band {
     /// The depth estimate and the stick in the compensated frame, `(s,
     /// s_near, s_far)`, for the exact crossing at `lam` (`λ'`, within
     /// `[lo, hi]`) and the hull `[lo, hi]` of all pieces (`λ'`); `None` when
-    /// the far end is unbounded.
+    /// the far end is unbounded. `err` as for [`Band::new`].
     #[inline(always)]
-    pub(crate) fn depths(&self, lam: f32, lo: f32, hi: f32) -> Option<(f32, f32, f32)> {
-        let den_far = (lo - self.e2a) - self.r1a;
+    pub(crate) fn depths(
+        &self,
+        err: &PointErrors,
+        lam: f32,
+        lo: f32,
+        hi: f32,
+    ) -> Option<(f32, f32, f32)> {
+        let (r1a, e2a) = (err.r1 * self.a_len, err.e2 * self.a_len);
+        let den_far = (lo - e2a) - r1a;
         // (A NaN fails.)
         if !(den_far > 0.0) {
             return None;
         }
+        // |a| (σ_a + (|W'| + σ_w) r₁): the stick's numerators are
+        // |a| A₊ and |a| A₋ (module docs), scaled by |a|.
+        let mv = self.a_len * (err.spread_a + (self.w.abs() + err.spread_w) * err.r1);
         let s = self.w + self.a2 / lam;
-        let s_far = self.w_hi + self.num_hi / den_far;
-        let s_near = self.w_lo + self.num_lo / ((hi + self.e2a) + self.r1a);
+        let s_far = (self.w + err.spread_w) + (self.a2 + mv) / den_far;
+        let s_near = (self.w - err.spread_w) + (self.a2 - mv) / ((hi + e2a) + r1a);
         Some((s, s_near, s_far))
     }
 
@@ -404,15 +416,31 @@ impl Band {
     }
 }
 
-/// A vertex's coordinates in a band's frame (see [`Band::coords`]).
+/// A vertex in a band's frame (see [`Band::vertex`]).
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Coords {
+pub(crate) struct Vertex {
     pub(crate) lam: f32,
     pub(crate) mu: f32,
+    gp: f32,
+    gm: f32,
+    out: u32,
 }
 
-/// What [`Band::clip`] found: the `λ'` range of the segment's part in the
-/// band, and the exact line's crossing `(t along the segment, λ')`.
+impl Vertex {
+    /// A placeholder (outside everything).
+    pub(crate) const NONE: Vertex = Vertex {
+        lam: 0.0,
+        mu: 0.0,
+        gp: -1.0,
+        gm: -1.0,
+        out: 15,
+    };
+}
+
+/// What [`Band::segment`] found: the `λ'` range of the segment's part in the
+/// band, and the exact line's crossing of the segment, `(t along the
+/// segment, λ')` (which the walk keeps only within the band's `λ'` range,
+/// and brings into the pieces' hull against rounding).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Clipped {
     pub(crate) lo: f32,
@@ -497,9 +525,9 @@ mod tests {
                 (p2[0] + rad2 * f64::from(libm::cosf(ang2))) as f32,
                 (p2[1] + rad2 * f64::from(libm::sinf(ang2))) as f32,
             ];
-            let c = band.coords(q);
+            let c = band.vertex(q);
             assert!(
-                band.clip(c, c).is_some(),
+                band.segment(&c, &c).is_some() && Band::contains(&c),
                 "case {case}: q {q:?} outside the band of {p:?} (w {w})"
             );
             inside += 1;

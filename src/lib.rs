@@ -49,9 +49,6 @@ pub mod motion_error;
 mod pencil;
 pub mod processor;
 mod search;
-#[cfg(feature = "_reference")]
-#[doc(hidden)]
-pub use search::probe;
 mod structure;
 
 pub use boundary::{Boundary, BoundaryError, Frame};

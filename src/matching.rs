@@ -21,8 +21,10 @@
 //!   [`Status::BoundaryEnd`]: the boundary may go on, undetected, inside
 //!   the band.
 
-use crate::depth::{Band, Clipped, Coords};
-use crate::search::Flow;
+use crate::camera::Pixel;
+use crate::depth::{Band, Vertex};
+use crate::math::{fmax, fmin};
+use crate::search::{Flow, Visitor};
 use crate::structure::{Status, MAX_PIECES};
 
 /// What a walk concluded.
@@ -42,42 +44,51 @@ pub(crate) enum Outcome {
     Flag(Status),
 }
 
-/// The state of one point's walk.
+/// The state of one point's walk (plain values: it lives in registers).
+#[derive(Clone, Copy)]
 pub(crate) struct Walk<'a> {
-    band: &'a Band,
-    boundary: &'a [crate::camera::Pixel],
+    band: Band,
+    boundary: &'a [Pixel],
     cot_twice: f32,
     pieces: usize,
-    /// Index of the last segment in the band (for adjacency).
-    last: usize,
-    piece: (f32, f32),
-    hull: (f32, f32),
-    /// The nearest exact crossing: `λ'`, segment, position on it.
-    best: Option<(f32, usize, f32)>,
-    /// The vertex whose coordinates were computed last, and them.
-    cached: Option<(usize, Coords)>,
-    decided: Option<Status>,
+    /// The index a segment must have to continue the current piece.
+    next: usize,
+    piece_lo: f32,
+    piece_hi: f32,
+    hull_lo: f32,
+    hull_hi: f32,
+    /// The nearest exact crossing: `λ'` (infinite: none), segment, position.
+    best_lam: f32,
+    best_j: usize,
+    best_t: f32,
+    /// The vertex computed last, and it.
+    cache_i: usize,
+    cache: Vertex,
+    /// `Grazing` or `Tangled` once decided, else `Ok`.
+    decided: Status,
     /// An end vertex of the polyline lies in the band.
     open: bool,
 }
 
 impl<'a> Walk<'a> {
-    pub(crate) fn new(
-        band: &'a Band,
-        boundary: &'a [crate::camera::Pixel],
-        cot_twice: f32,
-    ) -> Self {
+    #[inline(always)]
+    pub(crate) fn new(band: Band, boundary: &'a [Pixel], cot_twice: f32) -> Self {
         Self {
             band,
             boundary,
             cot_twice,
             pieces: 0,
-            last: usize::MAX,
-            piece: (0.0, 0.0),
-            hull: (f32::INFINITY, f32::NEG_INFINITY),
-            best: None,
-            cached: None,
-            decided: None,
+            next: usize::MAX,
+            piece_lo: 0.0,
+            piece_hi: 0.0,
+            hull_lo: f32::INFINITY,
+            hull_hi: f32::NEG_INFINITY,
+            best_lam: f32::INFINITY,
+            best_j: 0,
+            best_t: 0.0,
+            cache_i: usize::MAX,
+            cache: Vertex::NONE,
+            decided: Status::Ok,
             open: false,
         }
     }
@@ -85,102 +96,116 @@ impl<'a> Walk<'a> {
     /// The coordinates of vertex `i` (the previous segment's end is
     /// reused along a run).
     #[inline(always)]
-    fn coords(&mut self, i: usize) -> Option<Coords> {
-        if let Some((k, c)) = self.cached {
-            if k == i {
-                return Some(c);
-            }
+    fn coords(&mut self, i: usize) -> Option<Vertex> {
+        if self.cache_i == i {
+            return Some(self.cache);
         }
         let v = self.boundary.get(i)?;
-        let c = self.band.coords(v.arr());
-        self.cached = Some((i, c));
-        Some(c)
+        self.cache = self.band.vertex(v.arr());
+        self.cache_i = i;
+        Some(self.cache)
     }
 
     /// Take segment `j` (segments come in increasing index).
     #[inline(always)]
-    pub(crate) fn segment(&mut self, j: usize) -> Flow {
-        let (Some(c0), Some(c1)) = (self.coords(j), self.coords(j + 1)) else {
+    pub(crate) fn take(&mut self, j: usize) -> Flow {
+        let Some(c0) = self.coords(j) else {
             return Flow::Continue;
         };
-        match self.band.clip(c0, c1) {
-            Some(clipped) => {
-                let last = j + 2 >= self.boundary.len();
-                self.open |= (j == 0 && self.band.contains(c0)) || (last && self.band.contains(c1));
-                self.in_band(j, clipped)
-            }
-            None => Flow::Continue,
+        let Some(c1) = self.coords(j + 1) else {
+            return Flow::Continue;
+        };
+        let Some(c) = self.band.segment(&c0, &c1) else {
+            return Flow::Continue;
+        };
+        if j == 0 || j + 2 >= self.boundary.len() {
+            self.open |= (j == 0 && Band::contains(&c0))
+                || (j + 2 >= self.boundary.len() && Band::contains(&c1));
         }
-    }
-
-    #[inline(always)]
-    fn in_band(&mut self, j: usize, c: Clipped) -> Flow {
-        if self.pieces > 0 && self.last.wrapping_add(1) == j {
-            self.piece = (
-                crate::math::fmin(self.piece.0, c.lo),
-                crate::math::fmax(self.piece.1, c.hi),
-            );
+        if self.next == j {
+            self.piece_lo = fmin(self.piece_lo, c.lo);
+            self.piece_hi = fmax(self.piece_hi, c.hi);
         } else {
+            // A new piece: the last one joins the hull.
+            self.close_piece();
             self.pieces += 1;
             if self.pieces > MAX_PIECES {
-                self.decided = Some(Status::Tangled);
+                self.decided = Status::Tangled;
                 return Flow::Stop;
             }
-            self.piece = (c.lo, c.hi);
+            self.piece_lo = c.lo;
+            self.piece_hi = c.hi;
         }
-        self.last = j;
+        self.next = j + 1;
         if self
             .band
-            .grazing(self.piece.0, self.piece.1, self.cot_twice)
+            .grazing(self.piece_lo, self.piece_hi, self.cot_twice)
         {
-            self.decided = Some(Status::Grazing);
+            self.decided = Status::Grazing;
             return Flow::Stop;
         }
-        self.hull = (
-            crate::math::fmin(self.hull.0, c.lo),
-            crate::math::fmax(self.hull.1, c.hi),
-        );
         if let Some((t, lam)) = c.crossing {
-            if self.best.is_none_or(|(b, _, _)| lam < b) {
-                self.best = Some((lam, j, t));
+            // Only a crossing within the band's λ' range counts.
+            if lam < self.best_lam && lam > self.band.lam_lo && lam < self.band.lam_hi {
+                self.best_lam = lam;
+                self.best_j = j;
+                self.best_t = t;
             }
         }
         Flow::Continue
     }
 
+    /// Bring the current piece into the hull.
+    #[inline(always)]
+    fn close_piece(&mut self) {
+        if self.pieces > 0 {
+            self.hull_lo = fmin(self.hull_lo, self.piece_lo);
+            self.hull_hi = fmax(self.hull_hi, self.piece_hi);
+        }
+    }
+
     /// The outcome once the segments are through (or the walk stopped).
-    pub(crate) fn outcome(&self) -> Outcome {
-        if let Some(s) = self.decided {
-            return Outcome::Flag(s);
+    #[inline(always)]
+    pub(crate) fn outcome(&mut self) -> Outcome {
+        self.close_piece();
+        if self.decided != Status::Ok {
+            return Outcome::Flag(self.decided);
         }
         if self.open {
             return Outcome::Flag(Status::BoundaryEnd);
         }
-        let Some((lam, j, t)) = self.best else {
+        let (Some(v0), Some(v1)) = (
+            self.boundary.get(self.best_j),
+            self.boundary.get(self.best_j + 1),
+        ) else {
             return Outcome::Flag(Status::NoIntersection);
         };
-        let (Some(v0), Some(v1)) = (self.boundary.get(j), self.boundary.get(j + 1)) else {
+        if self.best_lam == f32::INFINITY {
             return Outcome::Flag(Status::NoIntersection);
-        };
+        }
         Outcome::Match {
-            p2: Band::point_on(v0.arr(), v1.arr(), t),
-            lam: crate::math::fmin(crate::math::fmax(lam, self.hull.0), self.hull.1),
-            lo: self.hull.0,
-            hi: self.hull.1,
+            p2: Band::point_on(v0.arr(), v1.arr(), self.best_t),
+            // Within the hull, as it is up to rounding.
+            lam: fmin(fmax(self.best_lam, self.hull_lo), self.hull_hi),
+            lo: self.hull_lo,
+            hi: self.hull_hi,
             pieces: self.pieces,
         }
     }
 }
 
+impl Visitor for Walk<'_> {
+    #[inline(always)]
+    fn segment(&mut self, j: usize) -> Flow {
+        self.take(j)
+    }
+}
+
 /// The reference: the walk over every segment of `boundary`, in order.
-pub(crate) fn reference_walk(
-    band: &Band,
-    boundary: &[crate::camera::Pixel],
-    cot_twice: f32,
-) -> Outcome {
+pub(crate) fn reference_walk(band: Band, boundary: &[Pixel], cot_twice: f32) -> Outcome {
     let mut walk = Walk::new(band, boundary, cot_twice);
     for j in 0..boundary.len().saturating_sub(1) {
-        if walk.segment(j) == Flow::Stop {
+        if walk.take(j) == Flow::Stop {
             break;
         }
     }

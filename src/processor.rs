@@ -39,7 +39,7 @@ use crate::epipolar::PairGeometry;
 use crate::matching::{Outcome, Walk};
 use crate::motion::Motion;
 use crate::pencil::{Keying, NO_KEY};
-use crate::search::{Flow, Index, OutOfWork, Query, Unkeyed, Work};
+use crate::search::{Flow, Index, OutOfWork, Query, Unkeyed, Visitor, Work};
 use crate::structure::{PointResult, ProcessError, Status, Step, Structure, FOLD_WINDOW};
 
 /// Work units a band test costs on top of the unit of looking at the
@@ -201,8 +201,28 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             out.points.set_len(b1.len());
             let slots = out.points.as_mut_slice();
             let mut r1_max = 0.0f32;
-            let keys = compensate(&pair, &keying, b1, slots, &mut r1_max);
-            index.build(keys, keying.period, Unkeyed::MeetNone, None);
+            // The keys' orientation along frame 2's boundary, a good guess
+            // for frame 1's too (the same curve seen from nearby).
+            let orient = orientation(
+                &keying,
+                b2.and_then(|b| b.first()),
+                b2.and_then(|b| b.last()),
+            );
+            let mut fold_index = index.builder((keying.period, orient), Unkeyed::MeetNone);
+            for (slot, &p1) in slots.iter_mut().zip(b1) {
+                let (k, e) = match compensate_point(&pair, &keying, p1, &mut r1_max) {
+                    Ok((r, key)) => {
+                        *slot = r;
+                        key
+                    }
+                    Err(status) => {
+                        *slot = PointResult::flagged(p1, status);
+                        (NO_KEY, 0.0)
+                    }
+                };
+                fold_index.push(k, e);
+            }
+            fold_index.finish(None);
             fold(index, slots, config.work_per_point, &mut work);
             let Some(b2) = b2 else {
                 for r in slots
@@ -219,14 +239,12 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 &pair,
                 &keying,
                 b2,
+                orient,
                 near_foe + 2.0 * (r1_max + pair.e2()),
             );
-            for r in slots
-                .iter_mut()
-                .filter(|r| r.status == Status::NoIntersection)
-            {
-                *r = match_point(&pair, &keying, near_foe, r, b2, index, &mut work, matcher);
-            }
+            match_boundary(
+                &pair, &keying, near_foe, slots, b2, index, &mut work, matcher,
+            );
         }
     }
 }
@@ -337,34 +355,12 @@ impl<'c> Pair<'c> {
     }
 }
 
-/// Step 1: compensate every frame-1 point and leave it in its output slot
-/// until step 4 overwrites it: `p₁'` in `pixel2`, `1/q_z` in `z`, `r₁` in
-/// `z_near`, the key of its epipolar line in `z_far`, and the status
-/// [`Status::NoIntersection`] for a point still to be matched (no extra
-/// memory). Yields each point's key and margin (none for a flagged point)
-/// for the fold test's index, and keeps the largest `r₁` in `r1_max`.
-fn compensate<'a>(
-    pair: &'a Pair,
-    keying: &'a Keying,
-    b1: &'a [Pixel],
-    slots: &'a mut [PointResult],
-    r1_max: &'a mut f32,
-) -> impl Iterator<Item = (f32, f32)> + 'a {
-    slots.iter_mut().zip(b1).map(move |(slot, &p1)| {
-        match compensate_point(pair, keying, p1, r1_max) {
-            Ok((r, key)) => {
-                *slot = r;
-                key
-            }
-            Err(status) => {
-                *slot = PointResult::flagged(p1, status);
-                (NO_KEY, 0.0)
-            }
-        }
-    })
-}
-
-/// [`compensate`] for one point: its slot and key, or why it is flagged.
+/// Step 1 for one frame-1 point: compensate it and make its output slot
+/// hold it until step 4 overwrites it: `p₁'` in `pixel2`, `1/q_z` in `z`,
+/// `r₁` in `z_near`, the key of its epipolar line in `z_far`, and the
+/// status [`Status::NoIntersection`] for a point still to be matched (no
+/// extra memory). Returns the slot and the key with its margin, or why the
+/// point is flagged, and keeps the largest `r₁` in `r1_max`.
 #[inline(always)]
 fn compensate_point(
     pair: &Pair,
@@ -434,24 +430,35 @@ fn fold<const N: usize>(
         if r.status != Status::NoIntersection || !k.is_finite() {
             continue;
         }
+        if !index.may_fold(i, k, FOLD_WINDOW) {
+            continue;
+        }
         let m = index.margin(i);
         let skip = (i.saturating_sub(FOLD_WINDOW), i + FOLD_WINDOW - 1);
-        let mut met = false;
+        let mut met = Met(false);
         let done = index.visit(
             Query::Keys(k - m, k + m),
             false,
             Some(skip),
             (work, 0),
-            |_| {
-                met = true;
-                Flow::Stop
-            },
+            &mut met,
         );
         match done {
             Err(OutOfWork) => *r = PointResult::flagged(r.pixel1, Status::OverBudget),
-            Ok(()) if met => *r = PointResult::flagged(r.pixel1, Status::Folded),
+            Ok(()) if met.0 => *r = PointResult::flagged(r.pixel1, Status::Folded),
             Ok(()) => {}
         }
+    }
+}
+
+/// The fold test's visitor: any segment offered meets the key.
+#[derive(Clone, Copy)]
+struct Met(bool);
+
+impl Visitor for Met {
+    fn segment(&mut self, _: usize) -> Flow {
+        self.0 = true;
+        Flow::Stop
     }
 }
 
@@ -465,9 +472,14 @@ fn index_frame2<const N: usize>(
     pair: &Pair,
     keying: &Keying,
     b2: &[Pixel],
+    orient: f32,
     radius: f32,
 ) {
-    let keys = b2.iter().map(|p| keying.key(p.arr()));
+    let mut builder = index.builder((keying.period, orient), Unkeyed::MeetAll);
+    for p in b2 {
+        let (k, e) = keying.key(p.arr());
+        builder.push(k, e);
+    }
     let foe = pair.foe.filter(|_| pair.geom.w() < 0.0 && keying.angular());
     match foe {
         Some(f) => {
@@ -475,14 +487,38 @@ fn index_frame2<const N: usize>(
                 (Some(a), Some(b)) => segment_distance2(f, a.arr(), b.arr()) <= radius * radius,
                 _ => false,
             };
-            index.build(keys, keying.period, Unkeyed::MeetAll, Some(&is_near));
+            builder.finish(Some(&is_near));
         }
-        None => index.build(keys, keying.period, Unkeyed::MeetAll, None),
+        None => builder.finish(None),
     }
+}
+
+/// Step 4 for every point of a boundary left by steps 1–2. (Out of line,
+/// with the loop inside: the frame's constants stay in registers.)
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+fn match_boundary<const N: usize>(
+    pair: &Pair,
+    keying: &Keying,
+    near_foe: f32,
+    slots: &mut [PointResult],
+    b2: &[Pixel],
+    index: &mut Index<N>,
+    work: &mut Work,
+    matcher: Matcher,
+) {
+    let mut credit = *work;
+    for r in slots.iter_mut() {
+        if r.status == Status::NoIntersection {
+            *r = match_point(pair, keying, near_foe, r, b2, index, &mut credit, matcher);
+        }
+    }
+    *work = credit;
 }
 
 /// Step 4 for one point left by steps 1–2 in `r`.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 fn match_point<const N: usize>(
     pair: &Pair,
     keying: &Keying,
@@ -518,21 +554,19 @@ fn match_point<const N: usize>(
     };
     let cot_twice = pair.config.cot_twice;
     let outcome = match matcher {
-        Matcher::Reference => crate::matching::reference_walk(&band, b2, cot_twice),
+        Matcher::Reference => crate::matching::reference_walk(band, b2, cot_twice),
         Matcher::Indexed => {
             let query = band_query(pair, keying, &band, key, near_foe);
             let with_near = geom.w() < 0.0;
-            let mut walk = Walk::new(&band, b2, cot_twice);
-            let done = index.visit(query, with_near, None, (work, CLIP_UNITS), |j| {
-                walk.segment(j)
-            });
+            let mut walk = Walk::new(band, b2, cot_twice);
+            let done = index.visit(query, with_near, None, (work, CLIP_UNITS), &mut walk);
             match done {
                 Err(OutOfWork) => return PointResult::flagged(p1, Status::OverBudget),
                 Ok(()) => walk.outcome(),
             }
         }
     };
-    conclude(pair, p1, iz, &band, outcome)
+    conclude(pair, p1, iz, &band, &errors, outcome)
 }
 
 /// The key interval to search for a band (see [`Band::key_half_width`]
@@ -566,7 +600,14 @@ fn band_query(pair: &Pair, keying: &Keying, band: &Band, key: f32, near_foe: f32
 }
 
 /// The point's result from the walk's outcome: depth (eq. 2.3) and stick.
-fn conclude(pair: &Pair, p1: Pixel, iz: f32, band: &Band, outcome: Outcome) -> PointResult {
+fn conclude(
+    pair: &Pair,
+    p1: Pixel,
+    iz: f32,
+    band: &Band,
+    errors: &PointErrors,
+    outcome: Outcome,
+) -> PointResult {
     let Outcome::Match {
         p2,
         lam,
@@ -586,7 +627,7 @@ fn conclude(pair: &Pair, p1: Pixel, iz: f32, band: &Band, outcome: Outcome) -> P
         status: Status::Unbounded,
         ..PointResult::EMPTY
     };
-    let Some((s, s_near, s_far)) = band.depths(lam, lo, hi) else {
+    let Some((s, s_near, s_far)) = band.depths(errors, lam, lo, hi) else {
         return r;
     };
     let z = s * iz;
@@ -613,6 +654,25 @@ fn conclude(pair: &Pair, p1: Pixel, iz: f32, band: &Band, outcome: Outcome) -> P
         Status::Ok
     };
     r
+}
+
+/// The likely orientation of the keys along a polyline from its end
+/// points' (+1 rising, −1 falling; pseudo-angles the shorter way round).
+fn orientation(keying: &Keying, first: Option<&Pixel>, last: Option<&Pixel>) -> f32 {
+    let key = |p: Option<&Pixel>| p.map_or(NO_KEY, |p| keying.key(p.arr()).0);
+    let mut d = key(last) - key(first);
+    if keying.period > 0.0 {
+        if d > 2.0 {
+            d -= 4.0;
+        } else if d < -2.0 {
+            d += 4.0;
+        }
+    }
+    if d < 0.0 {
+        -1.0
+    } else {
+        1.0
+    }
 }
 
 /// The squared distance from `p` to the segment `a → b`.

@@ -2,22 +2,22 @@
 //! whose keys lie in a given interval.
 //!
 //! Every segment `j` (from vertex `j` to `j + 1`) gets the interval of its
-//! end points' keys ([`crate::pencil`]); a ray can only meet the segment if
-//! its key lies in it. The index answers "every segment whose interval
-//! meets `[q_lo, q_hi]`", in increasing `j`, with the guarantee that no such
-//! segment is left out (the caller then decides with the exact geometry,
-//! so any superset gives the same result as a scan of every segment). Its
-//! invariants:
+//! end points' keys, each widened by its rounding margin ([`crate::pencil`]);
+//! a ray can only meet the segment if its key lies in it. The index answers
+//! "every segment whose interval meets `[q_lo, q_hi]`", in increasing `j`,
+//! with the guarantee that no such segment is left out (the caller then
+//! decides with the exact geometry, so any superset gives the same result
+//! as a scan of every segment). Its invariants:
 //!
 //! 1. Keys are *oriented* (multiplied by ±1) so that they rise from the
 //!    first to the last keyed vertex, and pseudo-angles are *unwrapped*
 //!    along the polyline (consecutive keys less than half a turn apart).
 //! 2. A few segments are kept *aside*, in a short sorted list that every
 //!    query checks: segments with an unkeyable end (frame 2: they may meet
-//!    any ray) and the two segments of each *outlying* vertex, one whose key
-//!    lies far outside its neighbours' (a spurious detector point): a few
-//!    such vertices would otherwise stretch every run. Their place in the
-//!    arrays holds the empty interval.
+//!    any ray) and *outlying* segments, whose interval reaches far beyond
+//!    those two places before and after (the two segments of a spurious
+//!    detector point): a few such would otherwise stretch every run. Their
+//!    place in the arrays holds the empty interval.
 //! 3. For the others, `pm[j]` is the running maximum of the intervals' high
 //!    ends up to `j` and `sm[j]` the running minimum of the low ends from
 //!    `j` on. Both are non-decreasing, so the segments meeting the query
@@ -33,6 +33,18 @@
 //! rays the run is long, and every step of it is paid from the frame's
 //! [`Work`] budget, so the frame's cost stays bounded whatever the input.
 //!
+//! The build is two linear passes (keys, intervals and `pm` forwards; `sm`
+//! backwards). Only when the envelopes come out loose (somewhere `pm[j] −
+//! sm[j]` exceeds [`WIDE`] average widths: a fold, an outlier, an unkeyed
+//! segment, or a wrong guess of the orientation) does a third pass look for
+//! outliers and the envelopes get rebuilt without them, and a **block
+//! tree** is built: the key range of every aligned block of [`FAN`],
+//! `FAN²`, … segments. A run through a loose index skips every block whose
+//! range misses the query (at an aligned position, the largest such block),
+//! so a long run costs about one step per block it crosses and per segment
+//! it visits, not one per segment. A tight index never builds or reads the
+//! tree.
+//!
 //! Periodic keys (pseudo-angles) are searched at each copy `q + 4m` that
 //! can meet the keys' range (at most [`MAX_COPIES`], else every segment is
 //! visited).
@@ -46,17 +58,18 @@ pub(crate) const MAX_ASIDE: usize = 8;
 pub(crate) const MAX_NEAR: usize = 8;
 /// Linear probes before a search for the run's start falls back to
 /// bisection.
-const PROBES: usize = 8;
+const PROBES: u32 = 6;
 /// At most this many copies of a periodic key are searched one by one.
 pub(crate) const MAX_COPIES: usize = 3;
-/// A vertex is an outlier when its key lies outside its neighbours' by more
-/// than this many times their own difference, and by more than [`WIDE`]
-/// times the average width of a segment's interval.
-const OUTLYING: f32 = 4.0;
-/// See [`OUTLYING`].
+/// The fan-out of the block tree.
+const FAN: usize = 8;
+/// The levels of the block tree (blocks of up to `FAN^LEVELS` segments).
+const LEVELS: usize = 4;
+
+/// The looseness of the envelopes (in average interval widths) that makes
+/// the build look for outliers, and how far an outlier's interval reaches
+/// beyond its neighbours'.
 const WIDE: f32 = 8.0;
-/// Outlying vertices whose segments an index keeps aside.
-const MAX_OUTLIERS: usize = MAX_ASIDE / 2;
 
 /// Work units: every segment a query looks at costs one, every bisection
 /// step one; the caller pays its own exact tests.
@@ -68,24 +81,6 @@ pub(crate) struct Work {
 /// The frame's work budget was spent.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct OutOfWork;
-
-/// TEMPORARY instrumentation.
-#[cfg(feature = "_reference")]
-#[doc(hidden)]
-pub mod probe {
-    use core::sync::atomic::{AtomicU32, Ordering};
-    pub static RUN: AtomicU32 = AtomicU32::new(0);
-    pub static TAKEN: AtomicU32 = AtomicU32::new(0);
-    pub static BISECT: AtomicU32 = AtomicU32::new(0);
-    pub static QUERIES: AtomicU32 = AtomicU32::new(0);
-    pub static ASIDE: AtomicU32 = AtomicU32::new(0);
-    pub fn add(c: &AtomicU32, n: u32) {
-        c.fetch_add(n, Ordering::Relaxed);
-    }
-    pub fn take(c: &AtomicU32) -> u32 {
-        c.swap(0, Ordering::Relaxed)
-    }
-}
 
 impl Work {
     pub(crate) const fn new() -> Self {
@@ -121,6 +116,13 @@ pub(crate) enum Flow {
     Stop,
 }
 
+/// Takes the segments a query offers ([`Index::visit`]), in increasing
+/// index.
+pub(crate) trait Visitor {
+    /// Segment `j`; whether to go on.
+    fn segment(&mut self, j: usize) -> Flow;
+}
+
 /// How segments with an unkeyable end count.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Unkeyed {
@@ -139,16 +141,37 @@ pub(crate) enum Query {
     Everything,
 }
 
+/// One segment's entry: its (oriented) key interval and the suffix minimum
+/// of the low ends from it on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Seg {
+    lo: f32,
+    hi: f32,
+    sm: f32,
+    /// The prefix maximum of the high ends up to this segment.
+    pm: f32,
+}
+
+const EMPTY_SEG: Seg = Seg {
+    lo: f32::INFINITY,
+    hi: f32::NEG_INFINITY,
+    sm: f32::INFINITY,
+    pm: f32::NEG_INFINITY,
+};
+
 /// The index of one polyline (see the module docs). Memory: `20 N` bytes
 /// plus the two short lists.
 #[derive(Debug, Clone)]
 pub(crate) struct Index<const N: usize> {
+    seg: [Seg; N],
     /// Each vertex's key margin ([`crate::pencil`]).
     margin: [f32; N],
-    lo: [f32; N],
-    hi: [f32; N],
-    pm: [f32; N],
-    sm: [f32; N],
+    /// The block tree (loose indexes only): the `(min lo, max hi)` of each
+    /// aligned block of `FAN^l` segments, level `l = 1 …` after level
+    /// `l − 1`, flattened; `levels` levels are built (0: no tree).
+    tree: [f32; N],
+    levels: usize,
     segments: usize,
     orient: f32,
     period: f32,
@@ -161,9 +184,6 @@ pub(crate) struct Index<const N: usize> {
     /// there were more than fit.
     near: heapless::Vec<u16, MAX_NEAR>,
     near_overflow: bool,
-    /// Outlying vertex candidates of the last build: vertex and how far its
-    /// key lies outside its neighbours'.
-    outliers: heapless::Vec<(usize, f32), MAX_OUTLIERS>,
     hint: usize,
 }
 
@@ -177,11 +197,10 @@ impl<const N: usize> Index<N> {
     /// An empty index.
     pub(crate) const fn new() -> Self {
         Self {
+            seg: [EMPTY_SEG; N],
             margin: [0.0; N],
-            lo: [0.0; N],
-            hi: [0.0; N],
-            pm: [0.0; N],
-            sm: [0.0; N],
+            tree: [0.0; N],
+            levels: 0,
             segments: 0,
             orient: 1.0,
             period: 0.0,
@@ -190,161 +209,230 @@ impl<const N: usize> Index<N> {
             aside: heapless::Vec::new(),
             near: heapless::Vec::new(),
             near_overflow: false,
-            outliers: heapless::Vec::new(),
             hint: 0,
         }
     }
 
-    /// Index the polyline whose vertex keys and their margins (raw keys,
-    /// [`NO_KEY`] where none) `keys` yields, at most `N` of them; `period` 4
-    /// for pseudo-angles. A segment's interval is that of its end keys,
+    /// Start indexing a polyline: push its vertex keys and their margins
+    /// in order ([`Builder::push`]), then [`Builder::finish`]. `period` 4
+    /// for pseudo-angles; `orient` the likely orientation of the keys (+1
+    /// rising, −1 falling: any value gives the same index, a wrong one
+    /// costs a rebuild). A segment's interval is that of its end keys,
     /// each widened by its margin.
-    ///
-    /// `near(j)` says whether segment `j` comes within the FOE-near radius
-    /// (frame 2 with `W' < 0`; `None` otherwise).
-    pub(crate) fn build(
+    #[inline(always)]
+    pub(crate) fn builder(
         &mut self,
-        keys: impl Iterator<Item = (f32, f32)>,
-        period: f32,
+        (period, orient): (f32, f32),
         unkeyed: Unkeyed,
-        near: Option<&dyn Fn(usize) -> bool>,
-    ) {
+    ) -> Builder<'_, N> {
         self.period = period;
         self.hint = 0;
+        self.levels = 0;
         self.aside.clear();
         self.near.clear();
         self.near_overflow = false;
-        self.outliers.clear();
-        // Unwrapped vertex keys and the per-segment intervals (raw
-        // orientation); the orientation from the first and last keyed
-        // vertex; the outlying vertices, from a window of three keys.
-        // Bounded by `N` (the arrays).
-        let mut window = [NO_KEY; 3];
-        let (mut before, mut keyed, mut offset) = ((NO_KEY, 0.0f32), NO_KEY, 0.0f32);
-        let (mut first, mut last) = (NO_KEY, NO_KEY);
-        let mut n = 0usize;
-        for ((i, (raw, e)), m) in keys.enumerate().zip(self.margin.iter_mut()) {
-            *m = e;
-            let mut k = raw;
-            if k.is_finite() {
-                k += offset;
-                if period > 0.0 && keyed.is_finite() {
-                    // Consecutive keys are less than half a turn apart.
-                    let d = k - keyed;
-                    if d > 2.0 {
-                        offset -= 4.0;
-                        k -= 4.0;
-                    } else if d < -2.0 {
-                        offset += 4.0;
-                        k += 4.0;
-                    }
-                }
-                if !first.is_finite() {
-                    first = k;
-                }
-                last = k;
-                keyed = k;
-            }
-            if let Some(j) = i.checked_sub(1) {
-                if let (Some(l), Some(h)) = (self.lo.get_mut(j), self.hi.get_mut(j)) {
-                    (*l, *h) = segment_interval(before, (k, e), unkeyed);
-                }
-            }
-            before = (k, e);
-            window = [window[1], window[2], k];
-            if i >= 2 {
-                let [k0, k1, k2] = window;
-                outlier_candidate(&mut self.outliers, i - 1, k1, k0, k2);
-                if i == 2 {
-                    outlier_candidate(&mut self.outliers, 0, k0, k1, k2);
-                }
-            }
-            n = i + 1;
+        Builder {
+            o: if orient < 0.0 { -1.0 } else { 1.0 },
+            period,
+            unkeyed,
+            n: 0,
+            prev: NO_KEY,
+            prev_e: 0.0,
+            keyed: NO_KEY,
+            offset: 0.0,
+            first: NO_KEY,
+            last: NO_KEY,
+            run: f32::NEG_INFINITY,
+            sum: 0.0,
+            odd: false,
+            index: self,
         }
-        if n >= 3 {
-            let [k0, k1, k2] = window;
-            outlier_candidate(&mut self.outliers, n - 1, k2, k1, k0);
-        }
-        self.segments = n.saturating_sub(1);
-        self.orient = if last >= first || !first.is_finite() {
-            1.0
-        } else {
-            -1.0
-        };
-        self.finish(near);
     }
 
-    /// Orientation, the aside list, the envelopes and the near list.
-    fn finish(&mut self, near: Option<&dyn Fn(usize) -> bool>) {
+    /// The suffix minima `sm`; whether somewhere the envelopes are more
+    /// than `wide` apart.
+    fn suffix_minima(&mut self, wide: f32) -> bool {
         let s = self.segments;
-        let o = self.orient;
-        let (Some(lo), Some(hi)) = (self.lo.get_mut(..s), self.hi.get_mut(..s)) else {
+        let Some(seg) = self.seg.get_mut(..s) else {
+            return false;
+        };
+        let (mut run, mut gap) = (f32::INFINITY, f32::NEG_INFINITY);
+        for g in seg.iter_mut().rev() {
+            run = fmin(run, g.lo);
+            g.sm = run;
+            gap = fmax(gap, g.pm - run);
+        }
+        // (A NaN gap fails: loose.)
+        !(gap <= wide)
+    }
+
+    /// The slow path of [`Self::build`]: orient the intervals as `orient`,
+    /// set aside the unkeyed segments and those of outlying vertices, and
+    /// rebuild the envelopes without them.
+    fn rebuild(&mut self, orient: f32, wide: f32) {
+        let s = self.segments;
+        let Some(seg) = self.seg.get_mut(..s) else {
             return;
         };
-        // Orient; the keys' range and the average width.
-        let (mut kmin, mut kmax, mut sum, mut count) =
-            (f32::INFINITY, f32::NEG_INFINITY, 0.0f32, 0u32);
-        for (l, h) in lo.iter_mut().zip(hi.iter_mut()) {
-            if o < 0.0 {
-                (*l, *h) = (-*h, -*l);
+        if orient != self.orient {
+            for g in seg.iter_mut() {
+                (g.lo, g.hi) = (-g.hi, -g.lo);
             }
-            if l.is_finite() && h.is_finite() {
-                kmin = fmin(kmin, *l);
-                kmax = fmax(kmax, *h);
-                sum += *h - *l;
-                count += 1;
-            }
+            self.orient = orient;
         }
-        self.kmin = kmin;
-        self.kmax = kmax;
-        let wide = if count > 0 {
-            WIDE * sum / count as f32
-        } else {
-            f32::INFINITY
-        };
-        // Aside: the segments meeting every key, then those next to an
-        // outlying vertex, in index order while there is room; their slots
-        // become empty.
-        let outliers = &self.outliers;
-        let outlying = |j: usize| {
-            outliers
-                .iter()
-                .any(|&(v, dev)| dev > wide && (v == j || v == j + 1))
-        };
-        for (j, (l, h)) in lo.iter_mut().zip(hi.iter_mut()).enumerate() {
-            let all = *l == f32::NEG_INFINITY;
-            if (all || (l.is_finite() && outlying(j))) && !self.aside.is_full() {
+        // Outliers: a segment whose interval reaches more than `wide`
+        // beyond those of the segments two places before and after it
+        // (both segments of a spurious vertex do; along a boundary whose
+        // keys move one way, neither end of an interval passes both of
+        // those). A heuristic for speed only: any choice gives the same
+        // results.
+        let mut aside = heapless::Vec::<(u16, f32, f32), MAX_ASIDE>::new();
+        for j in 0..s {
+            let at = |i: Option<usize>| i.and_then(|i| seg.get(i)).filter(|g| g.lo <= g.hi);
+            let (b, a) = (at(j.checked_sub(2)), at(j.checked_add(2)));
+            let Some(g) = seg.get(j).copied() else { break };
+            let all = g.lo == f32::NEG_INFINITY;
+            let out = g.lo.is_finite() && g.hi.is_finite() && (b.is_some() || a.is_some()) && {
+                let hi = fmax(
+                    b.map_or(f32::NEG_INFINITY, |x| x.hi),
+                    a.map_or(f32::NEG_INFINITY, |x| x.hi),
+                );
+                let lo = fmin(
+                    b.map_or(f32::INFINITY, |x| x.lo),
+                    a.map_or(f32::INFINITY, |x| x.lo),
+                );
+                g.hi - hi > wide || lo - g.lo > wide
+            };
+            if (all || out) && !aside.is_full() {
                 if let Ok(jj) = u16::try_from(j) {
-                    if self.aside.push((jj, *l, *h)).is_ok() {
-                        (*l, *h) = (f32::INFINITY, f32::NEG_INFINITY);
-                    }
+                    let _ = aside.push((jj, g.lo, g.hi));
                 }
             }
         }
-        // Envelopes over the rest (the empty interval changes neither).
-        let (Some(pm), Some(sm)) = (self.pm.get_mut(..s), self.sm.get_mut(..s)) else {
+        for &(j, _, _) in aside.iter() {
+            if let Some(g) = seg.get_mut(usize::from(j)) {
+                (g.lo, g.hi) = (f32::INFINITY, f32::NEG_INFINITY);
+            }
+        }
+        self.aside = aside;
+        let Some(seg) = self.seg.get_mut(..s) else {
             return;
         };
         let mut run = f32::NEG_INFINITY;
-        for (p, &h) in pm.iter_mut().zip(hi.iter()) {
-            run = fmax(run, h);
-            *p = run;
+        for g in seg.iter_mut() {
+            run = fmax(run, g.hi);
+            g.pm = run;
         }
-        let mut run = f32::INFINITY;
-        for (m, &l) in sm.iter_mut().zip(lo.iter()).rev() {
-            run = fmin(run, l);
-            *m = run;
-        }
-        if let Some(is_near) = near {
-            for j in 0..s {
-                if is_near(j) {
-                    match u16::try_from(j).ok().map(|jj| self.near.push(jj)) {
-                        Some(Ok(())) => {}
-                        _ => self.near_overflow = true,
-                    }
+        self.suffix_minima(wide);
+        self.build_tree();
+    }
+
+    /// The block tree over the current intervals (module docs): as many
+    /// levels as fit in the `tree` array (each level `l` has
+    /// `⌈s / FAN^l⌉` blocks of two values), at most [`LEVELS`]; every loop
+    /// bounded by the array or by the blocks of the level below.
+    fn build_tree(&mut self) {
+        let s = self.segments;
+        self.levels = 0;
+        let (mut base, mut below_base, mut below_n, mut size) = (0usize, 0usize, s, 1usize);
+        for level in 1..=LEVELS {
+            size = size.saturating_mul(FAN);
+            let n = s.div_ceil(size);
+            let Some(end) = base.checked_add(2 * n).filter(|&e| e <= N) else {
+                return;
+            };
+            for b in 0..n {
+                let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+                for c in b * FAN..((b + 1) * FAN).min(below_n) {
+                    let (l, h) = if level == 1 {
+                        self.seg
+                            .get(c)
+                            .map_or((f32::INFINITY, f32::NEG_INFINITY), |g| (g.lo, g.hi))
+                    } else {
+                        let i = below_base + 2 * c;
+                        (
+                            self.tree.get(i).copied().unwrap_or(f32::INFINITY),
+                            self.tree.get(i + 1).copied().unwrap_or(f32::NEG_INFINITY),
+                        )
+                    };
+                    lo = fmin(lo, l);
+                    hi = fmax(hi, h);
+                }
+                if let Some(t) = self.tree.get_mut(base + 2 * b) {
+                    *t = lo;
+                }
+                if let Some(t) = self.tree.get_mut(base + 2 * b + 1) {
+                    *t = hi;
                 }
             }
+            self.levels = level;
+            below_base = base;
+            below_n = n;
+            base = end;
+            if n <= 1 {
+                return;
+            }
         }
+    }
+
+    /// At segment `j` of a loose index's run: how many segments from `j`
+    /// on a block skip passes over: the largest block aligned at `j` whose
+    /// key range `meets` does not accept (0: look at segment `j` itself).
+    /// At most [`LEVELS`] steps.
+    #[inline(always)]
+    fn skip_at(&self, j: usize, meets: impl Fn(f32, f32) -> bool) -> usize {
+        let (mut base, mut size, mut n, mut skip) = (0usize, 1usize, self.segments, 0usize);
+        for _ in 0..self.levels {
+            size *= FAN;
+            n = n.div_ceil(FAN);
+            if j % size != 0 {
+                break;
+            }
+            let b = j / size;
+            let (lo, hi) = (
+                self.tree
+                    .get(base + 2 * b)
+                    .copied()
+                    .unwrap_or(f32::NEG_INFINITY),
+                self.tree
+                    .get(base + 2 * b + 1)
+                    .copied()
+                    .unwrap_or(f32::INFINITY),
+            );
+            // A block that meets the query holds every larger block's
+            // range too: stop there.
+            if lo <= hi && meets(lo, hi) {
+                break;
+            }
+            skip = size;
+            base += 2 * n;
+        }
+        skip
+    }
+
+    /// Whether vertex `i`, whose raw key is `key`, may lie on a ray that
+    /// meets a segment outside `i − w ..= i + w − 1`: `false` is certain
+    /// (its widened key lies above every interval before that window and
+    /// below every one after it, in the oriented order: the envelopes say
+    /// so in `O(1)`), `true` needs the query ([`Self::visit`]) to decide.
+    /// Non-periodic keys only (else always `true`).
+    #[inline(always)]
+    pub(crate) fn may_fold(&self, i: usize, key: f32, w: usize) -> bool {
+        if self.period > 0.0 || !self.aside.is_empty() {
+            return true;
+        }
+        let k = self.orient * key;
+        let e = self.margin(i);
+        let before = i
+            .checked_sub(w + 1)
+            .and_then(|j| self.seg.get(j))
+            .is_some_and(|g| k - e <= g.pm);
+        let after = self
+            .seg
+            .get(i + w)
+            .filter(|_| i + w < self.segments)
+            .is_some_and(|g| k + e >= g.sm);
+        before || after
     }
 
     /// The key margin of vertex `i` (0 when out of range).
@@ -358,20 +446,140 @@ impl<const N: usize> Index<N> {
     /// range of indices) are left out. Each segment looked at costs one
     /// unit of `work`, each one visited `extra` more (the caller's test),
     /// each bisection step one.
+    #[inline(always)]
     pub(crate) fn visit(
         &mut self,
         query: Query,
         with_near: bool,
         skip: Option<(usize, usize)>,
         (work, extra): (&mut Work, u32),
-        mut visit: impl FnMut(usize) -> Flow,
+        visit: &mut (impl Visitor + Copy),
+    ) -> Result<(), OutOfWork> {
+        // The usual case: one run, no lists to merge.
+        let lists =
+            !self.aside.is_empty() || (with_near && (!self.near.is_empty() || self.near_overflow));
+        if let (Query::Keys(q0, q1), false, false) = (query, self.period > 0.0, lists) {
+            let (ql, qh) = if self.orient < 0.0 {
+                (-q1, -q0)
+            } else {
+                (q0, q1)
+            };
+            return self.visit_run(ql, qh, skip, work, extra, visit);
+        }
+        // The rare paths take the visitor by reference to a copy, so that
+        // the caller's visitor (and work) never has its address taken and
+        // stays in registers on the usual path.
+        let (mut v, mut w) = (*visit, *work);
+        let r = self.visit_general(query, with_near, skip, (&mut w, extra), &mut v);
+        (*visit, *work) = (v, w);
+        r
+    }
+
+    /// [`Self::visit`] for one oriented interval and no lists.
+    #[inline(always)]
+    fn visit_run(
+        &mut self,
+        ql: f32,
+        qh: f32,
+        skip: Option<(usize, usize)>,
+        work: &mut Work,
+        extra: u32,
+        visit: &mut (impl Visitor + Copy),
+    ) -> Result<(), OutOfWork> {
+        // (A query that cannot meet the keys' range finds an empty run: its
+        // start is past every segment, or its first suffix minimum above it.)
+        let a = self.run_start(ql, work)?;
+        if a < self.segments {
+            self.hint = a;
+        }
+        let (skip0, skip1) = skip.unwrap_or((usize::MAX, 0));
+        if self.levels > 0 {
+            let (mut v, mut w) = (*visit, *work);
+            let r = self.visit_run_loose(a, (ql, qh), (skip0, skip1), (&mut w, extra), &mut v);
+            (*visit, *work) = (v, w);
+            return r;
+        }
+        let run = self.seg.get(a..self.segments.min(N)).unwrap_or(&[]);
+        // The credit in a local while the run is walked (bounded by the
+        // slice `run`).
+        let mut credit = work.credit;
+        let mut result = Ok(());
+        let mut j = a;
+        for g in run {
+            if g.sm > qh {
+                break;
+            }
+            if credit == 0 {
+                result = Err(OutOfWork);
+                break;
+            }
+            credit -= 1;
+            if g.lo <= qh && g.hi >= ql && !(j >= skip0 && j <= skip1) {
+                if credit < extra {
+                    credit = 0;
+                    result = Err(OutOfWork);
+                    break;
+                }
+                credit -= extra;
+                if visit.segment(j) == Flow::Stop {
+                    break;
+                }
+            }
+            j += 1;
+        }
+        work.credit = credit;
+        result
+    }
+
+    /// [`Self::visit_run`] through a loose index: the block tree skips the
+    /// blocks the query misses (each skip one unit). Bounded by the segment
+    /// count: every step advances `j`.
+    #[inline(never)]
+    fn visit_run_loose(
+        &mut self,
+        mut j: usize,
+        (ql, qh): (f32, f32),
+        (skip0, skip1): (usize, usize),
+        (work, extra): (&mut Work, u32),
+        visit: &mut dyn Visitor,
+    ) -> Result<(), OutOfWork> {
+        let s = self.segments.min(N);
+        let meets = |l: f32, h: f32| l <= qh && h >= ql;
+        while let Some(g) = self.seg.get(j).filter(|_| j < s) {
+            if g.sm > qh {
+                break;
+            }
+            work.spend(1)?;
+            let k = self.skip_at(j, meets);
+            if k > 0 {
+                j += k;
+                continue;
+            }
+            if meets(g.lo, g.hi) && !(j >= skip0 && j <= skip1) {
+                work.spend(extra)?;
+                if visit.segment(j) == Flow::Stop {
+                    break;
+                }
+            }
+            j += 1;
+        }
+        Ok(())
+    }
+
+    /// [`Self::visit`] in general: the copies of a periodic key, the aside
+    /// list and the FOE-near list merged into the run in index order. (The
+    /// visitor by reference: this rare path keeps the usual one's visitor
+    /// inlined.)
+    #[inline(never)]
+    fn visit_general(
+        &mut self,
+        query: Query,
+        with_near: bool,
+        skip: Option<(usize, usize)>,
+        (work, extra): (&mut Work, u32),
+        visit: &mut dyn Visitor,
     ) -> Result<(), OutOfWork> {
         let s = self.segments;
-        #[cfg(feature = "_reference")]
-        {
-            probe::add(&probe::QUERIES, 1);
-            probe::add(&probe::ASIDE, self.aside.len() as u32);
-        }
         let mut copies = [(0.0f32, 0.0f32); MAX_COPIES];
         let mut ncopies = 0usize;
         let mut everything = with_near && self.near_overflow;
@@ -405,9 +613,10 @@ impl<const N: usize> Index<N> {
             }
         }
         let hits = |l: f32, h: f32| {
-            everything
-                || l == f32::NEG_INFINITY
-                || copies.iter().any(|&(cl, ch)| l <= ch && h >= cl)
+            l <= h
+                && (everything
+                    || l == f32::NEG_INFINITY
+                    || copies.iter().any(|&(cl, ch)| l <= ch && h >= cl))
         };
         let skipped = |k: usize| skip.is_some_and(|(x, y)| k >= x && k <= y);
         // The merge of three sorted streams: the run, the aside list and
@@ -416,13 +625,27 @@ impl<const N: usize> Index<N> {
         let near: &[u16] = if with_near { &self.near } else { &[] };
         let (mut ia, mut inear) = (0usize, 0usize);
         loop {
+            // A loose index: skip the blocks of the run no copy meets (the
+            // aside and near entries in them keep their own streams, which
+            // the merge below still takes in index order).
+            if self.levels > 0 && !everything {
+                if self.seg.get(j).is_some_and(|g| j < s && g.sm <= top) {
+                    let k =
+                        self.skip_at(j, |l, h| copies.iter().any(|&(cl, ch)| l <= ch && h >= cl));
+                    if k > 0 {
+                        j += k;
+                        work.spend(1)?;
+                        continue;
+                    }
+                }
+            }
             let next_aside = self
                 .aside
                 .get(ia)
                 .map_or(usize::MAX, |&(k, _, _)| usize::from(k));
             let next_near = near.get(inear).map_or(usize::MAX, |&k| usize::from(k));
-            let next_run = match self.sm.get(j) {
-                Some(&m) if j < s && m <= top => j,
+            let next_run = match self.seg.get(j) {
+                Some(g) if j < s && g.sm <= top => j,
                 _ => usize::MAX,
             };
             let next = next_run.min(next_aside).min(next_near);
@@ -441,21 +664,15 @@ impl<const N: usize> Index<N> {
                 inear += 1;
             }
             if next == next_run {
-                if let (Some(&l), Some(&h)) = (self.lo.get(j), self.hi.get(j)) {
-                    take |= hits(l, h);
+                if let Some(g) = self.seg.get(j) {
+                    take |= hits(g.lo, g.hi);
                 }
                 j += 1;
-                #[cfg(feature = "_reference")]
-                probe::add(&probe::RUN, 1);
-            }
-            #[cfg(feature = "_reference")]
-            if take {
-                probe::add(&probe::TAKEN, 1);
             }
             work.spend(1)?;
             if take && !skipped(next) {
                 work.spend(extra)?;
-                if visit(next) == Flow::Stop {
+                if visit.segment(next) == Flow::Stop {
                     return Ok(());
                 }
             }
@@ -502,76 +719,152 @@ impl<const N: usize> Index<N> {
     /// bisection (each step one unit of work).
     #[inline(always)]
     fn run_start(&self, t: f32, work: &mut Work) -> Result<usize, OutOfWork> {
-        let n = self.segments;
-        let pm = self.pm.get(..n).unwrap_or(&[]);
-        let at = |j: usize| pm.get(j).copied().unwrap_or(f32::INFINITY);
-        if n == 0 {
-            return Ok(0);
-        }
-        let mut j = self.hint.min(n - 1);
+        let n = self.segments.min(N);
+        let seg = self.seg.get(..n).unwrap_or(&[]);
+        let at = |j: usize| seg.get(j).map_or(f32::INFINITY, |g| g.pm);
+        let mut j = self.hint.min(n.saturating_sub(1));
+        let mut probes = PROBES;
         if at(j) >= t {
-            for _ in 0..PROBES {
-                if j == 0 || at(j - 1) < t {
-                    return Ok(j);
+            // Back while the one before still reaches t.
+            while j > 0 && at(j - 1) >= t {
+                if probes == 0 {
+                    return bisect(seg, 0, j, t, work);
                 }
+                probes -= 1;
                 j -= 1;
             }
-            bisect(pm, 0, j, t, work)
+            Ok(j)
         } else {
-            for _ in 0..PROBES {
+            // Forward to the first that reaches t.
+            while j < n && at(j) < t {
+                if probes == 0 {
+                    return bisect(seg, j, n, t, work);
+                }
+                probes -= 1;
                 j += 1;
-                if j >= n || at(j) >= t {
-                    return Ok(j);
+            }
+            Ok(j)
+        }
+    }
+}
+
+/// Builds an [`Index`] one vertex at a time (pass 1 of the module docs:
+/// oriented, unwrapped keys, intervals, prefix maxima and the widths' sum,
+/// in locals while the vertices come).
+pub(crate) struct Builder<'a, const N: usize> {
+    index: &'a mut Index<N>,
+    o: f32,
+    period: f32,
+    unkeyed: Unkeyed,
+    n: usize,
+    prev: f32,
+    prev_e: f32,
+    keyed: f32,
+    offset: f32,
+    first: f32,
+    last: f32,
+    run: f32,
+    sum: f32,
+    odd: bool,
+}
+
+impl<const N: usize> Builder<'_, N> {
+    /// The next vertex's raw key ([`NO_KEY`] where none) and margin; at
+    /// most `N` count.
+    #[inline(always)]
+    pub(crate) fn push(&mut self, raw: f32, e: f32) {
+        let i = self.n;
+        let mut k = self.o * raw;
+        if self.period > 0.0 && k.is_finite() {
+            // Consecutive keys are less than half a turn apart.
+            k += self.offset;
+            let d = k - self.keyed;
+            if d > 2.0 {
+                self.offset -= 4.0;
+                k -= 4.0;
+            } else if d < -2.0 {
+                self.offset += 4.0;
+                k += 4.0;
+            }
+            self.keyed = k;
+        }
+        if let Some(m) = self.index.margin.get_mut(i) {
+            *m = e;
+        } else {
+            return;
+        }
+        if let Some(g) = i.checked_sub(1).and_then(|j| self.index.seg.get_mut(j)) {
+            // Both keys finite (their sum is, for keys this small).
+            if (k + self.prev).is_finite() {
+                g.lo = fmin(self.prev - self.prev_e, k - e);
+                g.hi = fmax(self.prev + self.prev_e, k + e);
+                self.sum += g.hi - g.lo;
+            } else {
+                // An unkeyed end: the rebuild sorts it out.
+                self.odd = true;
+                (g.lo, g.hi) = match self.unkeyed {
+                    Unkeyed::MeetAll => (f32::NEG_INFINITY, f32::INFINITY),
+                    Unkeyed::MeetNone => (f32::INFINITY, f32::NEG_INFINITY),
+                };
+            }
+            self.run = fmax(self.run, g.hi);
+            g.pm = self.run;
+        }
+        if k.is_finite() {
+            if !self.first.is_finite() {
+                self.first = k;
+            }
+            self.last = k;
+        }
+        self.prev = k;
+        self.prev_e = e;
+        self.n = i + 1;
+    }
+
+    /// Pass 2 and, when needed, the slow path (module docs); `near(j)`
+    /// says whether segment `j` comes within the FOE-near radius (frame 2
+    /// with `W' < 0`; `None` otherwise).
+    pub(crate) fn finish(self, near: Option<&dyn Fn(usize) -> bool>) {
+        let Builder {
+            index,
+            o,
+            n,
+            first,
+            last,
+            sum,
+            odd,
+            ..
+        } = self;
+        let s = n.saturating_sub(1);
+        index.segments = s;
+        // The keys (oriented by `o`) fall overall: orient them the other way.
+        let flip = last < first;
+        index.orient = o;
+        let wide = WIDE * sum / fmax(s as f32, 1.0);
+        let loose = index.suffix_minima(wide);
+        if loose || odd || flip {
+            index.rebuild(if flip { -o } else { o }, wide);
+        }
+        index.kmin = index.seg.first().map_or(f32::INFINITY, |g| g.sm);
+        index.kmax = index
+            .seg
+            .get(s.wrapping_sub(1))
+            .map_or(f32::NEG_INFINITY, |g| g.pm);
+        for &(_, l, h) in index.aside.iter() {
+            if l.is_finite() && h.is_finite() {
+                index.kmin = fmin(index.kmin, l);
+                index.kmax = fmax(index.kmax, h);
+            }
+        }
+        if let Some(is_near) = near {
+            for j in 0..s {
+                if is_near(j) {
+                    match u16::try_from(j).ok().map(|jj| index.near.push(jj)) {
+                        Some(Ok(())) => {}
+                        _ => index.near_overflow = true,
+                    }
                 }
             }
-            bisect(pm, j + 1, n, t, work)
-        }
-    }
-}
-
-/// Note vertex `v` (key `k`) as an outlier candidate when `k` lies
-/// outside `[min(a, b), max(a, b)]` by more than [`OUTLYING`] times
-/// `|a − b|`, keeping the [`MAX_OUTLIERS`] farthest.
-#[inline(always)]
-fn outlier_candidate(
-    outliers: &mut heapless::Vec<(usize, f32), MAX_OUTLIERS>,
-    v: usize,
-    k: f32,
-    a: f32,
-    b: f32,
-) {
-    let (lo, hi) = (fmin(a, b), fmax(a, b));
-    let dev = fmax(lo - k, k - hi);
-    // (Unkeyed neighbours give NaN or infinities: no candidate.)
-    if !(dev > OUTLYING * (hi - lo)) || !dev.is_finite() {
-        return;
-    }
-    if outliers.push((v, dev)).is_err() {
-        // Full: replace the nearest, if this one is farther.
-        let mut least = 0usize;
-        for (i, &(_, d)) in outliers.iter().enumerate() {
-            if d < outliers.get(least).map_or(f32::INFINITY, |o| o.1) {
-                least = i;
-            }
-        }
-        if let Some(o) = outliers.get_mut(least) {
-            if o.1 < dev {
-                *o = (v, dev);
-            }
-        }
-    }
-}
-
-/// A segment's interval from its two end keys (unwrapped) and their
-/// margins; an unkeyed end makes it meet every key or none.
-#[inline(always)]
-fn segment_interval((k0, e0): (f32, f32), (k1, e1): (f32, f32), unkeyed: Unkeyed) -> (f32, f32) {
-    if k0.is_finite() && k1.is_finite() {
-        (fmin(k0 - e0, k1 - e1), fmax(k0 + e0, k1 + e1))
-    } else {
-        match unkeyed {
-            Unkeyed::MeetAll => (f32::NEG_INFINITY, f32::INFINITY),
-            Unkeyed::MeetNone => (f32::INFINITY, f32::NEG_INFINITY),
         }
     }
 }
@@ -579,7 +872,7 @@ fn segment_interval((k0, e0): (f32, f32), (k1, e1): (f32, f32), unkeyed: Unkeyed
 /// First index in `[lo, hi)` with `v[j] ≥ t` (non-decreasing `v`), or `hi`;
 /// each step one unit of work.
 fn bisect(
-    v: &[f32],
+    v: &[Seg],
     mut lo: usize,
     mut hi: usize,
     t: f32,
@@ -588,10 +881,8 @@ fn bisect(
     hi = hi.min(v.len());
     while lo < hi {
         work.spend(1)?;
-        #[cfg(feature = "_reference")]
-        probe::add(&probe::BISECT, 1);
         let m = lo + (hi - lo) / 2;
-        if v.get(m).copied().unwrap_or(f32::INFINITY) >= t {
+        if v.get(m).map_or(f32::INFINITY, |g| g.pm) >= t {
             hi = m;
         } else {
             lo = m + 1;

@@ -17,6 +17,7 @@ fn main() {
             .unwrap()
     };
     let r = s.render();
+    println!("translation {:?} angles {:?}", r.translation, r.angles);
     let k = s.intrinsics;
     let budget: u32 = std::env::var("BUDGET")
         .ok()
@@ -29,23 +30,6 @@ fn main() {
         Config::default().with_work_budget(budget).unwrap(),
     );
     let st = point_stats(&r, &k, &p);
-    {
-        use roadstereo::probe::*;
-        let (q, run, taken, bis, aside) = (
-            take(&QUERIES),
-            take(&RUN),
-            take(&TAKEN),
-            take(&BISECT),
-            take(&ASIDE),
-        );
-        println!(
-            "queries {q} run {:.1} taken {:.1} bisect {:.1} aside {:.1} per query",
-            run as f64 / q as f64,
-            taken as f64 / q as f64,
-            bis as f64 / q as f64,
-            aside as f64 / q as f64
-        );
-    }
     let counts = p.structure().status_counts();
     for (c, s) in counts.iter().zip(roadstereo::Status::ALL) {
         if *c > 0 {

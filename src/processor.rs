@@ -508,12 +508,94 @@ fn match_boundary<const N: usize>(
     matcher: Matcher,
 ) {
     let mut credit = *work;
+    let lean = matcher == Matcher::Indexed
+        && pair.geom.w() > 0.0
+        && pair.translation <= 0.0
+        && pair.frame_r1.is_some()
+        && keying.angular()
+        && keying.period <= 0.0
+        && index.tight().is_some();
     for r in slots.iter_mut() {
-        if r.status == Status::NoIntersection {
-            *r = match_point(pair, keying, near_foe, r, b2, index, &mut credit, matcher);
+        if r.status != Status::NoIntersection {
+            continue;
         }
+        *r = if lean && r.z_far.is_finite() {
+            match_lean(pair, keying, r, b2, index, &mut credit)
+        } else {
+            match_point(pair, keying, near_foe, r, b2, index, &mut credit, matcher)
+        };
     }
     *work = credit;
+}
+
+/// [`match_point`] for the usual case (`W' > 0`, no motion errors, a
+/// frame-wide `r₁`, half-plane keys, a tight index, the point's key known):
+/// the same band, walk and conclusion, with the run walked here, as
+/// [`Index::visit`] walks it, so that the walk's state stays in registers.
+#[inline(always)]
+fn match_lean<const N: usize>(
+    pair: &Pair,
+    keying: &Keying,
+    r: &PointResult,
+    b2: &[Pixel],
+    index: &mut Index<N>,
+    work: &mut Work,
+) -> PointResult {
+    let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
+    let geom = &pair.geom;
+    let errors = PointErrors {
+        r1,
+        e2: pair.e2(),
+        spread_a: 0.0,
+        spread_w: 0.0,
+    };
+    let Ok(band) = Band::new(p, geom.epipolar_vector(p), geom.w(), &errors, 0.0) else {
+        return PointResult::flagged(p1, Status::AtFoe);
+    };
+    let crate::depth::Reach::Within(t, m) = band.key_half_width(0.0, false, keying.key_scale)
+    else {
+        return PointResult::flagged(p1, Status::NoIntersection);
+    };
+    let Some((segs, orient)) = index.tight() else {
+        return PointResult::flagged(p1, Status::NoIntersection);
+    };
+    let (q0, q1) = (key - (t + m), key + (t + m));
+    let (ql, qh) = if orient < 0.0 { (-q1, -q0) } else { (q0, q1) };
+    let Ok(a) = index.run_start(ql, work) else {
+        return PointResult::flagged(p1, Status::OverBudget);
+    };
+    let mut walk = Walk::new(band, b2, pair.config.cot_twice);
+    let mut credit = work.credit();
+    let mut j = a;
+    let mut over = false;
+    for g in segs.get(a..).unwrap_or(&[]) {
+        if g.sm > qh {
+            break;
+        }
+        if credit == 0 {
+            over = true;
+            break;
+        }
+        credit -= 1;
+        if g.lo <= qh && g.hi >= ql {
+            if credit < CLIP_UNITS {
+                credit = 0;
+                over = true;
+                break;
+            }
+            credit -= CLIP_UNITS;
+            if walk.take(j) == Flow::Stop {
+                break;
+            }
+        }
+        j += 1;
+    }
+    work.set_credit(credit);
+    index.set_hint(a);
+    if over {
+        return PointResult::flagged(p1, Status::OverBudget);
+    }
+    conclude(pair, p1, iz, &band, &errors, walk.outcome())
 }
 
 /// Step 4 for one point left by steps 1–2 in `r`.

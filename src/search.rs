@@ -93,6 +93,18 @@ impl Work {
         self.credit = self.credit.saturating_add(units);
     }
 
+    /// The units left.
+    #[inline(always)]
+    pub(crate) fn credit(&self) -> u32 {
+        self.credit
+    }
+
+    /// Set the units left (a caller that counts them in a local).
+    #[inline(always)]
+    pub(crate) fn set_credit(&mut self, credit: u32) {
+        self.credit = credit;
+    }
+
     /// Pay `units`, or fail (and keep nothing) when there are not enough.
     #[inline(always)]
     pub(crate) fn spend(&mut self, units: u32) -> Result<(), OutOfWork> {
@@ -145,10 +157,10 @@ pub(crate) enum Query {
 /// of the low ends from it on.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-struct Seg {
-    lo: f32,
-    hi: f32,
-    sm: f32,
+pub(crate) struct Seg {
+    pub(crate) lo: f32,
+    pub(crate) hi: f32,
+    pub(crate) sm: f32,
     /// The prefix maximum of the high ends up to this segment.
     pm: f32,
 }
@@ -435,6 +447,24 @@ impl<const N: usize> Index<N> {
         before || after
     }
 
+    /// For a *tight* index (non-periodic keys, nothing aside, no block
+    /// tree): its segments and orientation, for a caller that walks the run
+    /// itself ([`Self::run_start`], then `sm`, `lo`, `hi` as
+    /// [`Self::visit`] does); `None` otherwise.
+    #[inline(always)]
+    pub(crate) fn tight(&self) -> Option<(&[Seg], f32)> {
+        (self.period <= 0.0 && self.aside.is_empty() && self.levels == 0)
+            .then(|| (self.seg.get(..self.segments.min(N)).unwrap_or(&[]), self.orient))
+    }
+
+    /// Remember where a run started (for the next query's probes).
+    #[inline(always)]
+    pub(crate) fn set_hint(&mut self, a: usize) {
+        if a < self.segments {
+            self.hint = a;
+        }
+    }
+
     /// The key margin of vertex `i` (0 when out of range).
     pub(crate) fn margin(&self, i: usize) -> f32 {
         self.margin.get(i).copied().unwrap_or(0.0)
@@ -718,7 +748,7 @@ impl<const N: usize> Index<N> {
     /// The first segment `a` with `pm[a] ≥ t`: probes from the hint, then
     /// bisection (each step one unit of work).
     #[inline(always)]
-    fn run_start(&self, t: f32, work: &mut Work) -> Result<usize, OutOfWork> {
+    pub(crate) fn run_start(&self, t: f32, work: &mut Work) -> Result<usize, OutOfWork> {
         let n = self.segments.min(N);
         let seg = self.seg.get(..n).unwrap_or(&[]);
         let at = |j: usize| seg.get(j).map_or(f32::INFINITY, |g| g.pm);

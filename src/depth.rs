@@ -176,6 +176,9 @@ impl Band {
         err: &PointErrors,
         near_foe: f32,
     ) -> Result<Self, NoBand> {
+        if w > 0.0 && err.spread_a == 0.0 && err.spread_w == 0.0 {
+            return Self::forward(p, a, w, err.r1, err.e2);
+        }
         let a2 = dot(a, a);
         // `a2 > 1e-30` keeps the square root's input in its range (and
         // refuses NaN).
@@ -193,17 +196,7 @@ impl Band {
         let re = r1 + e2;
         let mv = spread_a + (wa + spread_w) * r1;
         let a_minus = a_len - mv;
-        let (h, foe_inv, lam_hi) = if w > 0.0 && spread_a == 0.0 && spread_w == 0.0 {
-            // The usual case. 1/(ρ₁ − r₁ − e₂) = W'/(|a| − W'(r₁ + e₂)), and
-            // h = W' r₁ / A₋ ≤ r₁ W'/(|a| − W'(r₁ + e₂)): one division.
-            let d = a_len - 3.0 * wa * re;
-            // (A NaN fails.)
-            if !(d > 0.0) {
-                return Err(NoBand::AtFoe);
-            }
-            let foe_inv = wa / (a_len - wa * re);
-            (r1 * foe_inv, foe_inv, f32::INFINITY)
-        } else {
+        let (h, foe_inv, lam_hi) = {
             let guard = if w < 0.0 { wa * (near_foe + re) } else { 0.0 };
             // (A NaN fails both.)
             if !(a_minus > 0.0 && a_len > guard) {
@@ -240,6 +233,40 @@ impl Band {
             // The maximum over the band of |μ|/(ρ₁ + λ): at its near end
             // (r₁ + e₂)/(ρ₁ − r₁ − e₂), or its slope h far out.
             half_angle: fmax(re * foe_inv, h),
+            foe_inv,
+        })
+    }
+
+    /// [`Band::new`] in the usual case, `W' > 0` and no translation error:
+    /// `1/(ρ₁ − r₁ − e₂) = W'/(|a| − W'(r₁ + e₂))` and `h = W' r₁ / A₋ ≤ r₁
+    /// W'/(|a| − W'(r₁ + e₂))`, one division; no far limit.
+    #[inline(always)]
+    pub(crate) fn forward(p: [f32; 2], a: [f32; 2], w: f32, r1: f32, e2: f32) -> Result<Self, NoBand> {
+        let a2 = dot(a, a);
+        // `a2 > 1e-30` keeps the square root's input in its range (and
+        // refuses NaN).
+        if !(a2 > 1.0e-30) {
+            return Err(NoBand::AtFoe);
+        }
+        let a_len = sqrt_pos(a2);
+        let re = r1 + e2;
+        // (A NaN fails.)
+        if !(a_len - 3.0 * w * re > 0.0) {
+            return Err(NoBand::AtFoe);
+        }
+        let foe_inv = w / (a_len - w * re);
+        let h = r1 * foe_inv;
+        Ok(Self {
+            p,
+            a,
+            a2,
+            a_len,
+            k0: re * (1.0 + h) * a_len,
+            h,
+            lam_lo: -re * a_len,
+            lam_hi: f32::INFINITY,
+            w,
+            half_angle: re * foe_inv,
             foe_inv,
         })
     }
@@ -361,10 +388,8 @@ impl Band {
                 return None;
             }
         }
-        let crossing = (side_bit(a.mu) != side_bit(b.mu)).then(|| {
-            let t = a.mu / (a.mu - b.mu);
-            (t, a.lam + t * dl)
-        });
+        let crossing =
+            (side_bit(a.mu) != side_bit(b.mu)).then(|| a.lam + a.mu / (a.mu - b.mu) * dl);
         Some(Clipped { lo, hi, crossing })
     }
 
@@ -409,10 +434,12 @@ impl Band {
         Some((s, s_near, s_far))
     }
 
-    /// The frame-2 point at `t` along the segment `v0 → v1`.
+    /// The point of the exact epipolar line at `λ'`: `p₁' + (λ'/|a|²) a`
+    /// (for a crossing: the frame-2 point, on the polyline up to rounding).
     #[inline(always)]
-    pub(crate) fn point_on(v0: [f32; 2], v1: [f32; 2], t: f32) -> [f32; 2] {
-        [v0[0] + t * (v1[0] - v0[0]), v0[1] + t * (v1[1] - v0[1])]
+    pub(crate) fn point_at(&self, lam: f32) -> [f32; 2] {
+        let t = lam / self.a2;
+        [self.p[0] + t * self.a[0], self.p[1] + t * self.a[1]]
     }
 }
 
@@ -438,14 +465,14 @@ impl Vertex {
 }
 
 /// What [`Band::segment`] found: the `λ'` range of the segment's part in the
-/// band, and the exact line's crossing of the segment, `(t along the
-/// segment, λ')` (which the walk keeps only within the band's `λ'` range,
-/// and brings into the pieces' hull against rounding).
+/// band, and the `λ'` of the exact line's crossing of the segment (which
+/// the walk keeps only within the band's `λ'` range, and brings into the
+/// piece's range against rounding).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Clipped {
     pub(crate) lo: f32,
     pub(crate) hi: f32,
-    pub(crate) crossing: Option<(f32, f32)>,
+    pub(crate) crossing: Option<f32>,
 }
 
 /// The side of a vertex from its `μ'`: 0 for `μ' ≥ 0`, 1 for `μ' < 0`. The

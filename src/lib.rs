@@ -33,6 +33,8 @@
     allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)
 )]
 
+#[cfg(feature = "_debug")]
+extern crate std;
 pub mod analysis;
 pub mod boundary;
 mod buffer;
@@ -50,6 +52,7 @@ mod pencil;
 pub mod processor;
 mod search;
 mod structure;
+mod wedge;
 
 pub use boundary::{Boundary, BoundaryError, Frame};
 pub use camera::{Camera, CameraError, Pixel, IMAGE_MARGIN_PX};
@@ -59,7 +62,7 @@ pub use epipolar::PairGeometry;
 pub use motion::{Motion, MotionError};
 pub use processor::Processor;
 pub use structure::{
-    BoundaryStructure, PointResult, ProcessError, Status, Step, Structure, FOLD_WINDOW, MAX_PIECES,
+    BoundaryStructure, PointResult, ProcessError, Status, Step, Structure, FOLD_WINDOW,
 };
 
 // The README's Rust examples are compiled and run as doc tests.

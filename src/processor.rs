@@ -36,10 +36,11 @@ use crate::camera::{Camera, Pixel};
 use crate::config::Config;
 use crate::depth::{interval, Band, PointErrors};
 use crate::epipolar::PairGeometry;
-use crate::matching::{Outcome, Walk};
+use crate::matching::{Outcome, Walker};
 use crate::motion::Motion;
-use crate::pencil::{Keying, NO_KEY};
-use crate::search::{Flow, Index, OutOfWork, Query, Unkeyed, Visitor, Work};
+use crate::pencil::{Keying, Pencil, NO_KEY};
+use crate::wedge::{Wedge, WedgeWalk, WedgeWalker};
+use crate::search::{run_start_in, Flow, Index, OutOfWork, Query, Unkeyed, Visitor, Work};
 use crate::structure::{PointResult, ProcessError, Status, Step, Structure, FOLD_WINDOW};
 
 /// Work units a band test costs on top of the unit of looking at the
@@ -424,41 +425,23 @@ fn fold<const N: usize>(
     allowance: u32,
     work: &mut Work,
 ) {
+    if index.strict() {
+        // No key meets a segment but its own two: nothing folds.
+        let n = u32::try_from(slots.len()).unwrap_or(u32::MAX);
+        work.grant(allowance.saturating_mul(n));
+        return;
+    }
     for (i, r) in slots.iter_mut().enumerate() {
         work.grant(allowance);
         let k = r.z_far;
         if r.status != Status::NoIntersection || !k.is_finite() {
             continue;
         }
-        if !index.may_fold(i, k, FOLD_WINDOW) {
-            continue;
-        }
-        let m = index.margin(i);
-        let skip = (i.saturating_sub(FOLD_WINDOW), i + FOLD_WINDOW - 1);
-        let mut met = Met(false);
-        let done = index.visit(
-            Query::Keys(k - m, k + m),
-            false,
-            Some(skip),
-            (work, 0),
-            &mut met,
-        );
-        match done {
+        match index.folds(i, k, FOLD_WINDOW, work) {
             Err(OutOfWork) => *r = PointResult::flagged(r.pixel1, Status::OverBudget),
-            Ok(()) if met.0 => *r = PointResult::flagged(r.pixel1, Status::Folded),
-            Ok(()) => {}
+            Ok(true) => *r = PointResult::flagged(r.pixel1, Status::Folded),
+            Ok(false) => {}
         }
-    }
-}
-
-/// The fold test's visitor: any segment offered meets the key.
-#[derive(Clone, Copy)]
-struct Met(bool);
-
-impl Visitor for Met {
-    fn segment(&mut self, _: usize) -> Flow {
-        self.0 = true;
-        Flow::Stop
     }
 }
 
@@ -508,94 +491,209 @@ fn match_boundary<const N: usize>(
     matcher: Matcher,
 ) {
     let mut credit = *work;
-    let lean = matcher == Matcher::Indexed
-        && pair.geom.w() > 0.0
-        && pair.translation <= 0.0
-        && pair.frame_r1.is_some()
-        && keying.angular()
-        && keying.period <= 0.0
-        && index.tight().is_some();
-    for r in slots.iter_mut() {
-        if r.status != Status::NoIntersection {
-            continue;
-        }
-        *r = if lean && r.z_far.is_finite() {
-            match_lean(pair, keying, r, b2, index, &mut credit)
+    if let (Pencil::Half { foe, side, .. }, true) = (
+        keying.pencil,
+        pair.geom.w() > 0.0 && pair.translation <= 0.0,
+    ) {
+        if matcher == Matcher::Indexed && index.tight().is_some() {
+            match_wedge_tight(pair, keying, (foe, side), slots, b2, index, &mut credit);
         } else {
-            match_point(pair, keying, near_foe, r, b2, index, &mut credit, matcher)
-        };
+            match_wedge(pair, keying, (foe, side), slots, b2, index, &mut credit, matcher);
+        }
+        *work = credit;
+        return;
+    }
+    for r in slots.iter_mut() {
+        if r.status == Status::NoIntersection {
+            *r = match_point(pair, keying, near_foe, r, b2, index, &mut credit, matcher);
+        }
     }
     *work = credit;
 }
 
-/// [`match_point`] for the usual case (`W' > 0`, no motion errors, a
-/// frame-wide `r₁`, half-plane keys, a tight index, the point's key known):
-/// the same band, walk and conclusion, with the run walked here, as
-/// [`Index::visit`] walks it, so that the walk's state stays in registers.
-#[inline(always)]
-fn match_lean<const N: usize>(
+/// The wedge path through a tight index: every point's run walked in
+/// locals ([`wedge_run`]). (Out of line: a small loop keeps its values in
+/// registers.)
+#[inline(never)]
+fn match_wedge_tight<const N: usize>(
     pair: &Pair,
     keying: &Keying,
-    r: &PointResult,
+    (foe, side): ([f32; 2], f32),
+    slots: &mut [PointResult],
     b2: &[Pixel],
     index: &mut Index<N>,
     work: &mut Work,
-) -> PointResult {
-    let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
-    let geom = &pair.geom;
-    let errors = PointErrors {
-        r1,
-        e2: pair.e2(),
-        spread_a: 0.0,
-        spread_w: 0.0,
+) {
+    let orient = index.orient();
+    let mut hint = index.hint();
+    let (e2, cot_twice, key_scale) = (pair.e2(), pair.config.cot_twice, keying.key_scale);
+    let segments = b2.len().saturating_sub(1);
+    let Some((segs, _)) = index.tight() else {
+        return;
     };
-    let Ok(band) = Band::new(p, geom.epipolar_vector(p), geom.w(), &errors, 0.0) else {
-        return PointResult::flagged(p1, Status::AtFoe);
+    for r in slots.iter_mut() {
+        if r.status != Status::NoIntersection {
+            continue;
+        }
+        let (p1, p, iz, r1) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near);
+        let Ok(wedge) = Wedge::new(p, (foe, side), (r1, e2), key_scale, orient) else {
+            *r = PointResult::flagged(p1, Status::AtFoe);
+            continue;
+        };
+        let (outcome, a) = wedge_run(&wedge, (segs, b2), hint, segments, cot_twice, work);
+        hint = a;
+        *r = conclude_wedge(pair, p1, iz, r1, &wedge, outcome);
+    }
+    index.set_hint(hint);
+}
+
+/// The wedge path through a loose index (the general visit) or the
+/// reference (every segment, with the intervals the index would hold).
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+fn match_wedge<const N: usize>(
+    pair: &Pair,
+    keying: &Keying,
+    (foe, side): ([f32; 2], f32),
+    slots: &mut [PointResult],
+    b2: &[Pixel],
+    index: &mut Index<N>,
+    work: &mut Work,
+    matcher: Matcher,
+) {
+    let orient = match matcher {
+        Matcher::Indexed => index.orient(),
+        Matcher::Reference => 1.0,
     };
-    let crate::depth::Reach::Within(t, m) = band.key_half_width(0.0, false, keying.key_scale)
-    else {
-        return PointResult::flagged(p1, Status::NoIntersection);
+    let (e2, cot_twice) = (pair.e2(), pair.config.cot_twice);
+    let segments = b2.len().saturating_sub(1);
+    for r in slots.iter_mut() {
+        if r.status != Status::NoIntersection {
+            continue;
+        }
+        let (p1, p, iz, r1) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near);
+        let Ok(wedge) = Wedge::new(p, (foe, side), (r1, e2), keying.key_scale, orient) else {
+            *r = PointResult::flagged(p1, Status::AtFoe);
+            continue;
+        };
+        let mut walker = WedgeWalker::new(wedge, b2, cot_twice);
+        let outcome = match matcher {
+            Matcher::Indexed => {
+                let query = if orient < 0.0 {
+                    Query::Keys(-wedge.kh, -wedge.kl)
+                } else {
+                    Query::Keys(wedge.kl, wedge.kh)
+                };
+                match index.visit(query, false, None, (work, CLIP_UNITS), &mut walker) {
+                    Err(OutOfWork) => Outcome::Flag(Status::OverBudget),
+                    Ok(()) => walker.outcome(),
+                }
+            }
+            Matcher::Reference => {
+                for j in 0..segments {
+                    let iv = match (b2.get(j), b2.get(j + 1)) {
+                        (Some(a), Some(b)) => raw_interval(keying, a.arr(), b.arr()),
+                        _ => (f32::INFINITY, f32::NEG_INFINITY),
+                    };
+                    if Visitor::segment(&mut walker, j, iv) == Flow::Stop {
+                        break;
+                    }
+                }
+                walker.outcome()
+            }
+        };
+        *r = conclude_wedge(pair, p1, iz, r1, &wedge, outcome);
+    }
+}
+
+/// A segment's key interval as the index builds it, from raw keys (the
+/// reference's view of [`crate::search`]).
+#[cfg_attr(not(any(test, feature = "_reference")), allow(dead_code))]
+fn raw_interval(keying: &Keying, a: [f32; 2], b: [f32; 2]) -> (f32, f32) {
+    let ((ka, ea), (kb, eb)) = (keying.key(a), keying.key(b));
+    if (ka + kb).is_finite() {
+        (
+            crate::math::fmin(ka - ea, kb - eb),
+            crate::math::fmax(ka + ea, kb + eb),
+        )
+    } else {
+        (f32::NEG_INFINITY, f32::INFINITY)
+    }
+}
+
+/// The wedge walk over a tight index's run (as [`Index::visit`] offers it
+/// and [`WedgeWalker`] takes it: each segment looked at costs a unit, each
+/// one whose interval meets the query [`CLIP_UNITS`] more), with the
+/// walk's values in locals. Returns the outcome and where the run started.
+#[inline(always)]
+fn wedge_run(
+    wedge: &Wedge,
+    (segs, b2): (&[crate::search::Seg], &[Pixel]),
+    hint: usize,
+    segments: usize,
+    cot_twice: f32,
+    work: &mut Work,
+) -> (Outcome, usize) {
+    let (kl, kh) = (wedge.kl, wedge.kh);
+    let a = match run_start_in(segs, hint, kl, work) {
+        Ok(a) => a,
+        Err(OutOfWork) => return (Outcome::Flag(Status::OverBudget), hint),
     };
-    let Some((segs, orient)) = index.tight() else {
-        return PointResult::flagged(p1, Status::NoIntersection);
-    };
-    let (q0, q1) = (key - (t + m), key + (t + m));
-    let (ql, qh) = if orient < 0.0 { (-q1, -q0) } else { (q0, q1) };
-    let Ok(a) = index.run_start(ql, work) else {
-        return PointResult::flagged(p1, Status::OverBudget);
-    };
-    let mut walk = Walk::new(band, b2, pair.config.cot_twice);
-    let mut credit = work.credit();
+    let mut walk = WedgeWalk::NEW;
+    let mut c = work.credit();
     let mut j = a;
-    let mut over = false;
-    for g in segs.get(a..).unwrap_or(&[]) {
-        if g.sm > qh {
+    let mut cached = usize::MAX;
+    let mut va = wedge.vertex([0.0; 2]);
+    let mut stop = None;
+    while let (Some(g), Some(v1)) = (segs.get(j), b2.get(j + 1)) {
+        if g.sm > kh {
             break;
         }
-        if credit == 0 {
-            over = true;
+        if c == 0 {
+            stop = Some(Status::OverBudget);
             break;
         }
-        credit -= 1;
-        if g.lo <= qh && g.hi >= ql {
-            if credit < CLIP_UNITS {
-                credit = 0;
-                over = true;
+        c -= 1;
+        if g.lo <= kh && g.hi >= kl {
+            if c < CLIP_UNITS {
+                c = 0;
+                stop = Some(Status::OverBudget);
                 break;
             }
-            credit -= CLIP_UNITS;
-            if walk.take(j) == Flow::Stop {
+            c -= CLIP_UNITS;
+            if cached != j {
+                if let Some(v) = b2.get(j) {
+                    va = wedge.vertex(v.arr());
+                }
+            }
+            let vb = wedge.vertex(v1.arr());
+            if let Err(s) = walk.take(wedge, j, (&va, &vb), (g.lo, g.hi), segments, cot_twice) {
+                stop = Some(s);
                 break;
             }
+            va = vb;
+            cached = j + 1;
         }
         j += 1;
     }
-    work.set_credit(credit);
-    index.set_hint(a);
-    if over {
-        return PointResult::flagged(p1, Status::OverBudget);
-    }
-    conclude(pair, p1, iz, &band, &errors, walk.outcome())
+    work.set_credit(c);
+    let outcome = match stop {
+        Some(s) => Outcome::Flag(s),
+        None => walk.outcome(),
+    };
+    (outcome, a)
+}
+
+/// The point's result from a wedge walk's outcome: depth and stick
+/// ([`crate::wedge`]).
+fn conclude_wedge(pair: &Pair, p1: Pixel, iz: f32, r1: f32, wedge: &Wedge, outcome: Outcome) -> PointResult {
+    let (lam, lo, hi) = match outcome {
+        Outcome::Match { lam, lo, hi } => (lam, lo, hi),
+        Outcome::Flag(s) => return PointResult::flagged(p1, s),
+    };
+    let p2 = wedge.point_at(lam);
+    let depths = wedge.depths(pair.geom.w(), r1, (lam, lo, hi));
+    finish_point(pair, p1, p2, iz, depths)
 }
 
 /// Step 4 for one point left by steps 1–2 in `r`.
@@ -640,7 +738,7 @@ fn match_point<const N: usize>(
         Matcher::Indexed => {
             let query = band_query(pair, keying, &band, key, near_foe);
             let with_near = geom.w() < 0.0;
-            let mut walk = Walk::new(band, b2, cot_twice);
+            let mut walk = Walker::new(band, b2, cot_twice);
             let done = index.visit(query, with_near, None, (work, CLIP_UNITS), &mut walk);
             match done {
                 Err(OutOfWork) => return PointResult::flagged(p1, Status::OverBudget),
@@ -690,26 +788,32 @@ fn conclude(
     errors: &PointErrors,
     outcome: Outcome,
 ) -> PointResult {
-    let Outcome::Match {
-        p2,
-        lam,
-        lo,
-        hi,
-        pieces,
-    } = outcome
-    else {
-        let Outcome::Flag(s) = outcome else {
-            return PointResult::flagged(p1, Status::NoIntersection);
-        };
-        return PointResult::flagged(p1, s);
+    let (lam, lo, hi) = match outcome {
+        Outcome::Match { lam, lo, hi } => (lam, lo, hi),
+        Outcome::Flag(s) => return PointResult::flagged(p1, s),
     };
+    let p2 = band.point_at(lam);
+    finish_point(pair, p1, p2, iz, band.depths(errors, lam, lo, hi))
+}
+
+/// A matched point's result from its frame-2 point and `(s, s_near,
+/// s_far)` (`None`: the stick is unbounded): eq. 2.3's depth `Z = s/q_z`,
+/// the checks on it, and the stick widened by `q_z`'s uncertainty.
+#[inline(always)]
+fn finish_point(
+    pair: &Pair,
+    p1: Pixel,
+    p2: [f32; 2],
+    iz: f32,
+    depths: Option<(f32, f32, f32)>,
+) -> PointResult {
     let mut r = PointResult {
         pixel1: p1,
         pixel2: Pixel::new(p2[0], p2[1]),
         status: Status::Unbounded,
         ..PointResult::EMPTY
     };
-    let Some((s, s_near, s_far)) = band.depths(errors, lam, lo, hi) else {
+    let Some((s, s_near, s_far)) = depths else {
         return r;
     };
     let z = s * iz;
@@ -730,11 +834,7 @@ fn conclude(
     r.z = z;
     r.z_near = stick.z_near;
     r.z_far = stick.z_far;
-    r.status = if pieces > 1 {
-        Status::Ambiguous
-    } else {
-        Status::Ok
-    };
+    r.status = Status::Ok;
     r
 }
 
@@ -770,3 +870,4 @@ fn segment_distance2(p: [f32; 2], a: [f32; 2], b: [f32; 2]) -> f32 {
     let d = [ap[0] - t * ab[0], ap[1] - t * ab[1]];
     crate::math::dot(d, d)
 }
+

@@ -131,8 +131,9 @@ pub(crate) enum Flow {
 /// Takes the segments a query offers ([`Index::visit`]), in increasing
 /// index.
 pub(crate) trait Visitor {
-    /// Segment `j`; whether to go on.
-    fn segment(&mut self, j: usize) -> Flow;
+    /// Segment `j` with its key interval (oriented; infinite for a segment
+    /// listed as near the FOE); whether to go on.
+    fn segment(&mut self, j: usize, interval: (f32, f32)) -> Flow;
 }
 
 /// How segments with an unkeyable end count.
@@ -197,6 +198,10 @@ pub(crate) struct Index<const N: usize> {
     near: heapless::Vec<u16, MAX_NEAR>,
     near_overflow: bool,
     hint: usize,
+    /// Every vertex is keyed and its widened key lies wholly above the one
+    /// before, or wholly below (no period): no vertex's key meets a
+    /// segment but its own two.
+    strict: bool,
 }
 
 impl<const N: usize> Default for Index<N> {
@@ -222,6 +227,7 @@ impl<const N: usize> Index<N> {
             near: heapless::Vec::new(),
             near_overflow: false,
             hint: 0,
+            strict: false,
         }
     }
 
@@ -257,6 +263,8 @@ impl<const N: usize> Index<N> {
             run: f32::NEG_INFINITY,
             sum: 0.0,
             odd: false,
+            up: true,
+            down: true,
             index: self,
         }
     }
@@ -395,12 +403,12 @@ impl<const N: usize> Index<N> {
     fn skip_at(&self, j: usize, meets: impl Fn(f32, f32) -> bool) -> usize {
         let (mut base, mut size, mut n, mut skip) = (0usize, 1usize, self.segments, 0usize);
         for _ in 0..self.levels {
-            size *= FAN;
+            size = size.saturating_mul(FAN);
             n = n.div_ceil(FAN);
-            if j % size != 0 {
+            // (`size` ≥ 8: the checks never fail.)
+            let (Some(0), Some(b)) = (j.checked_rem(size), j.checked_div(size)) else {
                 break;
-            }
-            let b = j / size;
+            };
             let (lo, hi) = (
                 self.tree
                     .get(base + 2 * b)
@@ -447,6 +455,28 @@ impl<const N: usize> Index<N> {
         before || after
     }
 
+    /// Whether no vertex's key meets a segment other than its own two (so
+    /// no vertex of this polyline folds).
+    pub(crate) fn strict(&self) -> bool {
+        self.strict
+    }
+
+    /// The fold test of vertex `i` with raw key `key`: whether its key
+    /// (widened by its margin) meets a segment outside `i − w ..= i + w −
+    /// 1` ([`Self::may_fold`], then the query; each segment looked at one
+    /// unit of `work`).
+    #[inline(always)]
+    pub(crate) fn folds(&mut self, i: usize, key: f32, w: usize, work: &mut Work) -> Result<bool, OutOfWork> {
+        if self.strict || !self.may_fold(i, key, w) {
+            return Ok(false);
+        }
+        let e = self.margin(i);
+        let skip = (i.saturating_sub(w), i.saturating_add(w).saturating_sub(1));
+        let mut met = Met(false);
+        self.visit(Query::Keys(key - e, key + e), false, Some(skip), (work, 0), &mut met)?;
+        Ok(met.0)
+    }
+
     /// For a *tight* index (non-periodic keys, nothing aside, no block
     /// tree): its segments and orientation, for a caller that walks the run
     /// itself ([`Self::run_start`], then `sm`, `lo`, `hi` as
@@ -457,12 +487,23 @@ impl<const N: usize> Index<N> {
             .then(|| (self.seg.get(..self.segments.min(N)).unwrap_or(&[]), self.orient))
     }
 
+    /// Where the last run started (the next query's probes start there).
+    pub(crate) fn hint(&self) -> usize {
+        self.hint
+    }
+
     /// Remember where a run started (for the next query's probes).
     #[inline(always)]
     pub(crate) fn set_hint(&mut self, a: usize) {
         if a < self.segments {
             self.hint = a;
         }
+    }
+
+    /// The orientation of the keys (+1 or −1; the index holds the keys
+    /// times it).
+    pub(crate) fn orient(&self) -> f32 {
+        self.orient
     }
 
     /// The key margin of vertex `i` (0 when out of range).
@@ -551,7 +592,7 @@ impl<const N: usize> Index<N> {
                     break;
                 }
                 credit -= extra;
-                if visit.segment(j) == Flow::Stop {
+                if visit.segment(j, (g.lo, g.hi)) == Flow::Stop {
                     break;
                 }
             }
@@ -587,7 +628,7 @@ impl<const N: usize> Index<N> {
             }
             if meets(g.lo, g.hi) && !(j >= skip0 && j <= skip1) {
                 work.spend(extra)?;
-                if visit.segment(j) == Flow::Stop {
+                if visit.segment(j, (g.lo, g.hi)) == Flow::Stop {
                     break;
                 }
             }
@@ -683,26 +724,32 @@ impl<const N: usize> Index<N> {
                 return Ok(());
             }
             let mut take = false;
+            // The segment's interval: the union of its streams' (an aside
+            // segment's is empty in the run).
+            let (mut il, mut ih) = (f32::INFINITY, f32::NEG_INFINITY);
             if next == next_aside {
                 if let Some(&(_, l, h)) = self.aside.get(ia) {
                     take |= hits(l, h);
+                    (il, ih) = (fmin(il, l), fmax(ih, h));
                 }
                 ia += 1;
             }
             if next == next_near {
                 take = true;
+                (il, ih) = (f32::NEG_INFINITY, f32::INFINITY);
                 inear += 1;
             }
             if next == next_run {
                 if let Some(g) = self.seg.get(j) {
                     take |= hits(g.lo, g.hi);
+                    (il, ih) = (fmin(il, g.lo), fmax(ih, g.hi));
                 }
                 j += 1;
             }
             work.spend(1)?;
             if take && !skipped(next) {
                 work.spend(extra)?;
-                if visit.segment(next) == Flow::Stop {
+                if visit.segment(next, (il, ih)) == Flow::Stop {
                     return Ok(());
                 }
             }
@@ -745,36 +792,59 @@ impl<const N: usize> Index<N> {
         (ql + 4.0 * m as f32 > self.kmax).then_some(c)
     }
 
-    /// The first segment `a` with `pm[a] ≥ t`: probes from the hint, then
-    /// bisection (each step one unit of work).
+    /// The first segment `a` with `pm[a] ≥ t` ([`run_start_in`] from the
+    /// hint).
     #[inline(always)]
     pub(crate) fn run_start(&self, t: f32, work: &mut Work) -> Result<usize, OutOfWork> {
         let n = self.segments.min(N);
-        let seg = self.seg.get(..n).unwrap_or(&[]);
-        let at = |j: usize| seg.get(j).map_or(f32::INFINITY, |g| g.pm);
-        let mut j = self.hint.min(n.saturating_sub(1));
-        let mut probes = PROBES;
-        if at(j) >= t {
-            // Back while the one before still reaches t.
-            while j > 0 && at(j - 1) >= t {
-                if probes == 0 {
-                    return bisect(seg, 0, j, t, work);
-                }
-                probes -= 1;
-                j -= 1;
+        run_start_in(self.seg.get(..n).unwrap_or(&[]), self.hint, t, work)
+    }
+}
+
+/// The first segment `a` of `seg` with `pm[a] ≥ t`: probes from `hint`,
+/// then bisection after [`PROBES`] (each bisection step one unit of work).
+#[inline(always)]
+pub(crate) fn run_start_in(
+    seg: &[Seg],
+    hint: usize,
+    t: f32,
+    work: &mut Work,
+) -> Result<usize, OutOfWork> {
+    let n = seg.len();
+    let at = |j: usize| seg.get(j).map_or(f32::INFINITY, |g| g.pm);
+    let mut j = hint.min(n.saturating_sub(1));
+    let mut probes = PROBES;
+    if at(j) >= t {
+        // Back while the one before still reaches t.
+        while j > 0 && at(j - 1) >= t {
+            if probes == 0 {
+                return bisect(seg, 0, j, t, work);
             }
-            Ok(j)
-        } else {
-            // Forward to the first that reaches t.
-            while j < n && at(j) < t {
-                if probes == 0 {
-                    return bisect(seg, j, n, t, work);
-                }
-                probes -= 1;
-                j += 1;
-            }
-            Ok(j)
+            probes -= 1;
+            j -= 1;
         }
+        Ok(j)
+    } else {
+        // Forward to the first that reaches t.
+        while j < n && at(j) < t {
+            if probes == 0 {
+                return bisect(seg, j, n, t, work);
+            }
+            probes -= 1;
+            j += 1;
+        }
+        Ok(j)
+    }
+}
+
+/// The fold test's visitor: any segment offered meets the key.
+#[derive(Clone, Copy)]
+struct Met(bool);
+
+impl Visitor for Met {
+    fn segment(&mut self, _: usize, _: (f32, f32)) -> Flow {
+        self.0 = true;
+        Flow::Stop
     }
 }
 
@@ -796,6 +866,10 @@ pub(crate) struct Builder<'a, const N: usize> {
     run: f32,
     sum: f32,
     odd: bool,
+    /// Each vertex's widened key lies wholly above (`up`) or below
+    /// (`down`) the one before, so far.
+    up: bool,
+    down: bool,
 }
 
 impl<const N: usize> Builder<'_, N> {
@@ -826,8 +900,12 @@ impl<const N: usize> Builder<'_, N> {
         if let Some(g) = i.checked_sub(1).and_then(|j| self.index.seg.get_mut(j)) {
             // Both keys finite (their sum is, for keys this small).
             if (k + self.prev).is_finite() {
-                g.lo = fmin(self.prev - self.prev_e, k - e);
-                g.hi = fmax(self.prev + self.prev_e, k + e);
+                let (plo, phi) = (self.prev - self.prev_e, self.prev + self.prev_e);
+                let (vlo, vhi) = (k - e, k + e);
+                self.up &= vlo > phi;
+                self.down &= vhi < plo;
+                g.lo = fmin(plo, vlo);
+                g.hi = fmax(phi, vhi);
                 self.sum += g.hi - g.lo;
             } else {
                 // An unkeyed end: the rebuild sorts it out.
@@ -863,10 +941,14 @@ impl<const N: usize> Builder<'_, N> {
             last,
             sum,
             odd,
+            up,
+            down,
+            period,
             ..
         } = self;
         let s = n.saturating_sub(1);
         index.segments = s;
+        index.strict = !odd && period <= 0.0 && (up || down);
         // The keys (oriented by `o`) fall overall: orient them the other way.
         let flip = last < first;
         index.orient = o;

@@ -8,10 +8,6 @@ use crate::buffer::Buffer;
 use crate::camera::{Camera, Pixel};
 use crate::depth::DepthInterval;
 
-/// At most this many separate pieces of a boundary in one point's error
-/// band are told apart ([`Status::Ambiguous`]); more is [`Status::Tangled`].
-pub const MAX_PIECES: usize = 8;
-
 /// Outcome for one frame-1 boundary point. Only [`Status::Ok`] is unflagged.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -21,10 +17,8 @@ pub enum Status {
     /// meets the corresponding frame-2 boundary in one piece, the exact
     /// epipolar line crosses it there, and the stick is bounded.
     Ok,
-    /// The band meets the boundary in 2 to [`MAX_PIECES`] separate pieces:
-    /// the correspondence is not unique. Depth from the crossing nearest
-    /// the rotated point along the epipolar line (smallest disparity), and
-    /// a stick covering every piece; flagged.
+    /// The band meets the boundary in two (or more) separate pieces: the
+    /// correspondence is not unique, and no depth is given.
     Ambiguous,
     /// The point's error disc holds the focus of expansion, or the point is
     /// too close to it for its band to be told from the FOE's: no disparity.
@@ -37,8 +31,6 @@ pub enum Status {
     /// has no boundary with this index).
     #[default]
     NoIntersection,
-    /// The band meets the boundary in more than [`MAX_PIECES`] pieces.
-    Tangled,
     /// A piece of the boundary in the band is longer than the band's width
     /// over the tangent of the minimum angle: the boundary crosses the
     /// epipolar line flatter than the minimum angle (or runs along it).
@@ -76,14 +68,13 @@ pub const FOLD_WINDOW: usize = 4;
 impl Status {
     /// Whether a depth, 3-D point and stick are given.
     pub fn has_depth(self) -> bool {
-        matches!(self, Status::Ok | Status::Ambiguous)
+        matches!(self, Status::Ok)
     }
     /// Whether a frame-2 crossing was chosen.
     pub fn has_match(self) -> bool {
         matches!(
             self,
             Status::Ok
-                | Status::Ambiguous
                 | Status::NonPositiveDepth
                 | Status::BeyondMaxDepth
                 | Status::Unbounded
@@ -101,7 +92,6 @@ impl Status {
             Status::AtFoe => "at_foe",
             Status::BehindCamera => "behind_camera",
             Status::NoIntersection => "no_intersection",
-            Status::Tangled => "tangled",
             Status::Grazing => "grazing",
             Status::NonPositiveDepth => "non_positive_depth",
             Status::BeyondMaxDepth => "beyond_max_depth",
@@ -113,13 +103,12 @@ impl Status {
         }
     }
     /// Every status, in declaration order.
-    pub const ALL: [Status; 14] = [
+    pub const ALL: [Status; 13] = [
         Status::Ok,
         Status::Ambiguous,
         Status::AtFoe,
         Status::BehindCamera,
         Status::NoIntersection,
-        Status::Tangled,
         Status::Grazing,
         Status::NonPositiveDepth,
         Status::BeyondMaxDepth,

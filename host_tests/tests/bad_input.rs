@@ -257,10 +257,12 @@ fn point_at_the_focus_of_expansion_is_flagged() {
 #[test]
 fn search_range_follows_the_sign_of_w() {
     let cam = Camera::new(800.0, 800.0, 256.0, 240.0, 512, 480).expect("camera");
-    let b1 = [Pixel::new(200.0, 400.0), Pixel::new(220.0, 300.0)];
-    // Frame 1's line, extended, scaled by 1.3 away from the FOE (the
-    // principal point): outward of frame 1, where forward motion moves it.
-    let outward = [Pixel::new(178.0, 474.0), Pixel::new(214.4, 292.0)];
+    // A line the rays from the FOE (the principal point) cross at 60-80°.
+    let b1 = [Pixel::new(150.0, 400.0), Pixel::new(250.0, 380.0)];
+    // Frame 1's line scaled by 1.3 away from the FOE, extended by a fifth
+    // of its length at either end: outward of frame 1, where forward
+    // motion moves it.
+    let outward = [Pixel::new(92.2, 453.2), Pixel::new(274.2, 416.8)];
     for (w, want_match) in [(0.5f32, true), (-0.5, false)] {
         let m = Motion::new([0.0, 0.0, w], [0.0; 3]).expect("motion");
         let mut p = Box::new(Processor::<N, B>::new(Config::default()));

@@ -69,7 +69,7 @@ fn main() -> ! {
         total_points += points as u64;
         worst = worst.max(instr);
         defmt::info!(
-            "frame={=u32} points={=u32} ok={=u32} ambiguous={=u32} at_foe={=u32} behind={=u32} no_intersection={=u32} tangled={=u32} grazing={=u32} nonpositive={=u32} beyond={=u32} unbounded={=u32} folded={=u32} out_of_view={=u32} boundary_end={=u32} over_budget={=u32} instr={=u32} budget_permille={=u32} digest={=u32:08x}",
+            "frame={=u32} points={=u32} ok={=u32} ambiguous={=u32} at_foe={=u32} behind={=u32} no_intersection={=u32} grazing={=u32} nonpositive={=u32} beyond={=u32} unbounded={=u32} folded={=u32} out_of_view={=u32} boundary_end={=u32} over_budget={=u32} instr={=u32} budget_permille={=u32} digest={=u32:08x}",
             i,
             points as u32,
             g(Status::Ok),
@@ -77,7 +77,6 @@ fn main() -> ! {
             g(Status::AtFoe),
             g(Status::BehindCamera),
             g(Status::NoIntersection),
-            g(Status::Tangled),
             g(Status::Grazing),
             g(Status::NonPositiveDepth),
             g(Status::BeyondMaxDepth),

@@ -39,7 +39,7 @@ fn main() -> std::process::ExitCode {
                 let c = s.status_counts();
                 let g = |st: Status| c[st as usize];
                 println!(
-                    "frame={} points={} ok={} ambiguous={} at_foe={} behind={} no_intersection={} tangled={} grazing={} nonpositive={} beyond={} unbounded={} folded={} out_of_view={} boundary_end={} over_budget={} digest={:08x}",
+                    "frame={} points={} ok={} ambiguous={} at_foe={} behind={} no_intersection={} grazing={} nonpositive={} beyond={} unbounded={} folded={} out_of_view={} boundary_end={} over_budget={} digest={:08x}",
                     i,
                     c.iter().sum::<usize>(),
                     g(Status::Ok),
@@ -47,7 +47,6 @@ fn main() -> std::process::ExitCode {
                     g(Status::AtFoe),
                     g(Status::BehindCamera),
                     g(Status::NoIntersection),
-                    g(Status::Tangled),
                     g(Status::Grazing),
                     g(Status::NonPositiveDepth),
                     g(Status::BeyondMaxDepth),

@@ -1,0 +1,404 @@
+//! The usual case of the matching stage: forward motion (`W' > 0`), no
+//! translation error, and a frame-2 boundary on one side of the FOE's row
+//! (half-plane keys, [`crate::pencil`]). Here the error band of
+//! [`crate::depth`] is replaced by a slightly larger region whose test is
+//! mostly a comparison of keys the index already holds: the **wedge**.
+//!
+//! # The wedge holds the band
+//! With the notation of [`crate::depth`] and no translation error, the band
+//! of a compensated point `p₁'` at distance `ρ₁ = |p₁' − F|` from the FOE
+//! `F` is `λ ≥ −(r₁ + e₂)`, `|μ| ≤ (r₁ + e₂)(1 + h) + h λ` with `h = r₁/(ρ₁
+//! − r₁ − e₂)` (`a = W'(p₁' − F)`, so `|a| = W' ρ₁` and `W'/(|a| − W'(r₁ +
+//! e₂)) = 1/(ρ₁ − r₁ − e₂)`). Seen from `F`, a band point at `λ` is at
+//! distance `ρ₁ + λ` along the ray through `p₁'`, so its angle from that ray
+//! has the tangent `|μ|/(ρ₁ + λ)`. At `λ = −(r₁ + e₂)` that is `(r₁ + e₂)/(ρ₁
+//! − r₁ − e₂)`; as `λ` grows the ratio moves monotonically towards its limit
+//! `h`, which is smaller (`r₁ ≤ r₁ + e₂`). So every band point lies in the
+//! wedge of rays from `F` within the angle `θ`, `tan θ = T = (r₁ + e₂)/(ρ₁
+//! − r₁ − e₂)`, of the ray through `p₁'`, at `λ ≥ −(r₁ + e₂)`: the region
+//! this module searches. It is the band widened by at most `(r₁ + e₂)(λ +
+//! r₁ + e₂)/(ρ₁ − r₁ − e₂)` on either side, a few hundredths of a pixel
+//! for a point 100 px from the FOE with a disparity of 10 px.
+//!
+//! # Keys decide most segments
+//! The half-plane key is a strictly monotone function of a ray's angle
+//! about `F` over the half-plane, and along a segment (which cannot pass
+//! through `F`) the angle is monotone, so a segment's rays have the keys
+//! between those of its end points. The wedge's rays have the keys between
+//! those of its two edges (the edge directions `d ± T d⊥`, `d = p₁' − F`;
+//! an edge outside the half-plane stands for the key limit `±1` on its
+//! side, as the wedge leaves the half-plane through the FOE's row). With
+//! every key widened by its rounding margin, a segment whose interval
+//! ([`crate::search`]) misses the wedge's is outside it; one whose interval
+//! lies inside the wedge's is inside it, end to end; only a segment whose
+//! interval straddles an edge's key is clipped by that edge's line, exactly
+//! (one division per edge it crosses). The segment's part in the wedge then
+//! has the range `[λ₀, λ₁]` of `λ = â·(q − p₁')` (`â = d/ρ₁`; `λ` is linear
+//! along the segment, so the ends of the part give it), cut at `λ ≥ −(r₁ +
+//! e₂)`.
+//!
+//! The walk over the segments (in order, with the rules of
+//! [`crate::matching`]: one piece, not grazing, no end vertex inside,
+//! the exact line's nearest crossing for the estimate) gives the piece's
+//! range `[lo, hi]` and the crossing's `λ`, and with `|a| = W' ρ₁`
+//! the depth and stick of [`crate::depth`] become
+//!
+//! `s = W' (1 + ρ₁/λ)`,   `s_far = W' (1 + (ρ₁ + r₁)/(lo − r₁ − e₂))`,
+//! `s_near = W' (1 + (ρ₁ − r₁)/(hi + r₁ + e₂))`
+//!
+//! (numerators and denominators ordered as the IEEE operations keep them,
+//! so the rounded stick holds the rounded estimate). A piece is grazing
+//! when it is longer than the wedge's width at its near end over
+//! `tan φ_min`, `hi − lo > T (ρ₁ + lo) · 2 cot φ_min`: a test that only
+//! becomes true as the piece grows, so the walk may stop at the first
+//! segment that makes it true and get the outcome a walk to the end would.
+//!
+//! # Rounding
+//! `T` is rounded up by `2⁻¹⁶` relative; the edge directions, the keys and
+//! the `λ`s are computed from coordinates below the frame's scale `S` and
+//! are off by a few `2⁻²⁴ S` at most, which the slack of `2⁻²⁰ S` in `r₁`
+//! and `e₂` covers (see [`crate::depth`]).
+
+use crate::camera::Pixel;
+use crate::math::{dot, fmax, fmin, sqrt_pos, sub};
+use crate::matching::Outcome;
+use crate::search::{Flow, Visitor};
+use crate::structure::Status;
+
+/// `2⁻²⁰`, the keys' rounding unit ([`crate::pencil`]).
+const ULP20: f32 = 9.536_743e-7;
+
+/// One point's wedge (see the module docs), in the index's oriented keys.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Wedge {
+    foe: [f32; 2],
+    /// `p₁'`, `d = p₁' − F`, `â = d/ρ₁`, `ρ₁`.
+    p: [f32; 2],
+    d: [f32; 2],
+    u: [f32; 2],
+    pub(crate) rho: f32,
+    /// `T`, the tangent of the half-angle.
+    t: f32,
+    /// The wedge's key interval (oriented, widened by the edges' margins):
+    /// the index query.
+    pub(crate) kl: f32,
+    pub(crate) kh: f32,
+    /// Inward normals of the edges whose keys are `kl` and `kh`.
+    nl: [f32; 2],
+    nh: [f32; 2],
+    /// The exact line's key interval (oriented, widened by its margin).
+    own: (f32, f32),
+    /// `−(r₁ + e₂)`.
+    pub(crate) lam_lo: f32,
+}
+
+/// A point without a wedge: it lies within `3 (r₁ + e₂)` of the FOE
+/// ([`Status::AtFoe`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct AtFoe;
+
+impl Wedge {
+    /// The wedge of compensated point `p` for a FOE `foe`, the boundary on
+    /// the `side` of its row (+1 below), errors `r1`, `e2`, keys with
+    /// `key_scale` (`crate::pencil::Keying`) oriented by `orient`.
+    #[inline(always)]
+    pub(crate) fn new(
+        p: [f32; 2],
+        (foe, side): ([f32; 2], f32),
+        (r1, e2): (f32, f32),
+        key_scale: f32,
+        orient: f32,
+    ) -> Result<Self, AtFoe> {
+        let d = sub(p, foe);
+        let re = r1 + e2;
+        let rho = sqrt_pos(dot(d, d));
+        // (A NaN fails.)
+        if !(rho > 3.0 * re) {
+            return Err(AtFoe);
+        }
+        let inv = 1.0 / rho;
+        let t = re / (rho - re) * (1.0 + 1.53e-5);
+        let perp = [-d[1], d[0]];
+        let em = [d[0] - t * perp[0], d[1] - t * perp[1]];
+        let ep = [d[0] + t * perp[0], d[1] + t * perp[1]];
+        // Keys of the edge directions; an edge outside the half-plane
+        // stands for the key limit where the wedge crosses the FOE's row,
+        // on the side of d (the wedge is narrower than 53°).
+        let limit = orient * if d[0] >= 0.0 { 1.0 } else { -1.0 };
+        let key = |e: [f32; 2]| {
+            let te = side * e[1];
+            if te > 0.0 {
+                let i = 1.0 / (e[0].abs() + te);
+                (orient * (e[0] * i), key_scale * i + ULP20, true)
+            } else {
+                (limit, 0.0, false)
+            }
+        };
+        let ((km, mm, im), (kp, mp, ip)) = (key(em), key(ep));
+        // Inward normals: perp(e₋) and −perp(e₊) point towards d.
+        let (nm, np) = ([-em[1], em[0]], [ep[1], -ep[0]]);
+        let (mut kl, nl, mut kh, nh) = if km <= kp {
+            (km - mm, nm, kp + mp, np)
+        } else {
+            (kp - mp, np, km + mm, nm)
+        };
+        let td = side * d[1];
+        if !(td > 0.0 || im || ip) {
+            // The whole wedge lies beyond the FOE's row: no keyed point.
+            (kl, kh) = (f32::INFINITY, f32::NEG_INFINITY);
+        }
+        // The exact line's own key (none beyond the row: it never enters
+        // the half-plane past p₁').
+        let own = if td > 0.0 {
+            let i = 1.0 / (d[0].abs() + td);
+            let (k, m) = (orient * (d[0] * i), key_scale * i + ULP20);
+            (k - m, k + m)
+        } else {
+            (f32::INFINITY, f32::NEG_INFINITY)
+        };
+        Ok(Self {
+            foe,
+            p,
+            d,
+            u: [d[0] * inv, d[1] * inv],
+            rho,
+            t,
+            kl,
+            kh,
+            nl,
+            nh,
+            own,
+            lam_lo: -re,
+        })
+    }
+
+    /// A vertex in the wedge's frame: `v − F` and its `λ`.
+    #[inline(always)]
+    pub(crate) fn vertex(&self, v: [f32; 2]) -> WVertex {
+        let w = sub(v, self.foe);
+        WVertex {
+            w,
+            lam: dot(self.u, w) - self.rho,
+        }
+    }
+
+    /// The point of the exact line at `λ` (for a crossing: the frame-2
+    /// point, on the polyline up to rounding).
+    #[inline(always)]
+    pub(crate) fn point_at(&self, lam: f32) -> [f32; 2] {
+        [self.p[0] + lam * self.u[0], self.p[1] + lam * self.u[1]]
+    }
+
+    /// The depth estimate and the stick's ends in the compensated frame,
+    /// `(s, s_near, s_far)` (module docs), for `w = W'`; `None` when the
+    /// far end is unbounded (the disparity is not larger than its error).
+    #[inline(always)]
+    pub(crate) fn depths(&self, w: f32, r1: f32, (lam, lo, hi): (f32, f32, f32)) -> Option<(f32, f32, f32)> {
+        let den_far = lo + self.lam_lo;
+        // (A NaN fails.)
+        if !(den_far > 0.0) {
+            return None;
+        }
+        let s = w + w * (self.rho / lam);
+        let s_far = w + w * ((self.rho + r1) / den_far);
+        let s_near = w + w * ((self.rho - r1) / (hi - self.lam_lo));
+        Some((s, s_near, s_far))
+    }
+}
+
+/// A frame-2 vertex relative to the FOE, with its `λ` along a wedge's line.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct WVertex {
+    w: [f32; 2],
+    lam: f32,
+}
+
+/// The walk over a polyline's segments through one wedge (the rules of
+/// [`crate::matching`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct WedgeWalk {
+    /// The segment that continues the piece (`usize::MAX`: none yet).
+    next: usize,
+    lo: f32,
+    hi: f32,
+    /// The nearest crossing's `λ` (infinite: none).
+    best: f32,
+    open: bool,
+}
+
+impl WedgeWalk {
+    pub(crate) const NEW: WedgeWalk = WedgeWalk {
+        next: usize::MAX,
+        lo: 0.0,
+        hi: 0.0,
+        best: f32::INFINITY,
+        open: false,
+    };
+
+    /// Take segment `j` from vertex `a` to vertex `b`, whose key interval
+    /// (oriented, [`crate::search`]) is `(klo, khi)`, of a polyline of
+    /// `segments` segments; segments come in increasing index. `Err` when
+    /// the outcome is decided ([`Status::Ambiguous`] or
+    /// [`Status::Grazing`]).
+    #[inline(always)]
+    pub(crate) fn take(
+        &mut self,
+        wedge: &Wedge,
+        j: usize,
+        (a, b): (&WVertex, &WVertex),
+        (klo, khi): (f32, f32),
+        segments: usize,
+        cot_twice: f32,
+    ) -> Result<(), Status> {
+        if klo > wedge.kh || khi < wedge.kl {
+            return Ok(());
+        }
+        let (mut t0, mut t1) = (0.0f32, 1.0f32);
+        if klo < wedge.kl || khi > wedge.kh {
+            // The segment's rays reach past an edge: clip it by that edge's
+            // line (the side towards d is inside).
+            for (cut, n) in [(klo < wedge.kl, wedge.nl), (khi > wedge.kh, wedge.nh)] {
+                if cut {
+                    let (ca, cb) = (dot(n, a.w), dot(n, b.w));
+                    if ca < 0.0 {
+                        if cb < 0.0 {
+                            return Ok(());
+                        }
+                        t0 = fmax(t0, ca / (ca - cb));
+                    } else if cb < 0.0 {
+                        t1 = fmin(t1, ca / (ca - cb));
+                    }
+                }
+            }
+            // (A NaN fails.)
+            if !(t0 <= t1) {
+                return Ok(());
+            }
+        }
+        let dl = b.lam - a.lam;
+        let l0 = if t0 == 0.0 { a.lam } else { a.lam + t0 * dl };
+        let l1 = if t1 == 1.0 { b.lam } else { a.lam + t1 * dl };
+        let (lo, hi) = if l0 <= l1 { (l0, l1) } else { (l1, l0) };
+        // (A NaN fails.)
+        if !(hi >= wedge.lam_lo) {
+            return Ok(());
+        }
+        let lo = fmax(lo, wedge.lam_lo);
+        if self.next == j {
+            self.lo = fmin(self.lo, lo);
+            self.hi = fmax(self.hi, hi);
+        } else {
+            if self.next != usize::MAX {
+                return Err(Status::Ambiguous);
+            }
+            self.lo = lo;
+            self.hi = hi;
+            // The first vertex is in the wedge when no edge cut it off.
+            self.open |= j == 0 && t0 == 0.0 && a.lam >= wedge.lam_lo;
+        }
+        self.open |= j + 1 == segments && t1 == 1.0 && b.lam >= wedge.lam_lo;
+        self.next = j + 1;
+        if self.hi - self.lo > wedge.t * (wedge.rho + self.lo) * cot_twice {
+            return Err(Status::Grazing);
+        }
+        if klo <= wedge.own.1 && khi >= wedge.own.0 {
+            // The exact line may cross here: the sides of the ends.
+            let d = wedge.d;
+            let (sa, sb) = (d[0] * a.w[1] - d[1] * a.w[0], d[0] * b.w[1] - d[1] * b.w[0]);
+            if crate::depth::side_bit(sa) != crate::depth::side_bit(sb) {
+                let lam = a.lam + sa / (sa - sb) * dl;
+                if lam < self.best && lam > wedge.lam_lo {
+                    self.best = lam;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The outcome once the segments are through (`λ` in pixels).
+    #[inline(always)]
+    pub(crate) fn outcome(&self) -> Outcome {
+        if self.open {
+            return Outcome::Flag(Status::BoundaryEnd);
+        }
+        if self.next == usize::MAX || self.best == f32::INFINITY {
+            return Outcome::Flag(Status::NoIntersection);
+        }
+        Outcome::Match {
+            lam: fmin(fmax(self.best, self.lo), self.hi),
+            lo: self.lo,
+            hi: self.hi,
+        }
+    }
+}
+
+/// A wedge walk as an index [`Visitor`] (the loose index, and the
+/// reference): the wedge, the polyline, the last vertex (reused along a
+/// run) and the walk.
+#[derive(Clone, Copy)]
+pub(crate) struct WedgeWalker<'a> {
+    wedge: Wedge,
+    boundary: &'a [Pixel],
+    cot_twice: f32,
+    cache_i: usize,
+    cache: WVertex,
+    walk: WedgeWalk,
+    decided: Option<Status>,
+}
+
+impl<'a> WedgeWalker<'a> {
+    pub(crate) fn new(wedge: Wedge, boundary: &'a [Pixel], cot_twice: f32) -> Self {
+        Self {
+            wedge,
+            boundary,
+            cot_twice,
+            cache_i: usize::MAX,
+            cache: WVertex {
+                w: [0.0; 2],
+                lam: 0.0,
+            },
+            walk: WedgeWalk::NEW,
+            decided: None,
+        }
+    }
+
+    #[inline(always)]
+    fn vertex(&mut self, i: usize) -> Option<WVertex> {
+        if self.cache_i == i {
+            return Some(self.cache);
+        }
+        let v = self.boundary.get(i)?;
+        self.cache = self.wedge.vertex(v.arr());
+        self.cache_i = i;
+        Some(self.cache)
+    }
+
+    /// The walk's outcome.
+    pub(crate) fn outcome(&self) -> Outcome {
+        match self.decided {
+            Some(s) => Outcome::Flag(s),
+            None => self.walk.outcome(),
+        }
+    }
+}
+
+impl Visitor for WedgeWalker<'_> {
+    #[inline(always)]
+    fn segment(&mut self, j: usize, interval: (f32, f32)) -> Flow {
+        let (Some(a), Some(b)) = (self.vertex(j), self.vertex(j + 1)) else {
+            return Flow::Continue;
+        };
+        let segments = self.boundary.len().saturating_sub(1);
+        let wedge = self.wedge;
+        match self
+            .walk
+            .take(&wedge, j, (&a, &b), interval, segments, self.cot_twice)
+        {
+            Ok(()) => Flow::Continue,
+            Err(s) => {
+                self.decided = Some(s);
+                Flow::Stop
+            }
+        }
+    }
+}

@@ -115,7 +115,7 @@ fn vertical_translation_error_dominates() {
                 for (k, a) in acc.iter_mut().enumerate() {
                     let mut e = [0.0f32; 3];
                     e[k] = 1.0;
-                    let ec = vehicle_to_camera(e, tilt);
+                    let ec = vehicle_to_camera(e, tilt).expect("tilt in range");
                     let d: f32 = (0..3).map(|i| g[i] * ec[i]).sum();
                     *a += f64::from((d / z).abs());
                 }

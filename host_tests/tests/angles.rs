@@ -288,3 +288,171 @@ fn ground_in_view_reduces_the_tilt() {
         assert_eq!(ground_interval(1.0, 0.4, fov), Err(e), "half fov {fov}");
     }
 }
+
+/// `Intrinsics::predicted_foe` and `camera_motion` at every roll of the
+/// table, against `f64` (the issue: a roll of 7 rad gave a wrong FOE). An
+/// FOE `f · t / t_z` away moves by about `f |t| / t_z · δ` for a rotation
+/// error `δ` (1.2e-7 here): 2e-4 px for this camera and translation.
+#[test]
+fn calibration_reduces_every_roll() {
+    use roadstereo::calibration::{CalibrationError, Intrinsics};
+    let base = Intrinsics {
+        cx: 273.59,
+        cy: 233.96,
+        roll: 0.0,
+        fx: 614.5,
+        fy: 780.7,
+    };
+    let t = [2.5f32, -1.5, 2.5];
+    let robot = roadstereo::Motion::new([0.3, 0.1, 1.0], [0.0, 0.1, 0.0]).unwrap();
+    for x in accepted() {
+        let k = Intrinsics { roll: x, ..base };
+        let (s, c) = (sin(x), cos(x));
+        let (tx, ty, tz) = (f64::from(t[0]), f64::from(t[1]), f64::from(t[2]));
+        let want = [
+            f64::from(k.cx) + f64::from(k.fx) * (c * tx + s * ty) / tz,
+            f64::from(k.cy) + f64::from(k.fy) * (-s * tx + c * ty) / tz,
+        ];
+        let got = k.predicted_foe(t).unwrap();
+        assert!(
+            close(got.u, want[0], 2e-4, 1e-6) && close(got.v, want[1], 2e-4, 1e-6),
+            "roll {x}: {got:?} vs {want:?}"
+        );
+        // T_c = R_zᵀ T and R_c = R_zᵀ R_y(0.1) R_z, in f64.
+        let m = k.camera_motion(&robot).unwrap();
+        let tc = [0.3 * c + 0.1 * s, -0.3 * s + 0.1 * c, 1.0];
+        for (g, w) in m.translation().iter().zip(tc) {
+            assert!(close(*g, w, 1e-6, 0.0), "roll {x}: {g} vs {w}");
+        }
+        let (sb, cb) = (libm::sin(0.1), libm::cos(0.1));
+        let ry = [[cb, 0.0, sb], [0.0, 1.0, 0.0], [-sb, 0.0, cb]];
+        let rz = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+        let mul = |a: [[f64; 3]; 3], b: [[f64; 3]; 3]| {
+            let mut o = [[0.0; 3]; 3];
+            for (i, row) in o.iter_mut().enumerate() {
+                for (j, cell) in row.iter_mut().enumerate() {
+                    *cell = (0..3).map(|k| a[i][k] * b[k][j]).sum();
+                }
+            }
+            o
+        };
+        let rzt = [[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]];
+        let want = mul(rzt, mul(ry, rz));
+        let got = m.rotation_matrix();
+        for i in 0..3 {
+            for j in 0..3 {
+                // Through asin/atan2 and back: a few ulps of 1.
+                assert!(
+                    close(got[i][j], want[i][j], 1e-6, 0.0),
+                    "roll {x}: R[{i}][{j}]"
+                );
+            }
+        }
+    }
+    for (x, e) in rejected() {
+        let k = Intrinsics { roll: x, ..base };
+        // NaN and infinite parameters are NotFinite, as for every field.
+        let want = if e == AngleError::NotFinite {
+            CalibrationError::NotFinite
+        } else {
+            CalibrationError::Angle(e)
+        };
+        assert_eq!(k.predicted_foe(t), Err(want), "roll {x}");
+        assert_eq!(k.camera_motion(&robot), Err(want), "roll {x}");
+    }
+}
+
+/// `calibrate_jointly` started from a roll whole turns away from the
+/// step-by-step one converges to the same camera (within the joint fit's
+/// tolerances of the truth: c ± 1.5 px, γ ± 0.5°, f ± 2 %), with its roll
+/// reported in `[−π, π]`; a start roll beyond the range is a typed error.
+#[test]
+fn joint_calibration_reduces_the_start_roll() {
+    use host_tests::calib::{calibrate_run, paper_motions, TrueCamera};
+    use roadstereo::calibration::{calibrate_jointly, CalibrationError, Intrinsics, MotionFlows};
+    let cam = TrueCamera::default();
+    let (sets, stepwise, joint) = calibrate_run(&cam, &paper_motions(), 50, 0.0, 11).unwrap();
+    let motions: Vec<MotionFlows<'_>> = paper_motions()
+        .iter()
+        .zip(&sets)
+        .map(|(t, f)| MotionFlows {
+            translation: t.map(|x| x as f32),
+            flows: f,
+        })
+        .collect();
+    let tau = std::f32::consts::TAU;
+    for turns in [-3.0f32, -1.0, 1.0, 2.0, 1000.0] {
+        let start = Intrinsics {
+            roll: stepwise.roll + turns * tau,
+            ..stepwise
+        };
+        let j = calibrate_jointly::<512>(&motions, &start).unwrap();
+        let k = j.intrinsics;
+        assert!(
+            (-std::f32::consts::PI..=std::f32::consts::PI).contains(&k.roll),
+            "{k:?}"
+        );
+        assert!(
+            (f64::from(k.roll) - cam.roll).to_degrees().abs() <= 0.5,
+            "{turns}: {k:?}"
+        );
+        assert!((f64::from(k.cx) - cam.cx).hypot(f64::from(k.cy) - cam.cy) <= 1.5);
+        assert!((f64::from(k.fx) / cam.fx - 1.0).abs() <= 0.02);
+        assert!((f64::from(k.fy) / cam.fy - 1.0).abs() <= 0.02);
+        // The same minimum as from the step-by-step start.
+        assert!(
+            (k.roll - joint.intrinsics.roll).abs() < 1e-4,
+            "{turns}: {k:?}"
+        );
+    }
+    for (x, e) in rejected() {
+        let start = Intrinsics {
+            roll: x,
+            ..stepwise
+        };
+        let want = if e == AngleError::NotFinite {
+            CalibrationError::NotFinite
+        } else {
+            CalibrationError::Angle(e)
+        };
+        assert_eq!(calibrate_jointly::<512>(&motions, &start), Err(want));
+    }
+}
+
+/// The two functions that validate their angles into the unreduced
+/// kernel's range instead: `Motion::new` (±60° per axis, the rotation
+/// matrix against `f64`) and `Config::new` (a minimum angle of 0.1°–89°).
+#[test]
+fn validated_angle_ranges_hold_at_their_ends() {
+    use roadstereo::motion::MAX_ROTATION_RAD;
+    use roadstereo::{Config, ConfigError, Motion, MotionError};
+    for a in [0.0f32, -0.0, 0.4, MAX_ROTATION_RAD, -MAX_ROTATION_RAD] {
+        let m = Motion::new([0.0, 0.0, 1.0], [0.0, a, 0.0]).unwrap();
+        let r = m.rotation_matrix();
+        // R_y(β): r00 = cos β, r02 = sin β.
+        assert!(close(r[0][0], cos(a), 1.2e-7, 0.0) && close(r[0][2], sin(a), 1.2e-7, 0.0));
+    }
+    for (a, e) in [
+        (up(MAX_ROTATION_RAD), MotionError::RotationTooLarge),
+        (6.0, MotionError::RotationTooLarge),
+        (f32::MAX, MotionError::RotationTooLarge),
+        (f32::NAN, MotionError::NotFinite),
+        (f32::INFINITY, MotionError::NotFinite),
+    ] {
+        for axis in 0..3 {
+            let mut rot = [0.0; 3];
+            rot[axis] = a;
+            assert_eq!(Motion::new([0.0, 0.0, 1.0], rot), Err(e), "{a}");
+        }
+    }
+    for deg in [0.1f32, 10.0, 89.0] {
+        assert!(Config::new(0.5, 0.5, deg, 100.0).is_ok(), "{deg}");
+    }
+    for deg in [0.09f32, 89.01, 400.0, f32::NAN, f32::INFINITY] {
+        assert_eq!(
+            Config::new(0.5, 0.5, deg, 100.0),
+            Err(ConfigError::MinAngle),
+            "{deg}"
+        );
+    }
+}

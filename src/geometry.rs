@@ -188,8 +188,8 @@ fn heights<const N: usize>(points: &[Sample], s: f32, c: f32, m: usize) -> Optio
                 cover = cover.saturating_sub(1);
                 j += 1;
             }
-            // Every interval has `lo ≤ hi`, so the ends above run out
-            // together; this arm only ends the sweep.
+            // Every interval has `lo ≤ hi`, so the sorted lo ends run out
+            // no later than the hi ends: this arm only ends the sweep.
             (Some(_), None) | (None, None) => break,
         }
     }

@@ -59,7 +59,8 @@ fn sqrt_estimate(x: f32) -> f32 {
 ///
 /// Callers that may use this one, each with its range established before
 /// the call: `Motion::new` (`|angle| ≤` `MAX_ROTATION_RAD`, 60°),
-/// `Config::new` (0.1°–89°), the tilt grid of `geometry` (0°–60°), and
+/// `Config::new` (0.1°–89°), the tilt grid of `geometry` (0°–60°), the
+/// ground interval of `analysis` (rays checked to be in `(0, π/2)`), and
 /// [`sin_cos_reduced`] on its reduced argument (`|r| ≤ π/4 + 1e-3`).
 ///
 /// `libm`'s `sinf`/`cosf` reduce their argument in double precision, which

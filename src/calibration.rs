@@ -252,8 +252,11 @@ fn pair(a: &Flow, b: &Flow) -> Option<[f32; 2]> {
 ///    most `max(3 × median, FLOW_TOLERANCE_PX)`, and re-fit by weighted
 ///    least squares on the misalignments.
 ///
-/// Zero-length flows are ignored. `N` is the capacity. Work `O(n²)` for
-/// `n ≤ N` flows (a calibration, not a per-frame task).
+/// Zero-length flows are ignored. `N` is the capacity. Every flow end must
+/// be finite and within ±[`MAX_COORD_PX`] (`NotFinite`, `OutOfRange`);
+/// [`CalibrationError::Overflow`] if the FOE or its spread would not be
+/// finite. Work `O(n²)` for `n ≤ N` flows (a calibration, not a per-frame
+/// task).
 ///
 /// ```
 /// use roadstereo::calibration::{focus_of_expansion, Flow};
@@ -667,7 +670,8 @@ pub const JOINT_ITERATIONS: usize = 10;
 /// [`focus_of_expansion`], `start` finite with its roll within
 /// ±[`crate::MAX_ANGLE_RAD`]. The result's roll is in `[−π, π]`; every
 /// number of the result is finite ([`CalibrationError::Overflow`]
-/// otherwise). Work: at most `JOINT_ITERATIONS + 1` passes over the flows.
+/// otherwise). Work: at most `JOINT_ITERATIONS + 1` passes over the flows,
+/// each `O(n²)` per motion of `n ≤ N` flows (the median of the masks).
 pub fn calibrate_jointly<const N: usize>(
     motions: &[MotionFlows<'_>],
     start: &Intrinsics,

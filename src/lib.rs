@@ -59,6 +59,7 @@ pub use camera::{Camera, CameraError, Pixel, IMAGE_MARGIN_PX};
 pub use config::{Config, ConfigError};
 pub use depth::DepthInterval;
 pub use epipolar::PairGeometry;
+pub use math::{AngleError, MAX_ANGLE_RAD};
 pub use motion::{Motion, MotionError};
 pub use processor::Processor;
 pub use structure::{

@@ -40,10 +40,18 @@ fn rz(t: f64) -> M3 {
     let (s, c) = t.sin_cos();
     [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
 }
-fn add(a: V3, b: V3) -> V3 {
+/// The rotation of the README's conventions, `R = R_y(β) R_x(α) R_z(γ)`
+/// for angles `(α, β, γ)`.
+pub fn rotation(angles: V3) -> M3 {
+    mm(&mm(&ry(angles[1]), &rx(angles[0])), &rz(angles[2]))
+}
+
+/// Vector sum.
+pub fn add(a: V3, b: V3) -> V3 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
-fn sub(a: V3, b: V3) -> V3 {
+/// Vector difference.
+pub fn sub(a: V3, b: V3) -> V3 {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
@@ -272,7 +280,7 @@ impl Pose {
     /// The pose after the documented motion: translation `t` (in this
     /// camera's coordinates) and rotation angles (α, β, γ).
     pub fn moved(&self, t: V3, angles: V3) -> Self {
-        let rel = mm(&mm(&ry(angles[1]), &rx(angles[0])), &rz(angles[2]));
+        let rel = rotation(angles);
         Self {
             centre: add(self.centre, mv(&self.rot, t)),
             rot: mm(&self.rot, &rel),
@@ -441,6 +449,8 @@ pub struct Rendered {
     pub pose2: Pose,
     /// World boundary polylines (for plots).
     pub world: [Vec<V3>; 2],
+    /// For each boundary `k` of `frame1`/`frame2`, its curve in `world`.
+    pub world_index: Vec<usize>,
 }
 
 impl Scenario {
@@ -490,18 +500,24 @@ impl Scenario {
                 }
             }
         };
-        let (translation, angles) = pose1.motion_to(&pose2);
+        // A given camera motion is the motion, exactly (`W = 0` stays 0, not
+        // the 1e-17 the round trip through the poses would give).
+        let (translation, angles) = self
+            .camera_motion
+            .unwrap_or_else(|| pose1.motion_to(&pose2));
         let world = self.road.boundaries(2.0, self.range, 0.01);
         let k = &self.intrinsics;
         let rows = self.rows();
         let mut frame1 = Vec::new();
         let mut frame2 = Vec::new();
-        for curve in &world {
+        let mut world_index = Vec::new();
+        for (wi, curve) in world.iter().enumerate() {
             let b1 = detect_rows(curve, &pose1, k, self.range, &rows);
             let b2 = detect_rows(curve, &pose2, k, self.range, &rows);
             if b1.len() >= 2 && b2.len() >= 2 {
                 frame1.push(b1);
                 frame2.push(b2);
+                world_index.push(wi);
             }
         }
         Rendered {
@@ -512,6 +528,7 @@ impl Scenario {
             pose1,
             pose2,
             world,
+            world_index,
         }
     }
 }

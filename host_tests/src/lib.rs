@@ -3,6 +3,7 @@
 //! search, and helpers shared by the tests and the host tools.
 
 pub mod calib;
+pub mod certify;
 pub mod drive;
 pub mod jsonl;
 pub mod scenarios;

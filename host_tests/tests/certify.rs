@@ -77,8 +77,27 @@ fn print_report(rep: &Report, seconds: f64) {
             t.ok_unobserved_miss
         );
     }
-    println!("\n{} misses; the worst 10:", rep.misses.len());
-    for m in rep.misses.iter().take(10) {
+    // The worst miss of each scenario and variant, the worst 10 of those.
+    let mut groups: Vec<(&host_tests::certify::Miss, usize)> = Vec::new();
+    for m in &rep.misses {
+        match groups
+            .iter_mut()
+            .find(|(w, _)| (w.family, w.seed, w.variant) == (m.family, m.seed, m.variant))
+        {
+            Some(g) => g.1 += 1,
+            None => groups.push((m, 1)),
+        }
+    }
+    println!(
+        "\n{} misses in {} scenario variants; the worst of each, worst first:",
+        rep.misses.len(),
+        groups.len()
+    );
+    for (m, n) in &groups {
+        println!("  {n:4} × {}", m.describe());
+    }
+    println!("\nReplays of the worst 10:");
+    for (m, _) in groups.iter().take(10) {
         println!("* {}", m.describe());
         let replay = Case::new(m.family, m.seed).and_then(|c| replay_for(&c, m));
         match replay {

@@ -23,7 +23,7 @@ pub struct DriveFrame {
 pub fn encode(k: &Intrinsics, frames: &[DriveFrame]) -> Vec<u8> {
     let mut b = Vec::new();
     b.extend_from_slice(b"RSD1");
-    for x in [k.f, k.f, k.cx, k.cy] {
+    for x in [k.fx, k.fy, k.cx, k.cy] {
         b.extend_from_slice(&(x as f32).to_le_bytes());
     }
     b.extend_from_slice(&k.width.to_le_bytes());
@@ -138,7 +138,8 @@ pub fn bench_pair_one_per_row(n: usize) -> (Intrinsics, Vec<DriveFrame>) {
     let base = Intrinsics::default();
     let s = f64::from(scale);
     let k = Intrinsics {
-        f: base.f * s,
+        fx: base.fx * s,
+        fy: base.fy * s,
         cx: (base.cx + 0.5) * s - 0.5,
         cy: (base.cy + 0.5) * s - 0.5,
         width: base.width * scale,

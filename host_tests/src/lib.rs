@@ -3,6 +3,7 @@
 //! tests and the host tools.
 
 pub mod calib;
+pub mod certify;
 pub mod drive;
 pub mod jsonl;
 pub mod scenarios;

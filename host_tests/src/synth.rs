@@ -8,9 +8,10 @@
 //! `y = 0`; the camera sits `h` above it, pitched down by the tilt `θ`.
 
 pub type V3 = [f64; 3];
-type M3 = [[f64; 3]; 3];
+pub type M3 = [[f64; 3]; 3];
 
-fn mm(a: &M3, b: &M3) -> M3 {
+/// Matrix product.
+pub fn mm(a: &M3, b: &M3) -> M3 {
     let mut m = [[0.0; 3]; 3];
     for i in 0..3 {
         for j in 0..3 {
@@ -19,10 +20,12 @@ fn mm(a: &M3, b: &M3) -> M3 {
     }
     m
 }
-fn mv(a: &M3, v: V3) -> V3 {
+/// Matrix times vector.
+pub fn mv(a: &M3, v: V3) -> V3 {
     [0, 1, 2].map(|i| a[i][0] * v[0] + a[i][1] * v[1] + a[i][2] * v[2])
 }
-fn tr(a: &M3) -> M3 {
+/// Transpose.
+pub fn tr(a: &M3) -> M3 {
     [0, 1, 2].map(|i| [a[0][i], a[1][i], a[2][i]])
 }
 fn rx(t: f64) -> M3 {
@@ -37,17 +40,27 @@ fn rz(t: f64) -> M3 {
     let (s, c) = t.sin_cos();
     [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
 }
-fn add(a: V3, b: V3) -> V3 {
+/// The rotation of the README's conventions, `R = R_y(β) R_x(α) R_z(γ)`
+/// for angles `(α, β, γ)`.
+pub fn rotation(angles: V3) -> M3 {
+    mm(&mm(&ry(angles[1]), &rx(angles[0])), &rz(angles[2]))
+}
+
+/// Vector sum.
+pub fn add(a: V3, b: V3) -> V3 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
-fn sub(a: V3, b: V3) -> V3 {
+/// Vector difference.
+pub fn sub(a: V3, b: V3) -> V3 {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// The camera intrinsics of the paper's simulation (Sec. 3) by default.
+/// Pixels: `u = cx + fx x/z`, `v = cy + fy y/z` (README, "Conventions").
 #[derive(Debug, Clone, Copy)]
 pub struct Intrinsics {
-    pub f: f64,
+    pub fx: f64,
+    pub fy: f64,
     pub cx: f64,
     pub cy: f64,
     pub width: u16,
@@ -57,7 +70,8 @@ pub struct Intrinsics {
 impl Default for Intrinsics {
     fn default() -> Self {
         Self {
-            f: 800.0,
+            fx: 800.0,
+            fy: 800.0,
             cx: 255.5,
             cy: 239.5,
             width: 512,
@@ -67,10 +81,39 @@ impl Default for Intrinsics {
 }
 
 impl Intrinsics {
+    /// The paper's calibrated camera (Appendix II B): non-square pixels
+    /// (aspect 0.787) and an off-centre principal point, 512 × 480.
+    pub fn paper_calibrated() -> Self {
+        Self {
+            fx: 614.5,
+            fy: 780.7,
+            cx: 273.59,
+            cy: 233.96,
+            width: 512,
+            height: 480,
+        }
+    }
+
+    /// Pixel of a point in camera coordinates (`None` behind or on the
+    /// camera plane).
+    pub fn project(&self, c: V3) -> Option<[f64; 2]> {
+        (c[2] > 0.0).then(|| {
+            [
+                self.cx + self.fx * c[0] / c[2],
+                self.cy + self.fy * c[1] / c[2],
+            ]
+        })
+    }
+
+    /// The normalised ray `(x, y, 1)` of a pixel.
+    pub fn ray(&self, u: f64, v: f64) -> V3 {
+        [(u - self.cx) / self.fx, (v - self.cy) / self.fy, 1.0]
+    }
+
     pub fn camera(&self) -> roadstereo::Camera {
         roadstereo::Camera::new(
-            self.f as f32,
-            self.f as f32,
+            self.fx as f32,
+            self.fy as f32,
             self.cx as f32,
             self.cy as f32,
             self.width,
@@ -237,7 +280,7 @@ impl Pose {
     /// The pose after the documented motion: translation `t` (in this
     /// camera's coordinates) and rotation angles (α, β, γ).
     pub fn moved(&self, t: V3, angles: V3) -> Self {
-        let rel = mm(&mm(&ry(angles[1]), &rx(angles[0])), &rz(angles[2]));
+        let rel = rotation(angles);
         Self {
             centre: add(self.centre, mv(&self.rot, t)),
             rot: mm(&self.rot, &rel),
@@ -292,7 +335,7 @@ pub fn detect_rows(
         .map(|&p| {
             let c = pose.to_camera(p);
             let v = if c[2] > 1e-3 {
-                k.cy + k.f * c[1] / c[2]
+                k.cy + k.fy * c[1] / c[2]
             } else {
                 f64::NAN
             };
@@ -329,13 +372,13 @@ pub fn detect_rows(
             next += 1;
             let d = sub(c1, c0);
             let rr = r - k.cy;
-            let den = k.f * d[1] - rr * d[2];
+            let den = k.fy * d[1] - rr * d[2];
             if den.abs() <= 1e-15 {
                 continue;
             }
-            let lam = ((rr * c0[2]) - k.f * c0[1]) / den;
+            let lam = ((rr * c0[2]) - k.fy * c0[1]) / den;
             let p = [c0[0] + lam * d[0], c0[1] + lam * d[1], c0[2] + lam * d[2]];
-            let u = k.cx + k.f * p[0] / p[2];
+            let u = k.cx + k.fx * p[0] / p[2];
             if !(0.0..=f64::from(k.width) - 1.0).contains(&u) {
                 if started {
                     return out;
@@ -385,6 +428,12 @@ pub struct Scenario {
     pub drive: Drive,
     /// Or: a pure camera-frame translation/rotation instead of `drive`.
     pub camera_motion: Option<(V3, V3)>,
+    /// The detector reports every `row_step`-th image row (1: every row),
+    /// the rows `v` with `v % row_step == row_phase`.
+    pub row_step: u16,
+    pub row_phase: u16,
+    /// How far ahead the road is modelled and detected (length units).
+    pub range: f64,
 }
 
 /// Frames of a scenario with ground truth.
@@ -400,6 +449,8 @@ pub struct Rendered {
     pub pose2: Pose,
     /// World boundary polylines (for plots).
     pub world: [Vec<V3>; 2],
+    /// For each boundary `k` of `frame1`/`frame2`, its curve in `world`.
+    pub world_index: Vec<usize>,
 }
 
 impl Scenario {
@@ -412,11 +463,29 @@ impl Scenario {
             tilt: 23f64.to_radians(),
             drive,
             camera_motion: None,
+            row_step: 1,
+            row_phase: 0,
+            range: 60.0,
         }
     }
 
+    /// The frame-1 camera pose in the world (at the origin, heading 0).
+    pub fn pose1(&self) -> Pose {
+        Pose::vehicle_camera([0.0, 0.0, 0.0], 0.0, self.height, self.tilt)
+    }
+
+    /// The image rows the detector reports, bottom up.
+    pub fn rows(&self) -> Vec<f64> {
+        let step = self.row_step.max(1);
+        (0..self.intrinsics.height)
+            .rev()
+            .filter(|r| r % step == self.row_phase % step)
+            .map(f64::from)
+            .collect()
+    }
+
     pub fn render(&self) -> Rendered {
-        let pose1 = Pose::vehicle_camera([0.0, 0.0, 0.0], 0.0, self.height, self.tilt);
+        let pose1 = self.pose1();
         let pose2 = match self.camera_motion {
             Some((t, a)) => pose1.moved(t, a),
             None => {
@@ -431,17 +500,24 @@ impl Scenario {
                 }
             }
         };
-        let (translation, angles) = pose1.motion_to(&pose2);
-        let world = self.road.boundaries(2.0, 60.0, 0.01);
+        // A given camera motion is the motion, exactly (`W = 0` stays 0, not
+        // the 1e-17 the round trip through the poses would give).
+        let (translation, angles) = self
+            .camera_motion
+            .unwrap_or_else(|| pose1.motion_to(&pose2));
+        let world = self.road.boundaries(2.0, self.range, 0.01);
         let k = &self.intrinsics;
+        let rows = self.rows();
         let mut frame1 = Vec::new();
         let mut frame2 = Vec::new();
-        for curve in &world {
-            let b1 = detect(curve, &pose1, k, 60.0);
-            let b2 = detect(curve, &pose2, k, 60.0);
+        let mut world_index = Vec::new();
+        for (wi, curve) in world.iter().enumerate() {
+            let b1 = detect_rows(curve, &pose1, k, self.range, &rows);
+            let b2 = detect_rows(curve, &pose2, k, self.range, &rows);
             if b1.len() >= 2 && b2.len() >= 2 {
                 frame1.push(b1);
                 frame2.push(b2);
+                world_index.push(wi);
             }
         }
         Rendered {
@@ -452,6 +528,7 @@ impl Scenario {
             pose1,
             pose2,
             world,
+            world_index,
         }
     }
 }
@@ -499,13 +576,18 @@ impl Rendered {
         (lo..=hi).contains(&p.arc)
     }
 
+    /// The orientation of the frame-2 camera in frame-1 camera coordinates
+    /// (`R` of the README's conventions).
+    pub fn relative_rotation(&self) -> M3 {
+        mm(&tr(&self.pose1.rot), &self.pose2.rot)
+    }
+
     /// The rotation-compensated position and the true frame-2 position of a
     /// frame-1 pixel, by this module's own geometry (for test statistics).
     pub fn compensate(&self, k: &Intrinsics, u: f64, v: f64) -> [f64; 2] {
-        let ray = [(u - k.cx) / k.f, (v - k.cy) / k.f, 1.0];
-        let rel = mm(&tr(&self.pose1.rot), &self.pose2.rot);
-        let q = mv(&tr(&rel), ray);
-        [k.cx + k.f * q[0] / q[2], k.cy + k.f * q[1] / q[2]]
+        let ray = k.ray(u, v);
+        let q = mv(&tr(&self.relative_rotation()), ray);
+        [k.cx + k.fx * q[0] / q[2], k.cy + k.fy * q[1] / q[2]]
     }
 }
 

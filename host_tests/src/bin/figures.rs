@@ -149,8 +149,8 @@ fn example(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
             .collect()
     };
     let camera = jsonl::CameraIn {
-        fx: k.f as f32,
-        fy: k.f as f32,
+        fx: k.fx as f32,
+        fy: k.fy as f32,
         cx: k.cx as f32,
         cy: k.cy as f32,
         width: k.width,

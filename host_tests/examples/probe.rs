@@ -10,6 +10,8 @@ fn main() {
     let quant = args.get(3).map(|s| s == "q").unwrap_or(true);
     let s = if let Some(seed) = name.strip_prefix("random_") {
         scenarios::random(seed.parse().unwrap())
+    } else if let Some((fam, seed)) = name.split_once(':') {
+        scenarios::Family::from_name(fam).unwrap().scenario(seed.parse().unwrap())
     } else {
         scenarios::named()
             .into_iter()
@@ -66,8 +68,8 @@ fn main() {
     let c2 = r.pose2.to_camera(w);
     println!(
         "true p2 = ({:.3}, {:.3})",
-        k.cx + k.f * c2[0] / c2[2],
-        k.cy + k.f * c2[1] / c2[2]
+        k.cx + k.fx * c2[0] / c2[2],
+        k.cy + k.fy * c2[1] / c2[2]
     );
     // True crossing angles of every point of boundary b: the true epipolar
     // direction (p2 - p1') vs the true frame-2 curve's tangent at p2.
@@ -79,7 +81,7 @@ fn main() {
         };
         let proj = |w: [f64; 3]| {
             let c = r.pose2.to_camera(w);
-            [k.cx + k.f * c[0] / c[2], k.cy + k.f * c[1] / c[2]]
+            [k.cx + k.fx * c[0] / c[2], k.cy + k.fy * c[1] / c[2]]
         };
         let p2 = proj(w);
         let p1c = r.compensate(&k, tp.u, tp.v);

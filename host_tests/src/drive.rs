@@ -10,6 +10,8 @@
 
 use crate::synth::{self, Intrinsics, Pose, Road, V3};
 
+pub mod adversarial;
+
 /// One frame: motion from the previous frame and the pixel boundaries.
 #[derive(Debug, Clone)]
 pub struct DriveFrame {

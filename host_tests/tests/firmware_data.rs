@@ -73,3 +73,96 @@ fn embedded_frames_match_the_generator() {
         .iter()
         .all(|f| f.boundaries.iter().all(|b| b.len() <= 256)));
 }
+
+/// The adversarial family (`src/bin/data/adv_*.bin` and the firmware's
+/// table `adversarial.rs`) is exactly what the generator writes from
+/// `host_tests/src/drive/adversarial.rs` and `adversarial_found.json`
+/// (regenerate with `cargo run --release --bin adversarial`), and every
+/// pair passes the library's validation: two boundaries of exactly N
+/// points in each frame, at most one point per image row, every boundary
+/// accepted by `Frame::push_boundary`, the motion by `Motion::new`.
+#[test]
+fn adversarial_frames_match_the_generator_and_pass_validation() {
+    use drive::adversarial::{self, family, render, SIZES};
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../src/bin/data");
+    let members = family();
+    assert!(members.len() >= 12, "hand-made and searched members");
+    let mut names = std::collections::HashSet::new();
+    for m in &members {
+        assert!(names.insert(m.name.clone()), "{} twice", m.name);
+        assert!(
+            m.name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_'),
+            "{}: a name the firmware log can carry",
+            m.name
+        );
+        for n in SIZES {
+            let (k, frames) =
+                render(&m.params, n).unwrap_or_else(|e| panic!("{} {n}: {e}", m.name));
+            let path = dir.join(adversarial::file_name(&m.name, n));
+            let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            assert!(
+                drive::encode(&k, &frames) == bytes,
+                "{} is stale",
+                path.display()
+            );
+            // Read back as the firmware reads it, then validated by the library.
+            let (cam, back) = drive::decode(&bytes).expect("decodes");
+            assert_eq!((cam.width(), cam.height()), (k.width, k.height));
+            assert_eq!(back.len(), 2, "{} {n}: a pair", m.name);
+            for f in &back {
+                assert_eq!(f.boundaries.len(), 2, "{} {n}: two boundaries", m.name);
+                let bs: Vec<Vec<roadstereo::Pixel>> = f
+                    .boundaries
+                    .iter()
+                    .map(|b| {
+                        b.iter()
+                            .map(|q| roadstereo::Pixel::new(q[0], q[1]))
+                            .collect()
+                    })
+                    .collect();
+                for b in &bs {
+                    assert_eq!(b.len(), n, "{} {n}: N points per boundary", m.name);
+                    assert!(
+                        b.windows(2).all(|w| (w[1].v - w[0].v).abs() >= 0.999),
+                        "{} {n}: one point per row",
+                        m.name
+                    );
+                }
+                let _ = host_tests::frame(cam, &bs); // panics if rejected
+            }
+            assert!(roadstereo::Motion::new(back[1].translation, back[1].rotation).is_ok());
+            assert_eq!(back[0].translation, [0.0; 3], "frame 1 has no motion");
+        }
+    }
+    let table = std::fs::read_to_string(dir.join("adversarial.rs")).expect("adversarial.rs");
+    assert_eq!(
+        table,
+        adversarial::firmware_table(&members),
+        "adversarial.rs is stale"
+    );
+    // Only the generator's files under that name.
+    let on_disk = std::fs::read_dir(&dir)
+        .expect("data dir")
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|f| f.starts_with("adv_"))
+        .count();
+    assert_eq!(
+        on_disk,
+        members.len() * SIZES.len(),
+        "stray adv_*.bin files"
+    );
+}
+
+/// The family's base is the representative pair: its parameters render
+/// the bench's `bench_N.bin` bit for bit.
+#[test]
+fn adversarial_base_is_the_representative_pair() {
+    for n in [64, 128, 256, 512] {
+        let (k, f) =
+            drive::adversarial::render(&drive::adversarial::Params::fig6(), n).expect("valid");
+        let (kb, fb) = drive::bench_pair_one_per_row(n);
+        assert_eq!(drive::encode(&k, &f), drive::encode(&kb, &fb), "N = {n}");
+    }
+}

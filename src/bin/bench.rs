@@ -3,10 +3,13 @@
 //! Fig. 6 set-up on a curve of radius 15, one detector point per image row:
 //! the camera's resolution grows with N), and on the stress pairs (the
 //! paper's 512 × 480 camera sampled at up to 3.4 points per row, N = 256
-//! and 512); the cost of each stage at N = 256, the worst-case stack of one
+//! and 512); the worst-case stack of one
 //! per-frame call (stack painting), and the library's state and output
-//! sizes on the target. `cargo xtask bench` runs it, prints the tables and
-//! checks the budgets.
+//! sizes on the target; then every member of the adversarial family
+//! (issue 11: `host_tests/src/drive/adversarial.rs`, the table
+//! `data/adversarial.rs` it generates) at every N, measured like the
+//! representative rows, with the count of every status by name.
+//! `cargo xtask bench` runs it, prints the tables and checks the budgets.
 
 #![no_std]
 #![no_main]
@@ -17,7 +20,7 @@ use core::hint::black_box;
 
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
-use roadstereo::{Config, Frame, Processor, Structure};
+use roadstereo::{Config, Frame, Processor, Status, Structure};
 
 static BENCH: [(u32, &[u8]); 5] = [
     (32, include_bytes!("data/bench_32.bin")),
@@ -33,7 +36,50 @@ static STRESS: [(u32, &[u8]); 2] = [
     (512, include_bytes!("data/stress_512.bin")),
 ];
 
+// The adversarial family: `static ADVERSARIAL: &[(&str, u32, &[u8])]`, one
+// (member, N, RSD1 frame pair) per line, written by the generator
+// (`cd host_tests && cargo run --release --bin adversarial`).
+include!("data/adversarial.rs");
+
 const CAP: usize = 512;
+
+/// The count of every status present (and of `ok` always) as
+/// `status.<name>=<count>` fields, by [`Status::name`] over [`Status::ALL`],
+/// so a status added to the library is logged without a change here.
+fn status_fields(s: &Structure<CAP, 2>) -> heapless::String<400> {
+    let mut out = heapless::String::new();
+    let counts = s.status_counts();
+    for (i, st) in Status::ALL.iter().enumerate() {
+        let c = counts.get(i).copied().unwrap_or(0);
+        if c == 0 && *st != Status::Ok {
+            continue;
+        }
+        // Decimal digits of c, most significant first.
+        let mut digits = [0u8; 20];
+        let mut k = digits.len();
+        let mut x = c;
+        loop {
+            k -= 1;
+            digits[k] = b'0' + (x % 10) as u8;
+            x /= 10;
+            if x == 0 {
+                break;
+            }
+        }
+        let parts = [
+            "status.",
+            st.name(),
+            "=",
+            core::str::from_utf8(&digits[k..]).unwrap_or("?"),
+            " ",
+        ];
+        for p in parts {
+            // A full line drops the rest (400 bytes hold every status).
+            let _ = out.push_str(p);
+        }
+    }
+    out
+}
 
 fn load(
     data: &'static [u8],
@@ -171,6 +217,24 @@ fn main() -> ! {
             r.instr / r.points.max(1),
             r.ok,
             r.processed
+        );
+    }
+    for (name, n, data) in ADVERSARIAL.iter() {
+        let Some(m) = load(data, &mut f1, &mut f2) else {
+            defmt::error!("bad adversarial data for {=str} n={=u32}", name, n);
+            fw::exit(false)
+        };
+        let r = measure_pair(&mut processor, &f1, &f2, &m);
+        defmt::info!(
+            "adversarial name={=str} n={=u32} points={=u32} instr={=u32} per_point={=u32} digest={=u32:08x} processed={=bool} {=str}",
+            name,
+            n,
+            r.points,
+            r.instr,
+            r.instr / r.points.max(1),
+            processor.structure().digest(),
+            r.processed,
+            status_fields(processor.structure()).as_str()
         );
     }
     let (p, f, s) = (

@@ -3,7 +3,7 @@
 
 use crate::bench::{bench, bench_args};
 use crate::demo::demo;
-use crate::profile::profile;
+use crate::profile::{profile, CYCLES_PER_POINT};
 use crate::setup::setup_toolchain;
 use crate::util::{root, run, THUMB};
 
@@ -62,7 +62,10 @@ pub fn ci() -> Result<(), String> {
     // The firmware on the emulated controller: the demo, compared frame by
     // frame with the host build, then the benchmark, budgets and proofs.
     demo(true)?;
-    bench(&bench_args(&[])?)?;
-    // The profiler too, so it cannot rot (about ten seconds).
-    profile()
+    let bench = bench(&bench_args(&[])?);
+    // The profiler too, so it cannot rot (about ten seconds), with its
+    // cycles budget; it runs even when a bench budget is missed, so both
+    // verdicts are printed.
+    let profile = profile(CYCLES_PER_POINT);
+    bench.and(profile)
 }

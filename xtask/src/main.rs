@@ -7,7 +7,8 @@
 //!   `qemu-system-arm`, `defmt-print`), builds the firmware in release mode,
 //!   runs it and prints a summary table. `--check` also compares every
 //!   frame's results with the host build of the same code.
-//! * `bench`   — instruction counts, stage costs, stack, memory figures and
+//! * `bench`   — instruction counts (the representative pair and the
+//!   adversarial family of issue 11), stage costs, stack, memory figures and
 //!   the link-time proofs (panic-never, no `f64`, no allocator), with the
 //!   budgets checked (see `--help` of the task).
 //! * `profile` — where a per-frame call's instructions go: each of the
@@ -15,7 +16,8 @@
 //!   pair, ...) traced instruction by instruction on QEMU, counted per
 //!   function and per source line with an estimate of Cortex-M4F cycles
 //!   beside the instructions, and an annotated disassembly written to
-//!   `target/profile/annotated.txt`.
+//!   `target/profile/annotated.txt`; fails when the representative window
+//!   costs more than 718 estimated cycles per point (see `--help`).
 //! * `figures` — re-render `docs/` (figures and the replay example).
 //! * `ci`      — what `.ci/run` runs: toolchain setup, formatting, clippy,
 //!   thumb builds with and without `defmt`, `test`, then `demo --check`,
@@ -49,11 +51,15 @@ fn main() -> ExitCode {
         "bench" => bench_args(rest).and_then(|b| bench(&b)),
         "figures" => ci::figures(),
         "ci" => ci::ci(),
-        "profile" => profile::profile(),
+        "profile" if rest.iter().any(|a| a == "--help" || a == "-h") => {
+            println!("{}", profile::PROFILE_USAGE);
+            Ok(())
+        }
+        "profile" => profile::profile_args(rest).and_then(profile::profile),
         "setup" => setup::setup_emulator(),
         _ => {
             eprintln!(
-                "usage: cargo xtask <test|demo [--check]|bench [options]|profile|figures|ci|setup>"
+                "usage: cargo xtask <test|demo [--check]|bench [options]|profile [options]|figures|ci|setup>"
             );
             return ExitCode::from(2);
         }

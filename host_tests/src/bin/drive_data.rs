@@ -3,7 +3,10 @@
 //! to 256 points per boundary), `bench_N.bin` for N = 32 … 512 (one
 //! detector point per image row: [`drive::bench_pair_one_per_row`]) and
 //! `stress_N.bin` for N = 256, 512 (the paper's 512 × 480 camera sampled at
-//! up to 3.4 points per row: [`drive::bench_pair`]).
+//! up to 3.4 points per row: [`drive::bench_pair`]), and the adversarial
+//! family, `adv_<member>_N.bin` for N = 64 … 512 with the firmware's table
+//! `adversarial.rs` ([`drive::adversarial`]; the `adversarial` tool writes
+//! the same and can search for new members).
 
 use host_tests::drive;
 
@@ -46,5 +49,12 @@ fn main() -> std::io::Result<()> {
             )?;
         }
     }
+    let members = drive::adversarial::family();
+    let bytes = drive::adversarial::write_all(&dir, &members).map_err(std::io::Error::other)?;
+    println!(
+        "adversarial: {} members x N = {:?}, {bytes} bytes",
+        members.len(),
+        drive::adversarial::SIZES
+    );
     Ok(())
 }

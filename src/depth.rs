@@ -60,11 +60,11 @@
 //! segment is clipped to the region (a convex set: four half-planes), which
 //! gives the range `[λ_lo, λ_hi]` of its points in the band. Consecutive
 //! segments in the band form one *piece*; if the band meets the boundary in
-//! more than one piece the point is [`crate::Status::Ambiguous`], and its
-//! stick covers every piece.
+//! more than one piece the point is [`crate::Status::Ambiguous`] and gets no
+//! depth (either piece could hold the correspondent).
 //!
 //! # The stick
-//! With `L₋ = λ_lo − e₂` and `L₊ = λ_hi + e₂` over all pieces (the true
+//! With `L₋ = λ_lo − e₂` and `L₊ = λ_hi + e₂` over the piece (the true
 //! `p₂` is within `e₂` of some band point of the polyline), `1/τ` lies in
 //! `[A₋/(L₊ + r₁), A₊/(L₋ − r₁)]`, so
 //!
@@ -409,7 +409,7 @@ impl Band {
 
     /// The depth estimate and the stick in the compensated frame, `(s,
     /// s_near, s_far)`, for the exact crossing at `lam` (`λ'`, within
-    /// `[lo, hi]`) and the hull `[lo, hi]` of all pieces (`λ'`); `None` when
+    /// `[lo, hi]`) and the piece's range `[lo, hi]` (`λ'`); `None` when
     /// the far end is unbounded. `err` as for [`Band::new`].
     #[inline(always)]
     pub(crate) fn depths(

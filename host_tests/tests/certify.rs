@@ -1,19 +1,22 @@
 //! Certification of the guarantee and of the yield (issue 11, sections 2
 //! and 4), with the harness in `host_tests/src/certify.rs`.
 //!
-//! Run the certification and print its tables (about 5 s on two cores):
+//! [`certify_containment`] runs the certification (every family, every
+//! variant; about 5 s on two cores) and asserts the guarantee; print its
+//! tables with
 //!
 //! ```text
-//! cd host_tests && cargo test --release --test certify -- --ignored --nocapture
+//! cd host_tests && cargo test --release --test certify certify_containment -- --nocapture
 //! ```
 //!
+//! and check the yield targets too with `-- --ignored`.
 //! `CERTIFY_FAMILIES=far_foe,backward` and `CERTIFY_PER_FAMILY=10` run a
 //! subset (the figures are then asserted on it; the scenario count only on
-//! the full run). The tests that are not ignored check the harness itself:
-//! the variants stay inside the declared error model, the truth agrees with
-//! the library where the library is known to be right, the deviation bound
-//! and the fold truth are right, and the reproducers' truths follow from
-//! their geometry.
+//! the full run). The other tests check the harness itself: the variants
+//! stay inside the declared error model, the truth agrees with the library
+//! where the library is known to be right, the deviation bound and the
+//! fold truth are right, the reproducers' truths follow from their
+//! geometry, and the issue's two reproducers.
 
 use host_tests::certify::{
     certify, deviation_bound, fold_flags, point_segment_distance, replay_for, run, Case, Geometry,
@@ -107,32 +110,24 @@ fn print_report(rep: &Report, seconds: f64) {
     }
 }
 
-/// The certification: >= 1000 seeded scenarios over the families, each in
-/// the four variants; the truth inside the stick of 100 % of the `ok`
-/// points whose correspondent exists, actual >= 90 % of the ideal yield
-/// over all families and >= 80 % in each, folded loss <= 5 % per family
-/// (in every variant).
-#[test]
-#[ignore = "enabled with the matching redesign (issue 11)"]
-fn certify_containment_and_yield() {
-    let (families, per, full) = families_from_env();
-    let t0 = std::time::Instant::now();
-    let rep = certify(&families, 0..per);
-    print_report(&rep, t0.elapsed().as_secs_f64());
-
-    assert!(
-        rep.model_errors.is_empty(),
-        "inputs outside the declared model (a bug of the harness): {:#?}",
-        &rep.model_errors[..rep.model_errors.len().min(20)]
-    );
-    if full {
-        assert!(rep.cases >= 1000, "{} scenarios", rep.cases);
+/// The certification's findings against the issue's requirements: the
+/// guarantee (containment, the declared model, the scenario count, the
+/// folded loss) and the yield targets, as lists of what is not met.
+fn requirements(rep: &Report, full: bool) -> (Vec<String>, Vec<String>) {
+    let (mut guarantee, mut yields) = (Vec::new(), Vec::new());
+    if !rep.model_errors.is_empty() {
+        guarantee.push(format!(
+            "inputs outside the declared model (a bug of the harness): {:#?}",
+            &rep.model_errors[..rep.model_errors.len().min(20)]
+        ));
     }
-    let mut failures = Vec::new();
+    if full && rep.cases < 1000 {
+        guarantee.push(format!("{} scenarios < 1000", rep.cases));
+    }
     for v in Variant::ALL {
         let t = rep.variant_total(v);
         if t.containment() < CONTAINMENT {
-            failures.push(format!(
+            guarantee.push(format!(
                 "{}: containment {}/{} ({} misses)",
                 v.name(),
                 t.contained,
@@ -141,7 +136,7 @@ fn certify_containment_and_yield() {
             ));
         }
         if t.ideal == 0 || t.actual_over_ideal() < ACTUAL_OVER_IDEAL_ALL {
-            failures.push(format!(
+            yields.push(format!(
                 "{}: actual/ideal over all families {:.1} % < {:.0} %",
                 v.name(),
                 100.0 * t.actual_over_ideal(),
@@ -154,7 +149,7 @@ fn certify_containment_and_yield() {
             continue;
         }
         if t.actual_over_ideal() < ACTUAL_OVER_IDEAL_FAMILY {
-            failures.push(format!(
+            yields.push(format!(
                 "{} {}: actual/ideal {:.1} % < {:.0} %",
                 f.name(),
                 v.name(),
@@ -163,7 +158,7 @@ fn certify_containment_and_yield() {
             ));
         }
         if t.folded_loss() > FOLDED_LOSS_MAX {
-            failures.push(format!(
+            guarantee.push(format!(
                 "{} {}: folded loss {:.1} % > {:.0} %",
                 f.name(),
                 v.name(),
@@ -172,11 +167,47 @@ fn certify_containment_and_yield() {
             ));
         }
     }
+    (guarantee, yields)
+}
+
+/// The certification: >= 1000 seeded scenarios over the families, each in
+/// the four variants; the truth inside the stick of 100 % of the `ok`
+/// points whose correspondent exists (in every variant), every input
+/// inside the declared model, folded loss <= 5 % per family. The report
+/// (yield against the two-view ideal per family and variant, where the
+/// ideal points go) is printed; the yield targets are checked by
+/// [`certify_yield_targets`].
+#[test]
+fn certify_containment() {
+    let (families, per, full) = families_from_env();
+    let t0 = std::time::Instant::now();
+    let rep = certify(&families, 0..per);
+    print_report(&rep, t0.elapsed().as_secs_f64());
+    let (guarantee, _) = requirements(&rep, full);
     assert!(
-        failures.is_empty(),
+        guarantee.is_empty(),
         "{} requirements not met:\n{}",
-        failures.len(),
-        failures.join("\n")
+        guarantee.len(),
+        guarantee.join("\n")
+    );
+}
+
+/// Issue 11's yield targets: actual >= 90 % of the ideal yield over all
+/// families and >= 80 % in each, in every variant. Not met today (README,
+/// "What the tests show", gives the figures and where the points go):
+/// `cargo test --release --test certify -- --ignored` checks them.
+#[test]
+#[ignore = "issue 11's yield targets are not met yet (README gives the figures)"]
+fn certify_yield_targets() {
+    let (families, per, full) = families_from_env();
+    let rep = certify(&families, 0..per);
+    let (guarantee, yields) = requirements(&rep, full);
+    let all: Vec<String> = guarantee.into_iter().chain(yields).collect();
+    assert!(
+        all.is_empty(),
+        "{} requirements not met:\n{}",
+        all.len(),
+        all.join("\n")
     );
 }
 
@@ -455,7 +486,6 @@ fn reproducer_behind_p1_truth_follows_from_the_geometry() {
 /// out `ok` with a stick excluding the true depth (about 7.24); any depth
 /// it keeps must have a stick covering every consistent depth.
 #[test]
-#[ignore = "enabled with the matching redesign (issue 11)"]
 fn issue11_true_crossing_just_behind_p1() {
     use behind_p1::*;
     let out = run_pair(&paper_camera(), &F1, &F2, T, R);
@@ -544,7 +574,6 @@ fn reproducer_far_foe_truth_follows_from_the_geometry() {
 /// 12 points do not fold: all `ok`, within 0.01 % of the truth (as with the
 /// rotation exactly 0).
 #[test]
-#[ignore = "enabled with the matching redesign (issue 11)"]
 fn issue11_far_foe_is_not_folded() {
     use far_foe::*;
     let truth = far_foe_truth(R);

@@ -61,8 +61,9 @@ pub(crate) const MAX_NEAR: usize = 8;
 const PROBES: u32 = 6;
 /// At most this many copies of a periodic key are searched one by one.
 pub(crate) const MAX_COPIES: usize = 3;
-/// The fan-out of the block tree.
-const FAN: usize = 8;
+/// The fan-out of the block tree, `2^FAN_BITS`.
+const FAN_BITS: u32 = 3;
+const FAN: usize = 1 << FAN_BITS;
 /// The levels of the block tree (blocks of up to `FAN^LEVELS` segments).
 const LEVELS: usize = 4;
 
@@ -401,14 +402,21 @@ impl<const N: usize> Index<N> {
     /// At most [`LEVELS`] steps.
     #[inline(always)]
     fn skip_at(&self, j: usize, meets: impl Fn(f32, f32) -> bool) -> usize {
-        let (mut base, mut size, mut n, mut skip) = (0usize, 1usize, self.segments, 0usize);
-        for _ in 0..self.levels {
-            size = size.saturating_mul(FAN);
+        // Only a position aligned to a block starts one.
+        if j & (FAN - 1) != 0 {
+            return 0;
+        }
+        let (mut base, mut n, mut skip) = (0usize, self.segments, 0usize);
+        let mut shift = 0u32;
+        for _ in 0..self.levels.min(LEVELS) {
+            shift += FAN_BITS;
             n = n.div_ceil(FAN);
-            // (`size` ≥ 8: the checks never fail.)
-            let (Some(0), Some(b)) = (j.checked_rem(size), j.checked_div(size)) else {
+            // (`shift` ≤ 3 · LEVELS = 12.)
+            let size = 1usize << shift;
+            if j & (size - 1) != 0 {
                 break;
-            };
+            }
+            let b = j >> shift;
             let (lo, hi) = (
                 self.tree
                     .get(base + 2 * b)
@@ -526,16 +534,23 @@ impl<const N: usize> Index<N> {
         (work, extra): (&mut Work, u32),
         visit: &mut (impl Visitor + Copy),
     ) -> Result<(), OutOfWork> {
-        // The usual case: one run, no lists to merge.
-        let lists =
-            !self.aside.is_empty() || (with_near && (!self.near.is_empty() || self.near_overflow));
-        if let (Query::Keys(q0, q1), false, false) = (query, self.period > 0.0, lists) {
+        // The usual case: one run, no lists to merge; next, a run and the
+        // aside list.
+        let near = with_near && (!self.near.is_empty() || self.near_overflow);
+        if let (Query::Keys(q0, q1), false, false) = (query, self.period > 0.0, near) {
             let (ql, qh) = if self.orient < 0.0 {
                 (-q1, -q0)
             } else {
                 (q0, q1)
             };
-            return self.visit_run(ql, qh, skip, work, extra, visit);
+            if self.aside.is_empty() {
+                return self.visit_run(ql, qh, skip, work, extra, visit);
+            }
+            let (mut v, mut w) = (*visit, *work);
+            let skip = skip.unwrap_or((usize::MAX, 0));
+            let r = self.visit_run_aside((ql, qh), skip, (&mut w, extra), &mut v);
+            (*visit, *work) = (v, w);
+            return r;
         }
         // The rare paths take the visitor by reference to a copy, so that
         // the caller's visitor (and work) never has its address taken and
@@ -635,6 +650,60 @@ impl<const N: usize> Index<N> {
             j += 1;
         }
         Ok(())
+    }
+
+    /// [`Self::visit`] for one oriented interval through a run and the aside
+    /// list, merged in index order (the block tree skips the run's blocks
+    /// the query misses). Each step advances the run or the list; every
+    /// segment looked at and every skip costs one unit.
+    #[inline(never)]
+    fn visit_run_aside(
+        &mut self,
+        (ql, qh): (f32, f32),
+        (skip0, skip1): (usize, usize),
+        (work, extra): (&mut Work, u32),
+        visit: &mut impl Visitor,
+    ) -> Result<(), OutOfWork> {
+        let a = self.run_start(ql, work)?;
+        if a < self.segments {
+            self.hint = a;
+        }
+        let s = self.segments.min(N);
+        let meets = |l: f32, h: f32| l <= qh && h >= ql;
+        let (mut j, mut ia) = (a, 0usize);
+        loop {
+            let run_next = match self.seg.get(j) {
+                Some(g) if j < s && g.sm <= qh => j,
+                _ => usize::MAX,
+            };
+            let aside = self.aside.get(ia).copied();
+            let aside_next = aside.map_or(usize::MAX, |(k, _, _)| usize::from(k));
+            work.spend(1)?;
+            let (k, l, h) = match aside {
+                Some((_, l, h)) if aside_next < run_next => {
+                    ia += 1;
+                    (aside_next, l, h)
+                }
+                _ => {
+                    let Some(g) = self.seg.get(j).filter(|_| run_next != usize::MAX) else {
+                        return Ok(());
+                    };
+                    let skip = if self.levels > 0 { self.skip_at(j, meets) } else { 0 };
+                    if skip > 0 {
+                        j += skip;
+                        continue;
+                    }
+                    j += 1;
+                    (run_next, g.lo, g.hi)
+                }
+            };
+            if meets(l, h) && !(k >= skip0 && k <= skip1) {
+                work.spend(extra)?;
+                if visit.segment(k, (l, h)) == Flow::Stop {
+                    return Ok(());
+                }
+            }
+        }
     }
 
     /// [`Self::visit`] in general: the copies of a periodic key, the aside

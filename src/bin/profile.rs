@@ -28,6 +28,8 @@ static WINDOWS: &[(&str, &[u8])] = &[
     ("representative", include_bytes!("data/bench_256.bin")),
     // The bench's N = 256 stress pair (up to 3.4 points per row).
     ("stress", include_bytes!("data/stress_256.bin")),
+    // The demo drive's costliest frame pair (frames 14 and 15).
+    ("demo_15", include_bytes!("data/demo_15.bin")),
 ];
 
 /// Capacity: the bench's, so the per-frame code is the bench's too.

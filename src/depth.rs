@@ -241,7 +241,13 @@ impl Band {
     /// `1/(ρ₁ − r₁ − e₂) = W'/(|a| − W'(r₁ + e₂))` and `h = W' r₁ / A₋ ≤ r₁
     /// W'/(|a| − W'(r₁ + e₂))`, one division; no far limit.
     #[inline(always)]
-    pub(crate) fn forward(p: [f32; 2], a: [f32; 2], w: f32, r1: f32, e2: f32) -> Result<Self, NoBand> {
+    pub(crate) fn forward(
+        p: [f32; 2],
+        a: [f32; 2],
+        w: f32,
+        r1: f32,
+        e2: f32,
+    ) -> Result<Self, NoBand> {
         let a2 = dot(a, a);
         // `a2 > 1e-30` keeps the square root's input in its range (and
         // refuses NaN).
@@ -528,7 +534,7 @@ mod tests {
                 continue;
             };
             // A true point and depth.
-            let ang = rng.next() * 6.283;
+            let ang = rng.next() * core::f32::consts::TAU;
             let rad = f64::from(err.r1) * f64::from(rng.next());
             let pt = [
                 f64::from(p[0]) + rad * f64::from(libm::cosf(ang)),
@@ -546,7 +552,7 @@ mod tests {
             let tau = 1.0 / (s - wf);
             let p2 = [pt[0] + tau * at[0], pt[1] + tau * at[1]];
             // A polyline point within e2 of it.
-            let ang2 = rng.next() * 6.283;
+            let ang2 = rng.next() * core::f32::consts::TAU;
             let rad2 = f64::from(err.e2) * f64::from(rng.next());
             let q = [
                 (p2[0] + rad2 * f64::from(libm::cosf(ang2))) as f32,

@@ -403,7 +403,7 @@ mod tests {
                 ];
                 let m2 = Motion::new([0.1, -0.1, 0.4], ang2).expect("motion");
                 let g2 = PairGeometry::new(&cam, &cam, &m2);
-                let dir = rng.next() * 6.283;
+                let dir = rng.next() * core::f32::consts::TAU;
                 let p2 = Pixel::new(p.u + e1 * libm::cosf(dir), p.v + e1 * libm::sinf(dir));
                 let qz2 = 1.0 / g2.compensate(p2).expect("front").inv_depth_scale;
                 assert!((qz2 - qz).abs() <= bound, "{} > {bound}", (qz2 - qz).abs());

@@ -474,14 +474,26 @@ impl<const N: usize> Index<N> {
     /// 1` ([`Self::may_fold`], then the query; each segment looked at one
     /// unit of `work`).
     #[inline(always)]
-    pub(crate) fn folds(&mut self, i: usize, key: f32, w: usize, work: &mut Work) -> Result<bool, OutOfWork> {
+    pub(crate) fn folds(
+        &mut self,
+        i: usize,
+        key: f32,
+        w: usize,
+        work: &mut Work,
+    ) -> Result<bool, OutOfWork> {
         if self.strict || !self.may_fold(i, key, w) {
             return Ok(false);
         }
         let e = self.margin(i);
         let skip = (i.saturating_sub(w), i.saturating_add(w).saturating_sub(1));
         let mut met = Met(false);
-        self.visit(Query::Keys(key - e, key + e), false, Some(skip), (work, 0), &mut met)?;
+        self.visit(
+            Query::Keys(key - e, key + e),
+            false,
+            Some(skip),
+            (work, 0),
+            &mut met,
+        )?;
         Ok(met.0)
     }
 
@@ -491,8 +503,12 @@ impl<const N: usize> Index<N> {
     /// [`Self::visit`] does); `None` otherwise.
     #[inline(always)]
     pub(crate) fn tight(&self) -> Option<(&[Seg], f32)> {
-        (self.period <= 0.0 && self.aside.is_empty() && self.levels == 0)
-            .then(|| (self.seg.get(..self.segments.min(N)).unwrap_or(&[]), self.orient))
+        (self.period <= 0.0 && self.aside.is_empty() && self.levels == 0).then(|| {
+            (
+                self.seg.get(..self.segments.min(N)).unwrap_or(&[]),
+                self.orient,
+            )
+        })
     }
 
     /// Where the last run started (the next query's probes start there).
@@ -590,8 +606,7 @@ impl<const N: usize> Index<N> {
         // slice `run`).
         let mut credit = work.credit;
         let mut result = Ok(());
-        let mut j = a;
-        for g in run {
+        for (j, g) in (a..).zip(run) {
             if g.sm > qh {
                 break;
             }
@@ -611,7 +626,6 @@ impl<const N: usize> Index<N> {
                     break;
                 }
             }
-            j += 1;
         }
         work.credit = credit;
         result
@@ -688,7 +702,11 @@ impl<const N: usize> Index<N> {
                     let Some(g) = self.seg.get(j).filter(|_| run_next != usize::MAX) else {
                         return Ok(());
                     };
-                    let skip = if self.levels > 0 { self.skip_at(j, meets) } else { 0 };
+                    let skip = if self.levels > 0 {
+                        self.skip_at(j, meets)
+                    } else {
+                        0
+                    };
                     if skip > 0 {
                         j += skip;
                         continue;
@@ -768,15 +786,15 @@ impl<const N: usize> Index<N> {
             // A loose index: skip the blocks of the run no copy meets (the
             // aside and near entries in them keep their own streams, which
             // the merge below still takes in index order).
-            if self.levels > 0 && !everything {
-                if self.seg.get(j).is_some_and(|g| j < s && g.sm <= top) {
-                    let k =
-                        self.skip_at(j, |l, h| copies.iter().any(|&(cl, ch)| l <= ch && h >= cl));
-                    if k > 0 {
-                        j += k;
-                        work.spend(1)?;
-                        continue;
-                    }
+            if self.levels > 0
+                && !everything
+                && self.seg.get(j).is_some_and(|g| j < s && g.sm <= top)
+            {
+                let k = self.skip_at(j, |l, h| copies.iter().any(|&(cl, ch)| l <= ch && h >= cl));
+                if k > 0 {
+                    j += k;
+                    work.spend(1)?;
+                    continue;
                 }
             }
             let next_aside = self

@@ -277,6 +277,11 @@ impl Band {
         })
     }
 
+    /// `W'`.
+    pub(crate) fn w(&self) -> f32 {
+        self.w
+    }
+
     /// How wide the band's key interval is (for direction keys): its rays
     /// lie within `atan(t)` of the point's own, and `m` is the rounding
     /// margin of the point's own key (whose distance from the FOE is at

@@ -3,7 +3,7 @@
 //! outcome is decided.
 //!
 //! The walk is defined as a scan of **every** segment in increasing index
-//! (the reference, [`reference_walk`]); the processor feeds it only the
+//! (the reference, `Processor::reference_against_kept`); the processor feeds it only the
 //! segments the index offers ([`crate::search`]), a superset of those that
 //! meet the band, in the same order. A segment outside the band changes
 //! nothing, so both give the same outcome; the host tests compare them on
@@ -26,7 +26,7 @@
 use crate::camera::Pixel;
 use crate::depth::{Band, Vertex};
 use crate::math::{fmax, fmin};
-use crate::search::{Flow, Visitor};
+use crate::search::{Flow, Visitor, CLIP_UNITS};
 use crate::structure::Status;
 
 /// What a walk concluded.
@@ -123,8 +123,93 @@ impl Walk {
     }
 }
 
+/// A cheap test that a segment misses a band which narrows towards the FOE
+/// (`W' < 0`, slope `h ≤ 0`), from the segment's key interval and its
+/// distance from the FOE, so that the wide key interval such a band needs
+/// (its part near the FOE is wide in angle, [`Band::key_half_width`])
+/// costs one unit per segment instead of a clip.
+///
+/// A band point `q` at distance `r` from the FOE `F` and at the angle `φ`
+/// from the ray through `p₁'` has `λ = ρ₁ − r cos φ` and `|μ| = r |sin φ|`,
+/// so the band's `|μ| ≤ K₀ + h λ` gives `r |sin φ| ≤ c₀ + |h| r cos φ ≤ c₀ +
+/// |h| r` with `c₀ = K₀ − |h| ρ₁` (`> e₂ > 0`): `|sin φ| ≤ c₀/r + |h|`.
+/// Half-plane keys change by at most one unit per radian, so every point
+/// of a segment whose key interval lies `δ` from the point's own (both
+/// widened by their margins) is at `|φ| ≥ δ`, and `|sin φ| ≥ sin min(δ, 1)
+/// ≥ δ′ (1 − δ′²/6)` with `δ′ = min(δ, 1)` (`|φ| ≤ π/2 + (r₁ + e₂)/m` in the
+/// band beyond the FOE-near radius `m`). So a segment at least `m` from the
+/// FOE whose `δ′ (1 − δ′²/6) − |h|` exceeds `c₀/r_min` (`r_min` its
+/// distance from `F`) misses the band; `c₀` and `|h|` are taken 0.1 %
+/// larger and the left side 0.1 % smaller for rounding, far more than the
+/// band's own arithmetic is off, so a rejected segment is one the band's
+/// clip rejects too.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Radial {
+    foe: [f32; 2],
+    /// The point's own key interval (oriented as the intervals offered).
+    own: (f32, f32),
+    /// `(1.001 c₀)²`, `1.001 |h|`, `m²`.
+    c0sq: f32,
+    h: f32,
+    m2: f32,
+}
+
+impl Radial {
+    /// The test for `band` (`None` unless it narrows towards the FOE),
+    /// with the FOE, the point's own key interval and the FOE-near radius.
+    pub(crate) fn new(band: &Band, foe: [f32; 2], own: (f32, f32), near_foe: f32) -> Option<Self> {
+        let w = band.w();
+        if !(w < 0.0 && band.h <= 0.0) {
+            return None;
+        }
+        // ρ₁ = |a|/|W'| (a = W'(p₁' − F)).
+        let h = -band.h;
+        let c0 = band.k0 / band.a_len - h * (band.a_len / -w);
+        if !(c0 > 0.0) {
+            return None;
+        }
+        let c0 = c0 * 1.001;
+        Some(Self {
+            foe,
+            own,
+            c0sq: c0 * c0,
+            h: h * 1.001,
+            m2: near_foe * near_foe,
+        })
+    }
+
+    /// Whether the segment `a → b` with key interval `(lo, hi)` misses the
+    /// band for certain.
+    #[inline(always)]
+    fn rejects(&self, a: [f32; 2], b: [f32; 2], (lo, hi): (f32, f32)) -> bool {
+        let delta = fmax(lo - self.own.1, self.own.0 - hi);
+        // (A NaN fails.)
+        if !(delta > self.h) {
+            return false;
+        }
+        let dc = fmin(delta, 1.0);
+        let d = dc * (1.0 - dc * dc * (1.0 / 6.0)) * 0.999 - self.h;
+        if !(d > 0.0) {
+            return false;
+        }
+        // The squared distance from the FOE to the segment.
+        let ua = [a[0] - self.foe[0], a[1] - self.foe[1]];
+        let ab = [b[0] - a[0], b[1] - a[1]];
+        let l2 = ab[0] * ab[0] + ab[1] * ab[1];
+        let t = if l2 > 0.0 {
+            fmin(fmax(-(ua[0] * ab[0] + ua[1] * ab[1]) / l2, 0.0), 1.0)
+        } else {
+            0.0
+        };
+        let v = [ua[0] + t * ab[0], ua[1] + t * ab[1]];
+        let r2 = v[0] * v[0] + v[1] * v[1];
+        r2 >= self.m2 && d * d * r2 > self.c0sq
+    }
+}
+
 /// A walk as an index [`Visitor`]: the band, the polyline, the last vertex
-/// computed (reused along a run) and the walk.
+/// computed (reused along a run), the walk, and the band's [`Radial`] test
+/// if it has one.
 #[derive(Clone, Copy)]
 pub(crate) struct Walker<'a> {
     pub(crate) band: Band,
@@ -135,10 +220,16 @@ pub(crate) struct Walker<'a> {
     pub(crate) walk: Walk,
     /// Why the walk stopped early, if it did.
     pub(crate) decided: Option<Status>,
+    radial: Option<Radial>,
 }
 
 impl<'a> Walker<'a> {
-    pub(crate) fn new(band: Band, boundary: &'a [Pixel], cot_twice: f32) -> Self {
+    pub(crate) fn new(
+        band: Band,
+        boundary: &'a [Pixel],
+        cot_twice: f32,
+        radial: Option<Radial>,
+    ) -> Self {
         Self {
             band,
             boundary,
@@ -147,6 +238,7 @@ impl<'a> Walker<'a> {
             cache: Vertex::NONE,
             walk: Walk::NEW,
             decided: None,
+            radial,
         }
     }
 
@@ -174,31 +266,27 @@ impl<'a> Walker<'a> {
 
 impl Visitor for Walker<'_> {
     #[inline(always)]
-    fn segment(&mut self, j: usize, _: (f32, f32)) -> Flow {
+    fn segment(&mut self, j: usize, interval: (f32, f32)) -> (Flow, u32) {
+        if let (Some(rad), Some(a), Some(b)) =
+            (self.radial, self.boundary.get(j), self.boundary.get(j + 1))
+        {
+            if rad.rejects(a.arr(), b.arr(), interval) {
+                return (Flow::Continue, 0);
+            }
+        }
         let (Some(c0), Some(c1)) = (self.vertex(j), self.vertex(j + 1)) else {
-            return Flow::Continue;
+            return (Flow::Continue, 0);
         };
         let segments = self.boundary.len().saturating_sub(1);
         match self
             .walk
             .take(&self.band, j, (&c0, &c1), segments, self.cot_twice)
         {
-            Ok(()) => Flow::Continue,
+            Ok(()) => (Flow::Continue, CLIP_UNITS),
             Err(s) => {
                 self.decided = Some(s);
-                Flow::Stop
+                (Flow::Stop, CLIP_UNITS)
             }
         }
     }
-}
-
-/// The reference: the walk over every segment of `boundary`, in order.
-pub(crate) fn reference_walk(band: Band, boundary: &[Pixel], cot_twice: f32) -> Outcome {
-    let mut walker = Walker::new(band, boundary, cot_twice);
-    for j in 0..boundary.len().saturating_sub(1) {
-        if walker.segment(j, (f32::NEG_INFINITY, f32::INFINITY)) == Flow::Stop {
-            break;
-        }
-    }
-    walker.outcome()
 }

@@ -36,16 +36,14 @@ use crate::camera::{Camera, Pixel};
 use crate::config::Config;
 use crate::depth::{interval, Band, PointErrors};
 use crate::epipolar::PairGeometry;
-use crate::matching::{Outcome, Walker};
+use crate::matching::{Outcome, Radial, Walker};
 use crate::motion::Motion;
 use crate::pencil::{Keying, Pencil, NO_KEY};
-use crate::search::{run_start_in, Flow, Index, OutOfWork, Query, Unkeyed, Visitor, Work};
+use crate::search::{
+    run_start_in, Flow, Index, OutOfWork, Query, Unkeyed, Visitor, Work, CLIP_UNITS,
+};
 use crate::structure::{PointResult, ProcessError, Status, Step, Structure, FOLD_WINDOW};
 use crate::wedge::{Wedge, WedgeWalk, WedgeWalker};
-
-/// Work units a band test costs on top of the unit of looking at the
-/// segment (it is about three times as long).
-const CLIP_UNITS: u32 = 2;
 
 /// The per-frame motion-stereo processor for up to `B` boundaries of up to
 /// `N` points. No heap: everything lives inside this value, so it can be a
@@ -593,7 +591,7 @@ fn match_wedge<const N: usize>(
                 } else {
                     Query::Keys(wedge.kl, wedge.kh)
                 };
-                match index.visit(query, false, None, (work, CLIP_UNITS), &mut walker) {
+                match index.visit(query, false, None, work, &mut walker) {
                     Err(OutOfWork) => Outcome::Flag(Status::OverBudget),
                     Ok(()) => walker.outcome(),
                 }
@@ -604,7 +602,7 @@ fn match_wedge<const N: usize>(
                         (Some(a), Some(b)) => raw_interval(keying, a.arr(), b.arr()),
                         _ => (f32::INFINITY, f32::NEG_INFINITY),
                     };
-                    if Visitor::segment(&mut walker, j, iv) == Flow::Stop {
+                    if Visitor::segment(&mut walker, j, iv).0 == Flow::Stop {
                         break;
                     }
                 }
@@ -749,14 +747,42 @@ fn match_point<const N: usize>(
         return PointResult::flagged(p1, Status::AtFoe);
     };
     let cot_twice = pair.config.cot_twice;
+    // Moving backwards, a cheap test rejects most of the wide key
+    // interval's segments (half-plane keys; see `Radial`).
+    let orient = match matcher {
+        Matcher::Indexed => index.orient(),
+        Matcher::Reference => 1.0,
+    };
+    let radial = match (keying.pencil, pair.foe) {
+        (Pencil::Half { .. }, Some(foe)) => {
+            let (k, m) = keying.key(p);
+            let own = if orient < 0.0 {
+                (-k - m, -k + m)
+            } else {
+                (k - m, k + m)
+            };
+            Radial::new(&band, foe, own, near_foe)
+        }
+        _ => None,
+    };
+    let mut walk = Walker::new(band, b2, cot_twice, radial);
     let outcome = match matcher {
-        Matcher::Reference => crate::matching::reference_walk(band, b2, cot_twice),
+        Matcher::Reference => {
+            for j in 0..b2.len().saturating_sub(1) {
+                let iv = match (b2.get(j), b2.get(j + 1)) {
+                    (Some(a), Some(b)) => raw_interval(keying, a.arr(), b.arr()),
+                    _ => (f32::NEG_INFINITY, f32::INFINITY),
+                };
+                if Visitor::segment(&mut walk, j, iv).0 == Flow::Stop {
+                    break;
+                }
+            }
+            walk.outcome()
+        }
         Matcher::Indexed => {
             let query = band_query(pair, keying, &band, key, near_foe);
             let with_near = geom.w() < 0.0;
-            let mut walk = Walker::new(band, b2, cot_twice);
-            let done = index.visit(query, with_near, None, (work, CLIP_UNITS), &mut walk);
-            match done {
+            match index.visit(query, with_near, None, work, &mut walk) {
                 Err(OutOfWork) => return PointResult::flagged(p1, Status::OverBudget),
                 Ok(()) => walk.outcome(),
             }

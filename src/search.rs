@@ -72,8 +72,13 @@ const LEVELS: usize = 4;
 /// beyond its neighbours'.
 const WIDE: f32 = 8.0;
 
+/// Work units a segment's exact test (the band's or the wedge's clip)
+/// costs on top of the unit of looking at it: it is about three times as
+/// long.
+pub(crate) const CLIP_UNITS: u32 = 2;
+
 /// Work units: every segment a query looks at costs one, every bisection
-/// step one; the caller pays its own exact tests.
+/// step one; the visitor reports what its own test cost.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Work {
     credit: u32,
@@ -133,8 +138,9 @@ pub(crate) enum Flow {
 /// index.
 pub(crate) trait Visitor {
     /// Segment `j` with its key interval (oriented; infinite for a segment
-    /// listed as near the FOE); whether to go on.
-    fn segment(&mut self, j: usize, interval: (f32, f32)) -> Flow;
+    /// listed as near the FOE): whether to go on, and the units of work
+    /// its test took beyond the unit of looking at it (charged after).
+    fn segment(&mut self, j: usize, interval: (f32, f32)) -> (Flow, u32);
 }
 
 /// How segments with an unkeyable end count.
@@ -491,7 +497,7 @@ impl<const N: usize> Index<N> {
             Query::Keys(key - e, key + e),
             false,
             Some(skip),
-            (work, 0),
+            work,
             &mut met,
         )?;
         Ok(met.0)
@@ -539,7 +545,7 @@ impl<const N: usize> Index<N> {
     /// `query` (a superset of those that do: the caller tests each), plus
     /// the FOE-near list when `with_near`; segments in `skip` (an inclusive
     /// range of indices) are left out. Each segment looked at costs one
-    /// unit of `work`, each one visited `extra` more (the caller's test),
+    /// unit of `work`, each one visited what the visitor reports,
     /// each bisection step one.
     #[inline(always)]
     pub(crate) fn visit(
@@ -547,7 +553,7 @@ impl<const N: usize> Index<N> {
         query: Query,
         with_near: bool,
         skip: Option<(usize, usize)>,
-        (work, extra): (&mut Work, u32),
+        work: &mut Work,
         visit: &mut (impl Visitor + Copy),
     ) -> Result<(), OutOfWork> {
         // The usual case: one run, no lists to merge; next, a run and the
@@ -560,11 +566,11 @@ impl<const N: usize> Index<N> {
                 (q0, q1)
             };
             if self.aside.is_empty() {
-                return self.visit_run(ql, qh, skip, work, extra, visit);
+                return self.visit_run(ql, qh, skip, work, visit);
             }
             let (mut v, mut w) = (*visit, *work);
             let skip = skip.unwrap_or((usize::MAX, 0));
-            let r = self.visit_run_aside((ql, qh), skip, (&mut w, extra), &mut v);
+            let r = self.visit_run_aside((ql, qh), skip, &mut w, &mut v);
             (*visit, *work) = (v, w);
             return r;
         }
@@ -572,7 +578,7 @@ impl<const N: usize> Index<N> {
         // the caller's visitor (and work) never has its address taken and
         // stays in registers on the usual path.
         let (mut v, mut w) = (*visit, *work);
-        let r = self.visit_general(query, with_near, skip, (&mut w, extra), &mut v);
+        let r = self.visit_general(query, with_near, skip, &mut w, &mut v);
         (*visit, *work) = (v, w);
         r
     }
@@ -585,7 +591,6 @@ impl<const N: usize> Index<N> {
         qh: f32,
         skip: Option<(usize, usize)>,
         work: &mut Work,
-        extra: u32,
         visit: &mut (impl Visitor + Copy),
     ) -> Result<(), OutOfWork> {
         // (A query that cannot meet the keys' range finds an empty run: its
@@ -597,7 +602,7 @@ impl<const N: usize> Index<N> {
         let (skip0, skip1) = skip.unwrap_or((usize::MAX, 0));
         if self.levels > 0 {
             let (mut v, mut w) = (*visit, *work);
-            let r = self.visit_run_loose(a, (ql, qh), (skip0, skip1), (&mut w, extra), &mut v);
+            let r = self.visit_run_loose(a, (ql, qh), (skip0, skip1), &mut w, &mut v);
             (*visit, *work) = (v, w);
             return r;
         }
@@ -616,13 +621,14 @@ impl<const N: usize> Index<N> {
             }
             credit -= 1;
             if g.lo <= qh && g.hi >= ql && !(j >= skip0 && j <= skip1) {
-                if credit < extra {
+                let (flow, units) = visit.segment(j, (g.lo, g.hi));
+                if credit < units {
                     credit = 0;
                     result = Err(OutOfWork);
                     break;
                 }
-                credit -= extra;
-                if visit.segment(j, (g.lo, g.hi)) == Flow::Stop {
+                credit -= units;
+                if flow == Flow::Stop {
                     break;
                 }
             }
@@ -640,7 +646,7 @@ impl<const N: usize> Index<N> {
         mut j: usize,
         (ql, qh): (f32, f32),
         (skip0, skip1): (usize, usize),
-        (work, extra): (&mut Work, u32),
+        work: &mut Work,
         visit: &mut dyn Visitor,
     ) -> Result<(), OutOfWork> {
         let s = self.segments.min(N);
@@ -656,8 +662,9 @@ impl<const N: usize> Index<N> {
                 continue;
             }
             if meets(g.lo, g.hi) && !(j >= skip0 && j <= skip1) {
-                work.spend(extra)?;
-                if visit.segment(j, (g.lo, g.hi)) == Flow::Stop {
+                let (flow, units) = visit.segment(j, (g.lo, g.hi));
+                work.spend(units)?;
+                if flow == Flow::Stop {
                     break;
                 }
             }
@@ -675,7 +682,7 @@ impl<const N: usize> Index<N> {
         &mut self,
         (ql, qh): (f32, f32),
         (skip0, skip1): (usize, usize),
-        (work, extra): (&mut Work, u32),
+        work: &mut Work,
         visit: &mut impl Visitor,
     ) -> Result<(), OutOfWork> {
         let a = self.run_start(ql, work)?;
@@ -716,8 +723,9 @@ impl<const N: usize> Index<N> {
                 }
             };
             if meets(l, h) && !(k >= skip0 && k <= skip1) {
-                work.spend(extra)?;
-                if visit.segment(k, (l, h)) == Flow::Stop {
+                let (flow, units) = visit.segment(k, (l, h));
+                work.spend(units)?;
+                if flow == Flow::Stop {
                     return Ok(());
                 }
             }
@@ -734,7 +742,7 @@ impl<const N: usize> Index<N> {
         query: Query,
         with_near: bool,
         skip: Option<(usize, usize)>,
-        (work, extra): (&mut Work, u32),
+        work: &mut Work,
         visit: &mut dyn Visitor,
     ) -> Result<(), OutOfWork> {
         let s = self.segments;
@@ -835,8 +843,9 @@ impl<const N: usize> Index<N> {
             }
             work.spend(1)?;
             if take && !skipped(next) {
-                work.spend(extra)?;
-                if visit.segment(next, (il, ih)) == Flow::Stop {
+                let (flow, units) = visit.segment(next, (il, ih));
+                work.spend(units)?;
+                if flow == Flow::Stop {
                     return Ok(());
                 }
             }
@@ -929,9 +938,9 @@ pub(crate) fn run_start_in(
 struct Met(bool);
 
 impl Visitor for Met {
-    fn segment(&mut self, _: usize, _: (f32, f32)) -> Flow {
+    fn segment(&mut self, _: usize, _: (f32, f32)) -> (Flow, u32) {
         self.0 = true;
-        Flow::Stop
+        (Flow::Stop, 0)
     }
 }
 

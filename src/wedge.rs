@@ -62,7 +62,7 @@
 use crate::camera::Pixel;
 use crate::matching::Outcome;
 use crate::math::{dot, fmax, fmin, sqrt_pos, sub};
-use crate::search::{Flow, Visitor};
+use crate::search::{Flow, Visitor, CLIP_UNITS};
 use crate::structure::Status;
 
 /// `2⁻²⁰`, the keys' rounding unit ([`crate::pencil`]).
@@ -389,9 +389,9 @@ impl<'a> WedgeWalker<'a> {
 
 impl Visitor for WedgeWalker<'_> {
     #[inline(always)]
-    fn segment(&mut self, j: usize, interval: (f32, f32)) -> Flow {
+    fn segment(&mut self, j: usize, interval: (f32, f32)) -> (Flow, u32) {
         let (Some(a), Some(b)) = (self.vertex(j), self.vertex(j + 1)) else {
-            return Flow::Continue;
+            return (Flow::Continue, 0);
         };
         let segments = self.boundary.len().saturating_sub(1);
         let wedge = self.wedge;
@@ -399,10 +399,10 @@ impl Visitor for WedgeWalker<'_> {
             .walk
             .take(&wedge, j, (&a, &b), interval, segments, self.cot_twice)
         {
-            Ok(()) => Flow::Continue,
+            Ok(()) => (Flow::Continue, CLIP_UNITS),
             Err(s) => {
                 self.decided = Some(s);
-                Flow::Stop
+                (Flow::Stop, CLIP_UNITS)
             }
         }
     }

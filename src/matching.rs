@@ -127,7 +127,7 @@ impl Walk {
 /// (`W' < 0`, slope `h ≤ 0`), from the segment's key interval and its
 /// distance from the FOE, so that the wide key interval such a band needs
 /// (its part near the FOE is wide in angle, [`Band::key_half_width`])
-/// costs one unit per segment instead of a clip.
+/// costs two units per segment instead of three.
 ///
 /// A band point `q` at distance `r` from the FOE `F` and at the angle `φ`
 /// from the ray through `p₁'` has `λ = ρ₁ − r cos φ` and `|μ| = r |sin φ|`,
@@ -207,6 +207,10 @@ impl Radial {
     }
 }
 
+/// Work units a [`Radial`] rejection costs on top of the look (it is about
+/// as long as the look itself).
+const RADIAL_UNITS: u32 = 1;
+
 /// A walk as an index [`Visitor`]: the band, the polyline, the last vertex
 /// computed (reused along a run), the walk, and the band's [`Radial`] test
 /// if it has one.
@@ -271,7 +275,7 @@ impl Visitor for Walker<'_> {
             (self.radial, self.boundary.get(j), self.boundary.get(j + 1))
         {
             if rad.rejects(a.arr(), b.arr(), interval) {
-                return (Flow::Continue, 0);
+                return (Flow::Continue, RADIAL_UNITS);
             }
         }
         let (Some(c0), Some(c1)) = (self.vertex(j), self.vertex(j + 1)) else {

@@ -245,6 +245,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 &pair, &keying, near_foe, slots, b2, index, &mut work, matcher,
             );
         }
+        output.work = work.usage();
     }
 }
 

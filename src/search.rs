@@ -82,6 +82,8 @@ pub(crate) const CLIP_UNITS: u32 = 2;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Work {
     credit: u32,
+    /// Every unit granted so far.
+    granted: u32,
 }
 
 /// The frame's work budget was spent.
@@ -90,13 +92,22 @@ pub(crate) struct OutOfWork;
 
 impl Work {
     pub(crate) const fn new() -> Self {
-        Self { credit: 0 }
+        Self {
+            credit: 0,
+            granted: 0,
+        }
     }
 
     /// Add a point's allowance.
     #[inline(always)]
     pub(crate) fn grant(&mut self, units: u32) {
         self.credit = self.credit.saturating_add(units);
+        self.granted = self.granted.saturating_add(units);
+    }
+
+    /// `(spent, granted)` so far.
+    pub(crate) fn usage(&self) -> (u32, u32) {
+        (self.granted.saturating_sub(self.credit), self.granted)
     }
 
     /// The units left.

@@ -210,6 +210,8 @@ pub struct Structure<const N: usize, const B: usize> {
     pub(crate) camera1: Camera,
     pub(crate) slots: [BoundaryStructure<N>; B],
     pub(crate) count: usize,
+    /// Work units spent and granted ([`Structure::work_units`]).
+    pub(crate) work: (u32, u32),
 }
 
 impl<const N: usize, const B: usize> PartialEq for Structure<N, B> {
@@ -244,11 +246,21 @@ impl<const N: usize, const B: usize> Structure<N, B> {
         camera1: Camera::PLACEHOLDER,
         slots: [BoundaryStructure::EMPTY; B],
         count: 0,
+        work: (0, 0),
     };
 
     /// Per-boundary results (index as in frame 1).
     pub fn boundaries(&self) -> &[BoundaryStructure<N>] {
         self.slots.get(..self.count).unwrap_or(&[])
+    }
+
+    /// The frame's work budget ([`crate::Config::with_work_budget`]): the
+    /// units the search spent and the units the frame's points brought,
+    /// `(spent, granted)`. A frame whose points came out
+    /// [`Status::OverBudget`] spent all of it; the share spent says how
+    /// close to its deadline a frame came.
+    pub fn work_units(&self) -> (u32, u32) {
+        self.work
     }
 
     /// The camera of frame 1, in whose coordinates the points are given.

@@ -185,14 +185,16 @@ fn main() -> ! {
         };
         let r = measure_pair(&mut processor, &f1, &f2, &m);
         defmt::info!(
-            "bench n={=u32} points={=u32} instr={=u32} per_point={=u32} ok={=u32} digest={=u32:08x} processed={=bool}",
+            "bench n={=u32} points={=u32} instr={=u32} per_point={=u32} ok={=u32} digest={=u32:08x} processed={=bool} work_spent={=u32} work_granted={=u32}",
             n,
             r.points,
             r.instr,
             r.instr / r.points.max(1),
             r.ok,
             processor.structure().digest(),
-            r.processed
+            r.processed,
+            processor.structure().work_units().0,
+            processor.structure().work_units().1
         );
         if *n == 256 {
             processor.reset();
@@ -226,7 +228,7 @@ fn main() -> ! {
         };
         let r = measure_pair(&mut processor, &f1, &f2, &m);
         defmt::info!(
-            "adversarial name={=str} n={=u32} points={=u32} instr={=u32} per_point={=u32} digest={=u32:08x} processed={=bool} {=str}",
+            "adversarial name={=str} n={=u32} points={=u32} instr={=u32} per_point={=u32} digest={=u32:08x} processed={=bool} work_spent={=u32} work_granted={=u32} {=str}",
             name,
             n,
             r.points,
@@ -234,6 +236,8 @@ fn main() -> ! {
             r.instr / r.points.max(1),
             processor.structure().digest(),
             r.processed,
+            processor.structure().work_units().0,
+            processor.structure().work_units().1,
             status_fields(processor.structure()).as_str()
         );
     }

@@ -361,8 +361,11 @@ impl<const N: usize> Index<N> {
             run = fmax(run, g.hi);
             g.pm = run;
         }
-        self.suffix_minima(wide);
-        self.build_tree();
+        // The block tree only where the envelopes are still loose without
+        // the segments set aside.
+        if self.suffix_minima(wide) {
+            self.build_tree();
+        }
     }
 
     /// The block tree over the current intervals (module docs): as many

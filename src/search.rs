@@ -363,9 +363,8 @@ impl<const N: usize> Index<N> {
         }
         // The block tree only where the envelopes are still loose without
         // the segments set aside.
-        if self.suffix_minima(wide) {
-            self.build_tree();
-        }
+        self.suffix_minima(wide);
+        self.build_tree();
     }
 
     /// The block tree over the current intervals (module docs): as many
@@ -571,14 +570,29 @@ impl<const N: usize> Index<N> {
         visit: &mut (impl Visitor + Copy),
     ) -> Result<(), OutOfWork> {
         // The usual case: one run, no lists to merge; next, a run and the
-        // aside list.
+        // aside list. Periodic keys take this way when at most one copy of
+        // the query meets the keys' range (none: only unkeyed segments
+        // aside can meet it, so the query is made empty).
         let near = with_near && (!self.near.is_empty() || self.near_overflow);
-        if let (Query::Keys(q0, q1), false, false) = (query, self.period > 0.0, near) {
+        let mut one = None;
+        if let (Query::Keys(q0, q1), false) = (query, near) {
             let (ql, qh) = if self.orient < 0.0 {
                 (-q1, -q0)
             } else {
                 (q0, q1)
             };
+            if self.period <= 0.0 {
+                one = Some((ql, qh));
+            } else {
+                let mut c = [(0.0f32, 0.0f32); MAX_COPIES];
+                match self.copies(ql, qh, &mut c) {
+                    Some(0) => one = Some((f32::INFINITY, f32::NEG_INFINITY)),
+                    Some(1) => one = c.first().copied(),
+                    _ => {}
+                }
+            }
+        }
+        if let Some((ql, qh)) = one {
             if self.aside.is_empty() {
                 return self.visit_run(ql, qh, skip, work, visit);
             }

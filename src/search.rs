@@ -461,25 +461,37 @@ impl<const N: usize> Index<N> {
     /// meets a segment outside `i − w ..= i + w − 1`: `false` is certain
     /// (its widened key lies above every interval before that window and
     /// below every one after it, in the oriented order: the envelopes say
-    /// so in `O(1)`), `true` needs the query ([`Self::visit`]) to decide.
-    /// Non-periodic keys only (else always `true`).
+    /// so in `O(1)`, for each copy of a periodic key that can meet the
+    /// keys' range), `true` needs the query ([`Self::visit`]) to decide.
     #[inline(always)]
     pub(crate) fn may_fold(&self, i: usize, key: f32, w: usize) -> bool {
-        if self.period > 0.0 || !self.aside.is_empty() {
+        if !self.aside.is_empty() {
             return true;
         }
         let k = self.orient * key;
         let e = self.margin(i);
-        let before = i
-            .checked_sub(w + 1)
-            .and_then(|j| self.seg.get(j))
-            .is_some_and(|g| k - e <= g.pm);
-        let after = self
-            .seg
-            .get(i + w)
-            .filter(|_| i + w < self.segments)
-            .is_some_and(|g| k + e >= g.sm);
-        before || after
+        let test = |k: f32| {
+            let before = i
+                .checked_sub(w + 1)
+                .and_then(|j| self.seg.get(j))
+                .is_some_and(|g| k - e <= g.pm);
+            let after = self
+                .seg
+                .get(i + w)
+                .filter(|_| i + w < self.segments)
+                .is_some_and(|g| k + e >= g.sm);
+            before || after
+        };
+        if self.period <= 0.0 {
+            return test(k);
+        }
+        // Periodic keys: every copy of the key that can meet the keys'
+        // range (the envelopes hold the unwrapped keys).
+        let mut c = [(0.0f32, 0.0f32); MAX_COPIES];
+        match self.copies(k - e, k + e, &mut c) {
+            Some(n) => c.iter().take(n).any(|&(lo, _)| test(lo + e)),
+            None => true,
+        }
     }
 
     /// Whether no vertex's key meets a segment other than its own two (so
@@ -1125,4 +1137,231 @@ fn bisect(
         }
     }
     Ok(hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_rng::Rng;
+    extern crate std;
+    use std::vec::Vec;
+
+    const CAP: usize = 96;
+
+    /// A random key sequence of one of several shapes, with margins; some
+    /// keys missing ([`NO_KEY`]); periodic ones in `[0, 4)` when `period`.
+    fn keys(rng: &mut Rng, shape: u32, n: usize, period: bool) -> Vec<(f32, f32)> {
+        let mut k = rng.next() * 2.0 - 1.0;
+        let step = 0.002 + 0.05 * rng.next();
+        let mut out = Vec::new();
+        for i in 0..n {
+            let e = 1.0e-4 * rng.next();
+            k += match shape {
+                // Monotone.
+                0 => step,
+                // Monotone with jitter.
+                1 => step * (1.0 + 1.5 * (rng.next() - 0.5)),
+                // A fold halfway.
+                2 if i > n / 2 => -step,
+                2 => step,
+                // Nearly constant (radial).
+                3 => 1.0e-4 * (rng.next() - 0.5),
+                // Zig-zag.
+                _ => {
+                    if i % 2 == 0 {
+                        step
+                    } else {
+                        -0.8 * step
+                    }
+                }
+            };
+            let mut v = k;
+            // Spikes (spurious points).
+            if rng.next() < 0.04 {
+                v += (rng.next() - 0.5) * 3.0;
+            }
+            if period {
+                v = v.rem_euclid(4.0);
+            }
+            if rng.next() < 0.02 {
+                out.push((NO_KEY, 0.0));
+            } else {
+                out.push((v, e));
+            }
+        }
+        out
+    }
+
+    /// The segments' intervals as the builder forms them, in raw keys
+    /// unwrapped along the polyline for periodic keys (`None`: an end
+    /// without a key).
+    fn intervals(ks: &[(f32, f32)], period: bool) -> Vec<Option<(f32, f32)>> {
+        let mut unwrapped = Vec::new();
+        let (mut offset, mut last) = (0.0f32, NO_KEY);
+        for &(k, e) in ks {
+            if !k.is_finite() {
+                unwrapped.push((k, e));
+                continue;
+            }
+            let mut v = k + offset;
+            if period {
+                let d = v - last;
+                if d > 2.0 {
+                    offset -= 4.0;
+                    v -= 4.0;
+                } else if d < -2.0 {
+                    offset += 4.0;
+                    v += 4.0;
+                }
+                last = v;
+            }
+            unwrapped.push((v, e));
+        }
+        unwrapped
+            .windows(2)
+            .map(|w| {
+                let ((a, ea), (b, eb)) = (w[0], w[1]);
+                (a.is_finite() && b.is_finite())
+                    .then(|| (fmin(a - ea, b - eb), fmax(a + ea, b + eb)))
+            })
+            .collect()
+    }
+
+    /// Whether an interval meets `[lo, hi]` or one of its copies `+ 4m`.
+    fn meets(iv: (f32, f32), (lo, hi): (f32, f32), period: bool) -> bool {
+        if !period {
+            return iv.0 <= hi && iv.1 >= lo;
+        }
+        (-40..=40).any(|m| {
+            let s = 4.0 * m as f32;
+            iv.0 <= hi + s && iv.1 >= lo + s
+        })
+    }
+
+    /// The segments offered, and whether in increasing order.
+    #[derive(Clone, Copy)]
+    struct Record {
+        seen: [bool; CAP],
+        last: Option<usize>,
+        ordered: bool,
+    }
+    impl Visitor for Record {
+        fn segment(&mut self, j: usize, _: (f32, f32)) -> (Flow, u32) {
+            self.ordered &= self.last.is_none_or(|l| j > l);
+            self.last = Some(j);
+            if let Some(s) = self.seen.get_mut(j) {
+                *s = true;
+            }
+            (Flow::Continue, 0)
+        }
+    }
+
+    #[derive(Clone, Copy)]
+    struct Count(usize, usize);
+    impl Visitor for Count {
+        fn segment(&mut self, j: usize, _: (f32, f32)) -> (Flow, u32) {
+            // Increasing indices, counted.
+            assert!(self.1 == usize::MAX || j > self.1, "{j} after {}", self.1);
+            self.1 = j;
+            self.0 += 1;
+            (Flow::Continue, 0)
+        }
+    }
+
+    /// The index offers every segment whose interval meets the query (a
+    /// segment with an unkeyed end meets every query, in frame 2's index),
+    /// in increasing order, whatever the shape of the keys: monotone,
+    /// jittering, folding, radial, zig-zag, with spikes and missing keys,
+    /// periodic or not, either orientation guess.
+    #[test]
+    fn visit_offers_every_segment_that_meets_the_query() {
+        let mut rng = Rng(0x5ea7_c401);
+        let mut index = Index::<CAP>::new();
+        for case in 0..3000 {
+            let (shape, period) = (case % 5, case % 3 == 0);
+            let n = 2 + (rng.next() * (CAP - 2) as f32) as usize;
+            let ks = keys(&mut rng, shape, n, period);
+            let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+            let mut b = index.builder((if period { 4.0 } else { 0.0 }, orient), Unkeyed::MeetAll);
+            for &(k, e) in &ks {
+                b.push(k, e);
+            }
+            b.finish(None);
+            let ivs = intervals(&ks, period);
+            for _ in 0..8 {
+                let c = if period {
+                    4.0 * rng.next()
+                } else {
+                    rng.next() * 3.0 - 1.5
+                };
+                let w = 0.2 * rng.next() * rng.next();
+                let q = (c - w, c + w);
+                let mut rec = Record {
+                    seen: [false; CAP],
+                    last: None,
+                    ordered: true,
+                };
+                let mut work = Work::new();
+                work.grant(u32::MAX);
+                assert!(index
+                    .visit(Query::Keys(q.0, q.1), false, None, &mut work, &mut rec)
+                    .is_ok());
+                assert!(rec.ordered, "case {case}: out of order");
+                for (j, iv) in ivs.iter().enumerate() {
+                    let must = iv.is_none_or(|iv| meets(iv, q, period));
+                    assert!(
+                        !must || rec.seen[j],
+                        "case {case} (shape {shape}, period {period}): segment {j} {iv:?} meets {q:?} but was not offered"
+                    );
+                }
+                let mut count = Count(0, usize::MAX);
+                let mut work = Work::new();
+                work.grant(u32::MAX);
+                assert!(index
+                    .visit(Query::Everything, false, None, &mut work, &mut count)
+                    .is_ok());
+                assert_eq!(count.0, n - 1, "case {case}: every segment for Everything");
+            }
+        }
+    }
+
+    /// The fold test (the `strict` certificate, the envelopes' `O(1)`
+    /// answer and the query) equals the brute force: a vertex folds when its
+    /// widened key meets a segment outside its window (a segment with an
+    /// unkeyed end meets nothing here).
+    #[test]
+    fn folds_equals_brute_force() {
+        let mut rng = Rng(0xf01d_0002);
+        let mut index = Index::<CAP>::new();
+        let w = 4;
+        for case in 0..3000 {
+            let (shape, period) = (case % 5, case % 3 == 0);
+            let n = 2 + (rng.next() * (CAP - 2) as f32) as usize;
+            let ks = keys(&mut rng, shape, n, period);
+            let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+            let mut b = index.builder((if period { 4.0 } else { 0.0 }, orient), Unkeyed::MeetNone);
+            for &(k, e) in &ks {
+                b.push(k, e);
+            }
+            b.finish(None);
+            let ivs = intervals(&ks, period);
+            for (i, &(k, e)) in ks.iter().enumerate() {
+                if !k.is_finite() {
+                    continue;
+                }
+                let brute = ivs.iter().enumerate().any(|(j, iv)| {
+                    let outside = j + w < i || j > i + w - 1;
+                    outside && iv.is_some_and(|iv| meets(iv, (k - e, k + e), period))
+                });
+                let mut work = Work::new();
+                work.grant(u32::MAX);
+                let fast = index.folds(i, k, w, &mut work);
+                assert_eq!(
+                    fast,
+                    Ok(brute),
+                    "case {case} (shape {shape}, period {period}) vertex {i} key {k}"
+                );
+            }
+        }
+    }
 }

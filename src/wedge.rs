@@ -407,3 +407,95 @@ impl Visitor for WedgeWalker<'_> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::depth::{Band, PointErrors};
+    use crate::test_rng::Rng;
+
+    /// Every point the band holds (a true frame-1 point within `r₁`, any
+    /// depth, a polyline point within `e₂` of its correspondent, computed in
+    /// `f64`) lies in the wedge: its key interval meets the wedge's, and
+    /// the wedge walk takes it as a piece (`W' > 0`, no translation error;
+    /// keys on either side of the FOE's row).
+    #[test]
+    fn wedge_holds_every_band_point() {
+        let mut rng = Rng(0x3ed9_e001);
+        let mut inside = 0;
+        let key_scale = 9.536_743e-7 * 1024.0;
+        for case in 0..40_000 {
+            let w = 0.05 + rng.next();
+            let g = [(rng.next() - 0.5) * 300.0, (rng.next() - 0.5) * 300.0];
+            let c2 = [255.5f32, 239.5];
+            let foe = [c2[0] + g[0] / w, c2[1] + g[1] / w];
+            let p = [512.0 * rng.next(), 480.0 * rng.next()];
+            let (r1, e2) = (0.05 + rng.next(), 0.05 + rng.next());
+            let ang = rng.next() * core::f32::consts::TAU;
+            let rad = f64::from(r1) * f64::from(rng.next());
+            let pt = [
+                f64::from(p[0]) + rad * f64::from(libm::cosf(ang)),
+                f64::from(p[1]) + rad * f64::from(libm::sinf(ang)),
+            ];
+            let wf = f64::from(w);
+            let at = [
+                wf * (pt[0] - f64::from(c2[0])) - f64::from(g[0]),
+                wf * (pt[1] - f64::from(c2[1])) - f64::from(g[1]),
+            ];
+            let s = wf + 0.01 + 60.0 * f64::from(rng.next()) * f64::from(rng.next());
+            let tau = 1.0 / (s - wf);
+            let p2 = [pt[0] + tau * at[0], pt[1] + tau * at[1]];
+            let ang2 = rng.next() * core::f32::consts::TAU;
+            let rad2 = f64::from(e2) * f64::from(rng.next());
+            let q = [
+                (p2[0] + rad2 * f64::from(libm::cosf(ang2))) as f32,
+                (p2[1] + rad2 * f64::from(libm::sinf(ang2))) as f32,
+            ];
+            // The boundary's side of the FOE's row: q's, and q keyed.
+            let dq = [q[0] - foe[0], q[1] - foe[1]];
+            let side = if dq[1] >= 0.0 { 1.0 } else { -1.0 };
+            let t = side * dq[1];
+            if !(t >= 4.0 && q[0].abs() < 3000.0 && q[1].abs() < 3000.0) {
+                continue;
+            }
+            let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+            let Ok(wedge) = Wedge::new(p, (foe, side), (r1, e2), key_scale, orient) else {
+                continue;
+            };
+            let i = 1.0 / (dq[0].abs() + t);
+            let (k, m) = (orient * (dq[0] * i), key_scale * i + ULP20);
+            assert!(
+                k + m >= wedge.kl && k - m <= wedge.kh,
+                "case {case}: key {k} ± {m} outside [{}, {}]",
+                wedge.kl,
+                wedge.kh
+            );
+            let v = wedge.vertex(q);
+            let mut walk = WedgeWalk::NEW;
+            let r = walk.take(&wedge, 5, (&v, &v), (k - m, k + m), 10, 11.34);
+            assert!(
+                walk.next == 6 || r == Err(Status::Grazing),
+                "case {case}: q {q:?} not in the wedge of {p:?} (foe {foe:?})"
+            );
+            // And the band itself holds it (the wedge is the larger).
+            let band = Band::new(
+                p,
+                [w * (p[0] - c2[0]) - g[0], w * (p[1] - c2[1]) - g[1]],
+                w,
+                &PointErrors {
+                    r1,
+                    e2,
+                    spread_a: 0.0,
+                    spread_w: 0.0,
+                },
+                0.0,
+            );
+            if let Ok(b) = band {
+                let c = b.vertex(q);
+                assert!(Band::contains(&c), "case {case}: q outside the band");
+            }
+            inside += 1;
+        }
+        assert!(inside > 5_000, "{inside}");
+    }
+}

@@ -48,12 +48,10 @@ fn clipped_runs(
                 }
             }
         }
-        (t0 <= t1).then(|| {
-            (
-                (a.0 + t0 * d.0, a.1 + t0 * d.1),
-                (a.0 + t1 * d.0, a.1 + t1 * d.1),
-            )
-        })
+        (t0 <= t1).then_some((
+            (a.0 + t0 * d.0, a.1 + t0 * d.1),
+            (a.0 + t1 * d.0, a.1 + t1 * d.1),
+        ))
     };
     let pts: Vec<(f64, f64)> = pts.into_iter().collect();
     let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();

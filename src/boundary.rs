@@ -211,6 +211,41 @@ impl<const N: usize, const B: usize> Frame<N, B> {
         }
     }
 
+    /// Start filling this frame in place for `camera`: no boundaries yet.
+    /// (The wire decoder writes points straight into the slots.)
+    pub(crate) fn restart(&mut self, camera: Camera) {
+        self.camera = camera;
+        self.count = 0;
+    }
+
+    /// The storage of the next boundary slot (all `N` points), to be
+    /// written before [`Frame::commit_next`]; `None` when the frame holds
+    /// `B` boundaries.
+    pub(crate) fn next_storage(&mut self) -> Option<&mut [Pixel; N]> {
+        self.slots
+            .get_mut(self.count)
+            .map(|s| s.points.storage_mut())
+    }
+
+    /// Validate the first `len` points written into the next slot exactly
+    /// as [`Frame::push_boundary`] validates its argument, and append them
+    /// as the next boundary; on error the frame is unchanged (the slot's
+    /// storage is scratch until it is counted).
+    pub(crate) fn commit_next(&mut self, len: usize) -> Result<(), BoundaryError> {
+        let camera = self.camera;
+        let Some(slot) = self.slots.get_mut(self.count) else {
+            return Err(BoundaryError::TooManyBoundaries);
+        };
+        let stored = slot.points.storage_mut();
+        let Some(points) = stored.get(..len) else {
+            return Err(BoundaryError::TooManyPoints { len, capacity: N });
+        };
+        Boundary::<N>::check(points, &camera)?;
+        slot.points.set_len(len);
+        self.count += 1;
+        Ok(())
+    }
+
     /// Remove all boundaries (keeps the camera).
     pub fn clear(&mut self) {
         self.count = 0;

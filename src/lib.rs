@@ -18,6 +18,9 @@
 //! Appendix I), [`motion_error`] (Sec. 4.2 and 5) and [`geometry`] (camera
 //! height, tilt and road width from the reconstruction, Sec. 4.2.1).
 //!
+//! [`wire`] is the camera front-end link's format and streaming decoder,
+//! [`link`] its embedded-hal / embedded-io drivers.
+//!
 //! See the README for the coordinate conventions and a worked example.
 #![no_std]
 #![forbid(unsafe_code)]
@@ -53,6 +56,7 @@ pub mod processor;
 mod search;
 mod structure;
 mod wedge;
+pub mod wire;
 
 pub use boundary::{Boundary, BoundaryError, Frame};
 pub use camera::{Camera, CameraError, Pixel, IMAGE_MARGIN_PX};

@@ -39,9 +39,9 @@ use crate::epipolar::PairGeometry;
 use crate::matching::{Outcome, Walker};
 use crate::motion::Motion;
 use crate::pencil::{Keying, Pencil, NO_KEY};
-use crate::wedge::{Wedge, WedgeWalk, WedgeWalker};
 use crate::search::{run_start_in, Flow, Index, OutOfWork, Query, Unkeyed, Visitor, Work};
 use crate::structure::{PointResult, ProcessError, Status, Step, Structure, FOLD_WINDOW};
+use crate::wedge::{Wedge, WedgeWalk, WedgeWalker};
 
 /// Work units a band test costs on top of the unit of looking at the
 /// segment (it is about three times as long).
@@ -498,7 +498,16 @@ fn match_boundary<const N: usize>(
         if matcher == Matcher::Indexed && index.tight().is_some() {
             match_wedge_tight(pair, keying, (foe, side), slots, b2, index, &mut credit);
         } else {
-            match_wedge(pair, keying, (foe, side), slots, b2, index, &mut credit, matcher);
+            match_wedge(
+                pair,
+                keying,
+                (foe, side),
+                slots,
+                b2,
+                index,
+                &mut credit,
+                matcher,
+            );
         }
         *work = credit;
         return;
@@ -686,7 +695,14 @@ fn wedge_run(
 
 /// The point's result from a wedge walk's outcome: depth and stick
 /// ([`crate::wedge`]).
-fn conclude_wedge(pair: &Pair, p1: Pixel, iz: f32, r1: f32, wedge: &Wedge, outcome: Outcome) -> PointResult {
+fn conclude_wedge(
+    pair: &Pair,
+    p1: Pixel,
+    iz: f32,
+    r1: f32,
+    wedge: &Wedge,
+    outcome: Outcome,
+) -> PointResult {
     let (lam, lo, hi) = match outcome {
         Outcome::Match { lam, lo, hi } => (lam, lo, hi),
         Outcome::Flag(s) => return PointResult::flagged(p1, s),
@@ -871,3 +887,23 @@ fn segment_distance2(p: [f32; 2], a: [f32; 2], b: [f32; 2]) -> f32 {
     crate::math::dot(d, d)
 }
 
+// ---------------------------------------------------------------------
+// Hook for the camera front-end link (issue 12, `crate::wire`): the
+// receiver builds a configuration per frame pair from its packets (the
+// boundaries' localisation-error radii, the motion's error bounds).
+// Nothing else in this file depends on it.
+impl<const N: usize, const B: usize> Processor<N, B> {
+    /// Use `config` from the next call on. The kept frame and the last
+    /// output are untouched; a [`Config`] is valid by construction.
+    ///
+    /// ```
+    /// use roadstereo::{Config, Processor};
+    /// let mut p = Processor::<16, 2>::new(Config::DEFAULT);
+    /// p.set_config(Config::DEFAULT.with_translation_error(0.01)?);
+    /// assert_eq!(p.config().translation_error(), 0.01);
+    /// # Ok::<(), roadstereo::ConfigError>(())
+    /// ```
+    pub fn set_config(&mut self, config: Config) {
+        self.config = config;
+    }
+}

@@ -47,6 +47,7 @@ mod config;
 pub mod depth;
 pub mod epipolar;
 pub mod geometry;
+pub mod link;
 mod matching;
 mod math;
 pub mod motion;

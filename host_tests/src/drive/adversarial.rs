@@ -73,7 +73,8 @@ pub fn camera_for(n: usize) -> Intrinsics {
     let base = Intrinsics::default();
     let sf = f64::from(s);
     Intrinsics {
-        f: base.f * sf,
+        fx: base.fx * sf,
+        fy: base.fy * sf,
         cx: (base.cx + 0.5) * sf - 0.5,
         cy: (base.cy + 0.5) * sf - 0.5,
         width: base.width * s,
@@ -414,21 +415,21 @@ impl Motion2 {
         let rel = mm(&tr(&p1.rot), &p2.rot);
         let t1 = mv(&tr(&p1.rot), sub(p2.centre, p1.centre));
         let d2 = mv(&tr(&rel), t1);
-        let foe = [k.cx + k.f * d2[0] / d2[2], k.cy + k.f * d2[1] / d2[2]];
+        let foe = [k.cx + k.fx * d2[0] / d2[2], k.cy + k.fy * d2[1] / d2[2]];
         Motion2 { p1, p2, rel, foe }
     }
     /// Frame-1 pixel → rotation-compensated pixel (`K Rᵀ K⁻¹`).
     fn compensate(&self, k: &Intrinsics, p: [f64; 2]) -> [f64; 2] {
         let q = mv(
             &tr(&self.rel),
-            [(p[0] - k.cx) / k.f, (p[1] - k.cy) / k.f, 1.0],
+            [(p[0] - k.cx) / k.fx, (p[1] - k.cy) / k.fy, 1.0],
         );
-        [k.cx + k.f * q[0] / q[2], k.cy + k.f * q[1] / q[2]]
+        [k.cx + k.fx * q[0] / q[2], k.cy + k.fy * q[1] / q[2]]
     }
     /// The inverse of [`Motion2::compensate`].
     fn uncompensate(&self, k: &Intrinsics, p: [f64; 2]) -> [f64; 2] {
-        let q = mv(&self.rel, [(p[0] - k.cx) / k.f, (p[1] - k.cy) / k.f, 1.0]);
-        [k.cx + k.f * q[0] / q[2], k.cy + k.f * q[1] / q[2]]
+        let q = mv(&self.rel, [(p[0] - k.cx) / k.fx, (p[1] - k.cy) / k.fy, 1.0]);
+        [k.cx + k.fx * q[0] / q[2], k.cy + k.fy * q[1] / q[2]]
     }
 }
 
@@ -462,8 +463,8 @@ fn motion(p: &Params, k: &Intrinsics) -> Motion2 {
             let s = f64::from(k.width) / f64::from(Intrinsics::default().width);
             let len = norm(mv(&tr(&p1.rot), sub(p2.centre, p1.centre)));
             let d2 = [
-                (scaled(u, s) - k.cx) / k.f,
-                (scaled(v, s) - k.cy) / k.f,
+                (scaled(u, s) - k.cx) / k.fx,
+                (scaled(v, s) - k.cy) / k.fy,
                 1.0,
             ];
             let n2 = norm(d2);

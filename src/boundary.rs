@@ -219,7 +219,7 @@ impl<const N: usize, const B: usize> Frame<N, B> {
     }
 
     /// The storage of the next boundary slot (all `N` points), to be
-    /// written before [`Frame::commit_next`]; `None` when the frame holds
+    /// written before [`Frame::commit_next_validated`]; `None` when the frame holds
     /// `B` boundaries.
     pub(crate) fn next_storage(&mut self) -> Option<&mut [Pixel; N]> {
         self.slots
@@ -227,23 +227,23 @@ impl<const N: usize, const B: usize> Frame<N, B> {
             .map(|s| s.points.storage_mut())
     }
 
-    /// Validate the first `len` points written into the next slot exactly
-    /// as [`Frame::push_boundary`] validates its argument, and append them
-    /// as the next boundary; on error the frame is unchanged (the slot's
-    /// storage is scratch until it is counted).
-    pub(crate) fn commit_next(&mut self, len: usize) -> Result<(), BoundaryError> {
-        let camera = self.camera;
+    /// Append the first `len` points written into the next slot as the
+    /// next boundary, **already validated** by the caller with checks
+    /// equivalent to [`Frame::push_boundary`]'s (the wire decoder checks
+    /// its fixed-point points as integers, in the same order with the same
+    /// errors; `wire`'s tests and the host fuzz test compare the two on
+    /// every decoded frame). `false` when the frame holds `B` boundaries or
+    /// `len > N` (nothing changes then).
+    pub(crate) fn commit_next_validated(&mut self, len: usize) -> bool {
+        if len > N {
+            return false;
+        }
         let Some(slot) = self.slots.get_mut(self.count) else {
-            return Err(BoundaryError::TooManyBoundaries);
+            return false;
         };
-        let stored = slot.points.storage_mut();
-        let Some(points) = stored.get(..len) else {
-            return Err(BoundaryError::TooManyPoints { len, capacity: N });
-        };
-        Boundary::<N>::check(points, &camera)?;
         slot.points.set_len(len);
         self.count += 1;
-        Ok(())
+        true
     }
 
     /// Remove all boundaries (keeps the camera).

@@ -466,14 +466,26 @@ impl<const N: usize> Index<N> {
     /// 1` ([`Self::may_fold`], then the query; each segment looked at one
     /// unit of `work`).
     #[inline(always)]
-    pub(crate) fn folds(&mut self, i: usize, key: f32, w: usize, work: &mut Work) -> Result<bool, OutOfWork> {
+    pub(crate) fn folds(
+        &mut self,
+        i: usize,
+        key: f32,
+        w: usize,
+        work: &mut Work,
+    ) -> Result<bool, OutOfWork> {
         if self.strict || !self.may_fold(i, key, w) {
             return Ok(false);
         }
         let e = self.margin(i);
         let skip = (i.saturating_sub(w), i.saturating_add(w).saturating_sub(1));
         let mut met = Met(false);
-        self.visit(Query::Keys(key - e, key + e), false, Some(skip), (work, 0), &mut met)?;
+        self.visit(
+            Query::Keys(key - e, key + e),
+            false,
+            Some(skip),
+            (work, 0),
+            &mut met,
+        )?;
         Ok(met.0)
     }
 
@@ -483,8 +495,12 @@ impl<const N: usize> Index<N> {
     /// [`Self::visit`] does); `None` otherwise.
     #[inline(always)]
     pub(crate) fn tight(&self) -> Option<(&[Seg], f32)> {
-        (self.period <= 0.0 && self.aside.is_empty() && self.levels == 0)
-            .then(|| (self.seg.get(..self.segments.min(N)).unwrap_or(&[]), self.orient))
+        (self.period <= 0.0 && self.aside.is_empty() && self.levels == 0).then(|| {
+            (
+                self.seg.get(..self.segments.min(N)).unwrap_or(&[]),
+                self.orient,
+            )
+        })
     }
 
     /// Where the last run started (the next query's probes start there).

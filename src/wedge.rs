@@ -60,8 +60,8 @@
 //! and `e₂` covers (see [`crate::depth`]).
 
 use crate::camera::Pixel;
-use crate::math::{dot, fmax, fmin, sqrt_pos, sub};
 use crate::matching::Outcome;
+use crate::math::{dot, fmax, fmin, sqrt_pos, sub};
 use crate::search::{Flow, Visitor};
 use crate::structure::Status;
 
@@ -193,7 +193,12 @@ impl Wedge {
     /// `(s, s_near, s_far)` (module docs), for `w = W'`; `None` when the
     /// far end is unbounded (the disparity is not larger than its error).
     #[inline(always)]
-    pub(crate) fn depths(&self, w: f32, r1: f32, (lam, lo, hi): (f32, f32, f32)) -> Option<(f32, f32, f32)> {
+    pub(crate) fn depths(
+        &self,
+        w: f32,
+        r1: f32,
+        (lam, lo, hi): (f32, f32, f32),
+    ) -> Option<(f32, f32, f32)> {
         let den_far = lo + self.lam_lo;
         // (A NaN fails.)
         if !(den_far > 0.0) {

@@ -147,6 +147,109 @@ fn input_slot(t: PacketType) -> Option<usize> {
     }
 }
 
+/// The order and range checks' state along one boundary's points.
+struct PointRun {
+    /// Largest `raw − 0x0101` for `u` and `v`.
+    limits: (u32, u32),
+    /// The previous point, raw (`u` in the low half, `v` in the high).
+    prev: u32,
+    /// The last row step (0 before the second point).
+    step: i32,
+    /// Index of the next point.
+    index: usize,
+}
+
+impl PointRun {
+    /// One point with every check (the first two of a boundary, where the
+    /// row direction is not known yet).
+    #[inline(always)]
+    fn check(&mut self, w: u32) -> Result<(), crate::BoundaryError> {
+        use crate::BoundaryError as E;
+        let index = self.index;
+        let base = u32::from(super::RAW_MINUS_ONE_PX);
+        let (u, v) = (w & 0xFFFF, w >> 16);
+        if u.wrapping_sub(base) > self.limits.0 || v.wrapping_sub(base) > self.limits.1 {
+            return Err(E::OutsideImage { index });
+        }
+        if index > 0 {
+            if w == self.prev {
+                return Err(E::Duplicate { index });
+            }
+            let dv = v as i32 - (self.prev >> 16) as i32;
+            if dv == 0 || (self.step != 0 && (dv ^ self.step) < 0) {
+                return Err(E::Unordered { index });
+            }
+            self.step = dv;
+        }
+        self.prev = w;
+        self.index = index + 1;
+        Ok(())
+    }
+
+    /// Check and convert `chunks` into `dst` (same length); stops at the
+    /// first bad point. The usual case, once the row direction is known,
+    /// in a lean loop; a point it does not pass gets the careful check,
+    /// which names the error.
+    #[inline(never)]
+    fn store(&mut self, chunks: &[[u8; 4]], dst: &mut [Pixel]) -> Result<(), crate::BoundaryError> {
+        let mut pairs = dst.iter_mut().zip(chunks);
+        while self.index < 2 {
+            let Some((d, c)) = pairs.next() else {
+                return Ok(());
+            };
+            let w = u32::from_le_bytes(*c);
+            self.check(w)?;
+            *d = Pixel::new(raw_to_px(w as u16), raw_to_px((w >> 16) as u16));
+        }
+        let base = u32::from(super::RAW_MINUS_ONE_PX);
+        let (umax, vmax) = self.limits;
+        let (mut prev, mut step) = (self.prev, self.step);
+        let mut taken = 0usize;
+        let mut failed = None;
+        for (d, c) in pairs {
+            let w = u32::from_le_bytes(*c);
+            let (u, v) = (w & 0xFFFF, w >> 16);
+            let dv = v as i32 - (prev >> 16) as i32;
+            // (A duplicate has dv = 0 too: the careful check tells which.)
+            if u.wrapping_sub(base) > umax
+                || v.wrapping_sub(base) > vmax
+                || dv == 0
+                || (dv ^ step) < 0
+            {
+                failed = Some(w);
+                break;
+            }
+            step = dv;
+            prev = w;
+            *d = Pixel::new(raw_to_px(u as u16), raw_to_px(v as u16));
+            taken += 1;
+        }
+        self.index += taken;
+        self.step = step;
+        self.prev = prev;
+        match failed {
+            Some(w) => self.check(w),
+            None => Ok(()),
+        }
+    }
+}
+
+/// The first zero byte of `s`: four bytes at a time (a word has a zero
+/// byte iff `(w − 0x0101_0101) & !w & 0x8080_8080 ≠ 0`), then byte by byte.
+#[inline(always)]
+fn zero_at(s: &[u8]) -> Option<usize> {
+    let (words, _) = s.as_chunks::<4>();
+    let mut at = 0;
+    for w in words {
+        let x = u32::from_le_bytes(*w);
+        if x.wrapping_sub(0x0101_0101) & !x & 0x8080_8080 != 0 {
+            break;
+        }
+        at += 4;
+    }
+    s.get(at..)?.iter().position(|&b| b == 0).map(|i| at + i)
+}
+
 fn le16(b: &[u8], at: usize) -> u16 {
     match b.get(at..at + 2) {
         Some(&[x, y]) => u16::from_le_bytes([x, y]),
@@ -211,6 +314,12 @@ pub struct Decoder<const N: usize, const B: usize> {
     done: usize,
     carry: [u8; POINT_LEN],
     carry_len: usize,
+    /// Largest raw `u` and `v` inside the image with its margin.
+    limits: (u32, u32),
+    /// The previous point (raw, `v` high) and the last row step, for the
+    /// order checks.
+    prev: u32,
+    step: i32,
 }
 
 impl<const N: usize, const B: usize> Decoder<N, B> {
@@ -243,6 +352,9 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
             done: 0,
             carry: [0; POINT_LEN],
             carry_len: 0,
+            limits: (0, 0),
+            prev: 0,
+            step: 0,
         }
     }
 
@@ -269,7 +381,7 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
                 let Some((chunk, after_chunk)) = rest.split_at_checked(take) else {
                     break;
                 };
-                if let Some(z) = chunk.iter().position(|&b| b == 0) {
+                if let Some(z) = zero_at(chunk) {
                     // A delimiter inside a run: the packet was cut short.
                     used += z + 1;
                     self.cobs = DecoderState::Idle;
@@ -469,6 +581,12 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
             });
         }
         self.frame.restart(camera);
+        // −1 ≤ u = (raw − 0x0101) / 16 − 1 ≤ width ⇔
+        // 0 ≤ raw − 0x0101 ≤ 16 (width + 1) (exact; below 0 it wraps).
+        self.limits = (
+            16 * (u32::from(camera.width()) + 1),
+            16 * (u32::from(camera.height()) + 1),
+        );
         self.info = FrameInfo {
             timestamp_us: ts,
             frame_id: id,
@@ -532,6 +650,7 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
         self.points = usize::from(n);
         self.done = 0;
         self.carry_len = 0;
+        self.step = 0;
         self.state = State::Points;
     }
 
@@ -562,38 +681,54 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
             self.store(body);
             s = rest;
         }
-        if self.done >= self.points {
+        if self.state == State::Points && self.done >= self.points {
             self.boundary_done();
         }
         s
     }
 
-    /// Convert whole points into the next slot's storage.
+    /// Validate whole points and convert them into the next slot's
+    /// storage. The checks are [`crate::Frame::push_boundary`]'s, done on
+    /// the raw values, in the same order, with the same errors: every
+    /// point is finite by construction; `u` is inside `[−1, width]` iff
+    /// `raw − 0x0101` is in `[0, 16 (width + 1)]` (the conversion is exact);
+    /// equal raw points are equal pixels; a row step's sign is the raw
+    /// step's.
     #[inline(always)]
     fn store(&mut self, body: &[u8]) {
         let (chunks, _) = body.as_chunks::<POINT_LEN>();
         let done = self.done;
+        let mut run = PointRun {
+            limits: self.limits,
+            prev: self.prev,
+            step: self.step,
+            index: done,
+        };
+        let mut bad = None;
         if let Some(dst) = self
             .frame
             .next_storage()
             .and_then(|s| s.get_mut(done..done + chunks.len()))
         {
-            for (d, &[a, b, c, e]) in dst.iter_mut().zip(chunks) {
-                *d = Pixel::new(
-                    raw_to_px(u16::from_le_bytes([a, b])),
-                    raw_to_px(u16::from_le_bytes([c, e])),
-                );
-            }
+            bad = run.store(chunks, dst).err();
         }
+        self.prev = run.prev;
+        self.step = run.step;
         self.done = done + chunks.len();
+        if let Some(error) = bad {
+            self.fault(WireError::Boundary {
+                boundary: u8::try_from(self.boundary).unwrap_or(u8::MAX),
+                error,
+            });
+        }
     }
 
     fn boundary_done(&mut self) {
         let k = self.boundary;
-        if let Err(error) = self.frame.commit_next(self.points) {
-            return self.fault(WireError::Boundary {
-                boundary: u8::try_from(k).unwrap_or(u8::MAX),
-                error,
+        if !self.frame.commit_next_validated(self.points) {
+            return self.fault(WireError::TooManyBoundaries {
+                count: u8::try_from(k + 1).unwrap_or(u8::MAX),
+                capacity: u8::try_from(B).unwrap_or(u8::MAX),
             });
         }
         self.boundary = k + 1;

@@ -57,7 +57,7 @@ pub const CRC_LEN: usize = 4;
 pub const FRAME_HEAD_LEN: usize = 18;
 /// A boundary's fixed part: index, quality, error radius, point count.
 pub const BOUNDARY_HEAD_LEN: usize = 6;
-/// One point: `u`, `v` as `u16` in 1/16 px, offset by 1 px.
+/// One point: `u`, `v` as `u16` in 1/16 px ([`raw_to_px`]).
 pub const POINT_LEN: usize = 4;
 /// A motion payload (fixed size).
 pub const MOTION_LEN: usize = 52;
@@ -203,19 +203,31 @@ pub(crate) const RESIDUE: u32 = {
     CRC.checksum(&c.to_le_bytes())
 };
 
-/// A point coordinate on the wire → pixels: `raw / 16 − 1` (exact in
-/// `f32`; covers `[−1, 4094.9375]` px).
+/// The raw value of a point coordinate of −1 px (the image's margin).
+///
+/// A coordinate `px` is sent as `raw = 16 (px + 1) + 0x0101`: 1/16 px
+/// steps, from −1 px (the margin) up to 4078.875 px. The offset `0x0101`
+/// keeps every byte of an integer or half-pixel coordinate non-zero (the
+/// high byte is at least 1; the low byte of `16 k + 1` never 0), and those
+/// are what row-scanning detectors report: in COBS a zero byte ends a run,
+/// and each run costs the decoder a fixed overhead, so point data without
+/// zeros is decoded in long runs.
+pub const RAW_MINUS_ONE_PX: u16 = 0x0101;
+
+/// A point coordinate on the wire → pixels: `raw / 16 − 17.0625`, i.e.
+/// `(raw − 0x0101) / 16 − 1` (exact in `f32`).
 #[inline(always)]
 pub fn raw_to_px(raw: u16) -> f32 {
-    f32::from(raw) * 0.0625 - 1.0
+    f32::from(raw) * 0.0625 - 17.0625
 }
 
 /// Pixels → a point coordinate on the wire, rounded to the nearest
-/// 1/16 px; `None` outside `[−1, 4094.9375]` px or not finite.
+/// 1/16 px; `None` below −1 px or above 4078.875 px (after rounding) or
+/// not finite.
 pub fn px_to_raw(px: f32) -> Option<u16> {
-    let t = (px + 1.0) * 16.0 + 0.5;
+    let t = (px + 1.0) * 16.0 + f32::from(RAW_MINUS_ONE_PX) + 0.5;
     // (NaN fails.)
-    if !(0.0..65536.0).contains(&t) {
+    if !(f32::from(RAW_MINUS_ONE_PX)..65536.0).contains(&t) {
         return None;
     }
     Some(t as u16)

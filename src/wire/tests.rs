@@ -128,13 +128,19 @@ fn residue_checks_any_intact_packet() {
 
 #[test]
 fn fixed_point_conversions_are_exact() {
-    for raw in [0u16, 1, 15, 16, 17, 8000, 65535] {
+    for raw in [257u16, 258, 272, 273, 8000, 65535] {
         assert_eq!(px_to_raw(raw_to_px(raw)), Some(raw));
     }
-    assert_eq!(raw_to_px(0), -1.0);
+    assert_eq!(raw_to_px(RAW_MINUS_ONE_PX), -1.0);
+    assert_eq!(raw_to_px(65535), 4078.875);
     assert_eq!(px_to_raw(-1.04), None);
     assert_eq!(px_to_raw(f32::NAN), None);
-    assert_eq!(px_to_raw(4095.0), None);
+    assert_eq!(px_to_raw(4079.0), None);
+    // Integer and half-pixel coordinates have no zero byte.
+    for k in 0..8000 {
+        let raw = px_to_raw(-1.0 + 0.5 * k as f32).unwrap();
+        assert!(raw.to_le_bytes().iter().all(|&b| b != 0), "{k}");
+    }
     assert_eq!(radius_to_raw(0.5), Some(128));
     assert!(raw_to_radius(radius_to_raw(0.3).unwrap()) >= 0.3);
     assert_eq!(radius_to_raw(100.5), None);

@@ -125,6 +125,12 @@ fn main() -> ! {
         N,
         BUDGET_INSTRUCTIONS
     );
+    defmt::info!(
+        "sizes receiver={=usize} uart_link={=usize} result_buffers={=usize}",
+        core::mem::size_of::<Receiver<N, B>>(),
+        core::mem::size_of::<UartLink<Uart0>>(),
+        RAW + wire::cobs_max(RAW)
+    );
     loop {
         let mut end = false;
         let polled = link.poll(&mut rx, |ev| match ev {

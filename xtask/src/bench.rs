@@ -520,15 +520,28 @@ fn wire_table(log: &str) {
         points / 2,
         bytes,
         num(&w, "link_bytes"),
-        if field(&w, "ok") == Some("true") { "correctly" } else { "WRONGLY" }
+        if field(&w, "ok") == Some("true") {
+            "correctly"
+        } else {
+            "WRONGLY"
+        }
     );
     println!("| what | instructions | per point | per byte |");
     println!("|---|---:|---:|---:|");
     for (name, k) in [
-        ("decode (COBS + CRC + parse + validation), whole packet in one feed", "decode"),
-        ("decode, fed in the UART driver's 64-byte chunks", "decode_chunked"),
+        (
+            "decode (COBS + CRC + parse + validation), whole packet in one feed",
+            "decode",
+        ),
+        (
+            "decode, fed in the UART driver's 64-byte chunks",
+            "decode_chunked",
+        ),
         ("CRC-32 alone, no table (0 B of table)", "crc_none"),
-        ("CRC-32 alone, 1 table (1 KiB; the library's choice)", "crc_table1"),
+        (
+            "CRC-32 alone, 1 table (1 KiB; the library's choice)",
+            "crc_table1",
+        ),
         ("CRC-32 alone, 16 tables (16 KiB)", "crc_table16"),
     ] {
         println!(

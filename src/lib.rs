@@ -18,6 +18,9 @@
 //! Appendix I), [`motion_error`] (Sec. 4.2 and 5) and [`geometry`] (camera
 //! height, tilt and road width from the reconstruction, Sec. 4.2.1).
 //!
+//! [`wire`] is the camera front-end link's format and streaming decoder,
+//! [`link`] its embedded-hal / embedded-io drivers.
+//!
 //! See the README for the coordinate conventions and a worked example.
 #![no_std]
 #![forbid(unsafe_code)]
@@ -45,6 +48,7 @@ mod config;
 pub mod depth;
 pub mod epipolar;
 pub mod geometry;
+pub mod link;
 mod matching;
 mod math;
 pub mod motion;
@@ -54,6 +58,7 @@ pub mod processor;
 mod search;
 mod structure;
 mod wedge;
+pub mod wire;
 
 pub use boundary::{Boundary, BoundaryError, Frame};
 pub use camera::{Camera, CameraError, Pixel, IMAGE_MARGIN_PX};

@@ -100,6 +100,22 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         &self.config
     }
 
+    /// Use `config` from the next call on (e.g. the error bounds that came
+    /// with a frame pair over the link, [`crate::wire`]). The kept frame
+    /// and the last output are untouched; a [`Config`] is valid by
+    /// construction.
+    ///
+    /// ```
+    /// use roadstereo::{Config, Processor};
+    /// let mut p = Processor::<16, 2>::new(Config::DEFAULT);
+    /// p.set_config(Config::DEFAULT.with_translation_error(0.01)?);
+    /// assert_eq!(p.config().translation_error(), 0.01);
+    /// # Ok::<(), roadstereo::ConfigError>(())
+    /// ```
+    pub fn set_config(&mut self, config: Config) {
+        self.config = config;
+    }
+
     /// The kept previous frame, if any.
     pub fn previous(&self) -> Option<&Frame<N, B>> {
         self.has_previous.then_some(&self.previous)

@@ -6,6 +6,7 @@ pub mod calib;
 pub mod certify;
 pub mod drive;
 pub mod jsonl;
+pub mod link;
 pub mod scenarios;
 pub mod synth;
 

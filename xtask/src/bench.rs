@@ -102,6 +102,7 @@ pub fn bench(b: &Budget) -> Result<(), String> {
     scaling_and_deadline(&per, b, &mut misses);
     adversarial(&log, b, &mut misses);
     memory_table(&log, &demo_elf, b, &mut misses)?;
+    wire_table(&log);
     symbol_checks(&[&elf, &demo_elf], &mut misses)?;
     verdict(&misses, b)
 }
@@ -501,4 +502,60 @@ fn verdict(misses: &[String], b: &Budget) -> Result<(), String> {
         b.per_point, b.per_point_256
     );
     Ok(())
+}
+
+/// The link decoder's cost (issue 12): the bench firmware's `wire` line.
+/// The goal of 60 instructions per point is printed, not enforced.
+fn wire_table(log: &str) {
+    let Some(w) = records(log, "wire points=").into_iter().next() else {
+        println!("xtask: the bench logged no `wire` line");
+        return;
+    };
+    let (points, bytes) = (num(&w, "points").max(1), num(&w, "packet_bytes").max(1));
+    let per = |k: &str| num(&w, k) as f64 / points as f64;
+    let per_byte = |k: &str| num(&w, k) as f64 / bytes as f64;
+    println!();
+    println!(
+        "Link decoder, one 2 x {} frame packet ({} bytes, {} on the link), decoded {}:",
+        points / 2,
+        bytes,
+        num(&w, "link_bytes"),
+        if field(&w, "ok") == Some("true") {
+            "correctly"
+        } else {
+            "WRONGLY"
+        }
+    );
+    println!("| what | instructions | per point | per byte |");
+    println!("|---|---:|---:|---:|");
+    for (name, k) in [
+        (
+            "decode (COBS + CRC + parse + validation), whole packet in one feed",
+            "decode",
+        ),
+        (
+            "decode, fed in the UART driver's 64-byte chunks",
+            "decode_chunked",
+        ),
+        ("CRC-32 alone, no table (0 B of table)", "crc_none"),
+        (
+            "CRC-32 alone, 1 table (1 KiB; the library's choice)",
+            "crc_table1",
+        ),
+        ("CRC-32 alone, 16 tables (16 KiB)", "crc_table16"),
+    ] {
+        println!(
+            "| {name} | {} | {:.1} | {:.1} |",
+            num(&w, k),
+            per(k),
+            per_byte(k)
+        );
+    }
+    let d = per("decode");
+    println!(
+        "goal: decode + CRC + validation <= 60 instructions per point: {:.1} ({}; not enforced); decoder state {} B",
+        d,
+        if d <= 60.0 { "met" } else { "not met" },
+        num(&w, "decoder_bytes")
+    );
 }

@@ -30,16 +30,20 @@
 //! side, as the wedge leaves the half-plane through the FOE's row). With
 //! every key widened by its rounding margin, a segment whose interval
 //! ([`crate::search`]) misses the wedge's is outside it; one whose interval
-//! lies inside the wedge's is inside it, end to end; only a segment whose
-//! interval straddles an edge's key is clipped by that edge's line, exactly
-//! (one division per edge it crosses). The segment's part in the wedge then
-//! has the range `[λ₀, λ₁]` of `λ = â·(q − p₁')` (`â = d/ρ₁`; `λ` is linear
-//! along the segment, so the ends of the part give it), cut at `λ ≥ −(r₁ +
-//! e₂)`.
+//! lies inside the wedge's is taken whole (it reaches at most its keys'
+//! margins past an edge, which only lengthens the piece: the stick stays a
+//! bound); only a segment whose interval straddles an edge's key is
+//! clipped by that edge's line, exactly (one division per edge it
+//! crosses). The segment's part in the wedge then has the range `[λ₀, λ₁]`
+//! of `λ = â·(q − p₁')` (`â = d/ρ₁`; `λ` is linear along the segment, so
+//! the ends of the part give it), cut at `λ ≥ −(r₁ + e₂)`.
 //!
 //! The walk over the segments (in order, with the rules of
 //! [`crate::matching`]: one piece, not grazing, no end vertex inside,
-//! the exact line's nearest crossing for the estimate) gives the piece's
+//! the exact line's nearest crossing for the estimate, where the segment's
+//! ends lie on the line's two sides: a segment whose keys miss the line's,
+//! widened by the margins, has both ends farther from the line than the
+//! sides' rounding, so no key test is needed there) gives the piece's
 //! range `[lo, hi]` and the crossing's `λ`, and with `|a| = W' ρ₁`
 //! the depth and stick of [`crate::depth`] become
 //!
@@ -60,8 +64,8 @@
 //! and `e₂` covers (see [`crate::depth`]).
 
 use crate::camera::Pixel;
-use crate::math::{dot, fmax, fmin, sqrt_pos, sub};
 use crate::matching::Outcome;
+use crate::math::{dot, fmax, fmin, sqrt_pos, sub};
 use crate::search::{Flow, Visitor};
 use crate::structure::Status;
 
@@ -86,8 +90,6 @@ pub(crate) struct Wedge {
     /// Inward normals of the edges whose keys are `kl` and `kh`.
     nl: [f32; 2],
     nh: [f32; 2],
-    /// The exact line's key interval (oriented, widened by its margin).
-    own: (f32, f32),
     /// `−(r₁ + e₂)`.
     pub(crate) lam_lo: f32,
 }
@@ -142,20 +144,10 @@ impl Wedge {
         } else {
             (kp - mp, np, km + mm, nm)
         };
-        let td = side * d[1];
-        if !(td > 0.0 || im || ip) {
+        if !(side * d[1] > 0.0 || im || ip) {
             // The whole wedge lies beyond the FOE's row: no keyed point.
             (kl, kh) = (f32::INFINITY, f32::NEG_INFINITY);
         }
-        // The exact line's own key (none beyond the row: it never enters
-        // the half-plane past p₁').
-        let own = if td > 0.0 {
-            let i = 1.0 / (d[0].abs() + td);
-            let (k, m) = (orient * (d[0] * i), key_scale * i + ULP20);
-            (k - m, k + m)
-        } else {
-            (f32::INFINITY, f32::NEG_INFINITY)
-        };
         Ok(Self {
             foe,
             p,
@@ -167,18 +159,21 @@ impl Wedge {
             kh,
             nl,
             nh,
-            own,
             lam_lo: -re,
         })
     }
 
-    /// A vertex in the wedge's frame: `v − F` and its `λ`.
+    /// A vertex in the wedge's frame: its `λ`, the values of the two
+    /// edges' inward normals (inside where both are ≥ 0) and its side of
+    /// the exact line, at `v − F`.
     #[inline(always)]
     pub(crate) fn vertex(&self, v: [f32; 2]) -> WVertex {
         let w = sub(v, self.foe);
         WVertex {
-            w,
             lam: dot(self.u, w) - self.rho,
+            gl: dot(self.nl, w),
+            gh: dot(self.nh, w),
+            side: self.d[0] * w[1] - self.d[1] * w[0],
         }
     }
 
@@ -193,7 +188,12 @@ impl Wedge {
     /// `(s, s_near, s_far)` (module docs), for `w = W'`; `None` when the
     /// far end is unbounded (the disparity is not larger than its error).
     #[inline(always)]
-    pub(crate) fn depths(&self, w: f32, r1: f32, (lam, lo, hi): (f32, f32, f32)) -> Option<(f32, f32, f32)> {
+    pub(crate) fn depths(
+        &self,
+        w: f32,
+        r1: f32,
+        (lam, lo, hi): (f32, f32, f32),
+    ) -> Option<(f32, f32, f32)> {
         let den_far = lo + self.lam_lo;
         // (A NaN fails.)
         if !(den_far > 0.0) {
@@ -206,11 +206,23 @@ impl Wedge {
     }
 }
 
-/// A frame-2 vertex relative to the FOE, with its `λ` along a wedge's line.
+/// A frame-2 vertex in a wedge's frame ([`Wedge::vertex`]).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct WVertex {
-    w: [f32; 2],
     lam: f32,
+    gl: f32,
+    gh: f32,
+    side: f32,
+}
+
+impl WVertex {
+    /// A placeholder, never read before it is overwritten.
+    pub(crate) const NONE: WVertex = WVertex {
+        lam: 0.0,
+        gl: 0.0,
+        gh: 0.0,
+        side: 0.0,
+    };
 }
 
 /// The walk over a polyline's segments through one wedge (the rules of
@@ -257,9 +269,8 @@ impl WedgeWalk {
         if klo < wedge.kl || khi > wedge.kh {
             // The segment's rays reach past an edge: clip it by that edge's
             // line (the side towards d is inside).
-            for (cut, n) in [(klo < wedge.kl, wedge.nl), (khi > wedge.kh, wedge.nh)] {
+            for (cut, ca, cb) in [(klo < wedge.kl, a.gl, b.gl), (khi > wedge.kh, a.gh, b.gh)] {
                 if cut {
-                    let (ca, cb) = (dot(n, a.w), dot(n, b.w));
                     if ca < 0.0 {
                         if cb < 0.0 {
                             return Ok(());
@@ -301,15 +312,12 @@ impl WedgeWalk {
         if self.hi - self.lo > wedge.t * (wedge.rho + self.lo) * cot_twice {
             return Err(Status::Grazing);
         }
-        if klo <= wedge.own.1 && khi >= wedge.own.0 {
-            // The exact line may cross here: the sides of the ends.
-            let d = wedge.d;
-            let (sa, sb) = (d[0] * a.w[1] - d[1] * a.w[0], d[0] * b.w[1] - d[1] * b.w[0]);
-            if crate::depth::side_bit(sa) != crate::depth::side_bit(sb) {
-                let lam = a.lam + sa / (sa - sb) * dl;
-                if lam < self.best && lam > wedge.lam_lo {
-                    self.best = lam;
-                }
+        // The exact line's crossing: the ends on its two sides.
+        let (sa, sb) = (a.side, b.side);
+        if crate::depth::side_bit(sa) != crate::depth::side_bit(sb) {
+            let lam = a.lam + sa / (sa - sb) * dl;
+            if lam < self.best && lam > wedge.lam_lo {
+                self.best = lam;
             }
         }
         Ok(())
@@ -353,10 +361,7 @@ impl<'a> WedgeWalker<'a> {
             boundary,
             cot_twice,
             cache_i: usize::MAX,
-            cache: WVertex {
-                w: [0.0; 2],
-                lam: 0.0,
-            },
+            cache: WVertex::NONE,
             walk: WedgeWalk::NEW,
             decided: None,
         }

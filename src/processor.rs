@@ -38,10 +38,12 @@ use crate::depth::{interval, Band, PointErrors};
 use crate::epipolar::PairGeometry;
 use crate::matching::{Outcome, Walker};
 use crate::motion::Motion;
-use crate::pencil::{Keying, Pencil, NO_KEY};
-use crate::wedge::{Wedge, WedgeWalk, WedgeWalker};
-use crate::search::{run_start_in, Flow, Index, OutOfWork, Query, Unkeyed, Visitor, Work};
+use crate::pencil::{half_key, Keying, Pencil, NO_KEY};
+use crate::search::{
+    run_start_in, Flow, Index, KeyOrder, OutOfWork, Query, Unkeyed, Visitor, Work,
+};
 use crate::structure::{PointResult, ProcessError, Status, Step, Structure, FOLD_WINDOW};
+use crate::wedge::{Wedge, WedgeWalk, WedgeWalker};
 
 /// Work units a band test costs on top of the unit of looking at the
 /// segment (it is about three times as long).
@@ -209,8 +211,10 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 b2.and_then(|b| b.first()),
                 b2.and_then(|b| b.last()),
             );
-            let mut fold_index = index.builder((keying.period, orient), Unkeyed::MeetNone);
-            for (slot, &p1) in slots.iter_mut().zip(b1) {
+            // Step 1, with each point's key margin where the fold index
+            // wants it, and whether the keys are strictly ordered.
+            let mut order = KeyOrder::NEW;
+            for ((slot, &p1), m) in slots.iter_mut().zip(b1).zip(index.margins_mut().iter_mut()) {
                 let (k, e) = match compensate_point(&pair, &keying, p1, &mut r1_max) {
                     Ok((r, key)) => {
                         *slot = r;
@@ -221,10 +225,26 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                         (NO_KEY, 0.0)
                     }
                 };
-                fold_index.push(k, e);
+                *m = e;
+                order.push(k, e);
             }
-            fold_index.finish(None);
-            fold(index, slots, config.work_per_point, &mut work);
+            if order.strict(keying.period) {
+                // No key meets a segment but its own two: nothing folds,
+                // and the fold index is not needed.
+                let n = u32::try_from(slots.len()).unwrap_or(u32::MAX);
+                work.grant(config.work_per_point.saturating_mul(n));
+            } else {
+                let mut fold_index = index.builder((keying.period, orient), Unkeyed::MeetNone);
+                fold_index.push_all_stored(slots.iter().map(|r| {
+                    if r.status == Status::NoIntersection {
+                        r.z_far
+                    } else {
+                        NO_KEY
+                    }
+                }));
+                fold_index.finish(None);
+                fold(index, slots, config.work_per_point, &mut work);
+            }
             let Some(b2) = b2 else {
                 for r in slots
                     .iter_mut()
@@ -459,9 +479,12 @@ fn index_frame2<const N: usize>(
     radius: f32,
 ) {
     let mut builder = index.builder((keying.period, orient), Unkeyed::MeetAll);
-    for p in b2 {
-        let (k, e) = keying.key(p.arr());
-        builder.push(k, e);
+    match keying.pencil {
+        Pencil::Half { foe, side, min_t } => {
+            let ks = keying.key_scale;
+            builder.push_all(b2.iter().map(|p| half_key(p.arr(), (foe, side, min_t), ks)));
+        }
+        _ => builder.push_all(b2.iter().map(|p| keying.key(p.arr()))),
     }
     let foe = pair.foe.filter(|_| pair.geom.w() < 0.0 && keying.angular());
     match foe {
@@ -498,7 +521,16 @@ fn match_boundary<const N: usize>(
         if matcher == Matcher::Indexed && index.tight().is_some() {
             match_wedge_tight(pair, keying, (foe, side), slots, b2, index, &mut credit);
         } else {
-            match_wedge(pair, keying, (foe, side), slots, b2, index, &mut credit, matcher);
+            match_wedge(
+                pair,
+                keying,
+                (foe, side),
+                slots,
+                b2,
+                index,
+                &mut credit,
+                matcher,
+            );
         }
         *work = credit;
         return;
@@ -686,7 +718,14 @@ fn wedge_run(
 
 /// The point's result from a wedge walk's outcome: depth and stick
 /// ([`crate::wedge`]).
-fn conclude_wedge(pair: &Pair, p1: Pixel, iz: f32, r1: f32, wedge: &Wedge, outcome: Outcome) -> PointResult {
+fn conclude_wedge(
+    pair: &Pair,
+    p1: Pixel,
+    iz: f32,
+    r1: f32,
+    wedge: &Wedge,
+    outcome: Outcome,
+) -> PointResult {
     let (lam, lo, hi) = match outcome {
         Outcome::Match { lam, lo, hi } => (lam, lo, hi),
         Outcome::Flag(s) => return PointResult::flagged(p1, s),
@@ -870,4 +909,3 @@ fn segment_distance2(p: [f32; 2], a: [f32; 2], b: [f32; 2]) -> f32 {
     let d = [ap[0] - t * ab[0], ap[1] - t * ab[1]];
     crate::math::dot(d, d)
 }
-

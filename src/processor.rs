@@ -43,7 +43,7 @@ use crate::search::{
     run_start_in, Flow, Index, KeyOrder, OutOfWork, Query, Unkeyed, Visitor, Work,
 };
 use crate::structure::{PointResult, ProcessError, Status, Step, Structure, FOLD_WINDOW};
-use crate::wedge::{Wedge, WedgeWalk, WedgeWalker};
+use crate::wedge::{WVertex, Wedge, WedgeWalk, WedgeWalker};
 
 /// Work units a band test costs on top of the unit of looking at the
 /// segment (it is about three times as long).
@@ -657,7 +657,7 @@ fn raw_interval(keying: &Keying, a: [f32; 2], b: [f32; 2]) -> (f32, f32) {
 /// and [`WedgeWalker`] takes it: each segment looked at costs a unit, each
 /// one whose interval meets the query [`CLIP_UNITS`] more), with the
 /// walk's values in locals. Returns the outcome and where the run started.
-#[inline(always)]
+#[inline(never)]
 fn wedge_run(
     wedge: &Wedge,
     (segs, b2): (&[crate::search::Seg], &[Pixel]),
@@ -673,40 +673,56 @@ fn wedge_run(
     };
     let mut walk = WedgeWalk::NEW;
     let mut c = work.credit();
-    let mut j = a;
+    // The vertex that starts segment `j`, when it is `va`.
     let mut cached = usize::MAX;
-    let mut va = wedge.vertex([0.0; 2]);
+    let mut va = WVertex::NONE;
     let mut stop = None;
-    while let (Some(g), Some(v1)) = (segs.get(j), b2.get(j + 1)) {
-        if g.sm > kh {
+    let run = segs.get(a..).unwrap_or(&[]).iter();
+    let ends = b2.get(a..).unwrap_or(&[]).windows(2);
+    for (j, (g, ends)) in (a..).zip(run.zip(ends)) {
+        let [v0, v1] = ends else {
             break;
+        };
+        // The interval's low end decides first: below `kl` the segment
+        // reaches past the low edge, above `kh` it misses (and past the
+        // suffix minimum the run ends).
+        let cut_lo = g.lo < kl;
+        if !cut_lo && !(g.lo <= kh) {
+            if g.sm > kh {
+                break;
+            }
+            if c == 0 {
+                stop = Some(Status::OverBudget);
+                break;
+            }
+            c -= 1;
+            continue;
         }
         if c == 0 {
             stop = Some(Status::OverBudget);
             break;
         }
         c -= 1;
-        if g.lo <= kh && g.hi >= kl {
-            if c < CLIP_UNITS {
-                c = 0;
-                stop = Some(Status::OverBudget);
-                break;
-            }
-            c -= CLIP_UNITS;
-            if cached != j {
-                if let Some(v) = b2.get(j) {
-                    va = wedge.vertex(v.arr());
-                }
-            }
-            let vb = wedge.vertex(v1.arr());
-            if let Err(s) = walk.take(wedge, j, (&va, &vb), (g.lo, g.hi), segments, cot_twice) {
-                stop = Some(s);
-                break;
-            }
-            va = vb;
-            cached = j + 1;
+        let cut_hi = g.hi > kh;
+        if !cut_hi && !(g.hi >= kl) {
+            continue;
         }
-        j += 1;
+        if c < CLIP_UNITS {
+            c = 0;
+            stop = Some(Status::OverBudget);
+            break;
+        }
+        c -= CLIP_UNITS;
+        if cached != j {
+            va = wedge.vertex(v0.arr());
+        }
+        let vb = wedge.vertex(v1.arr());
+        if let Err(s) = walk.take_met(wedge, j, (&va, &vb), (cut_lo, cut_hi), segments, cot_twice) {
+            stop = Some(s);
+            break;
+        }
+        va = vb;
+        cached = j + 1;
     }
     work.set_credit(c);
     let outcome = match stop {

@@ -163,18 +163,39 @@ impl Wedge {
         })
     }
 
-    /// A vertex in the wedge's frame: its `λ`, the values of the two
-    /// edges' inward normals (inside where both are ≥ 0) and its side of
-    /// the exact line, at `v − F`.
+    /// A vertex in the wedge's frame: `w = v − F`, its `λ` and its side of
+    /// the exact line.
     #[inline(always)]
     pub(crate) fn vertex(&self, v: [f32; 2]) -> WVertex {
         let w = sub(v, self.foe);
         WVertex {
+            w,
             lam: dot(self.u, w) - self.rho,
-            gl: dot(self.nl, w),
-            gh: dot(self.nh, w),
             side: self.d[0] * w[1] - self.d[1] * w[0],
         }
+    }
+
+    /// The part of the segment `a → b` inside the edges' lines where `cut`
+    /// says (low edge, high edge; the side towards `d` is inside), as its
+    /// range `(t0, t1)` along the segment; `None` when it has none.
+    #[inline(always)]
+    fn clip(&self, a: &WVertex, b: &WVertex, cut: (bool, bool)) -> Option<(f32, f32)> {
+        let (mut t0, mut t1) = (0.0f32, 1.0f32);
+        for (cut, n) in [(cut.0, self.nl), (cut.1, self.nh)] {
+            if cut {
+                let (ca, cb) = (dot(n, a.w), dot(n, b.w));
+                if ca < 0.0 {
+                    if cb < 0.0 {
+                        return None;
+                    }
+                    t0 = fmax(t0, ca / (ca - cb));
+                } else if cb < 0.0 {
+                    t1 = fmin(t1, ca / (ca - cb));
+                }
+            }
+        }
+        // (A NaN fails.)
+        (t0 <= t1).then_some((t0, t1))
     }
 
     /// The point of the exact line at `λ` (for a crossing: the frame-2
@@ -209,18 +230,16 @@ impl Wedge {
 /// A frame-2 vertex in a wedge's frame ([`Wedge::vertex`]).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct WVertex {
+    w: [f32; 2],
     lam: f32,
-    gl: f32,
-    gh: f32,
     side: f32,
 }
 
 impl WVertex {
     /// A placeholder, never read before it is overwritten.
     pub(crate) const NONE: WVertex = WVertex {
+        w: [0.0; 2],
         lam: 0.0,
-        gl: 0.0,
-        gh: 0.0,
         side: 0.0,
     };
 }
@@ -265,36 +284,46 @@ impl WedgeWalk {
         if klo > wedge.kh || khi < wedge.kl {
             return Ok(());
         }
-        let (mut t0, mut t1) = (0.0f32, 1.0f32);
-        if klo < wedge.kl || khi > wedge.kh {
-            // The segment's rays reach past an edge: clip it by that edge's
-            // line (the side towards d is inside).
-            for (cut, ca, cb) in [(klo < wedge.kl, a.gl, b.gl), (khi > wedge.kh, a.gh, b.gh)] {
-                if cut {
-                    if ca < 0.0 {
-                        if cb < 0.0 {
-                            return Ok(());
-                        }
-                        t0 = fmax(t0, ca / (ca - cb));
-                    } else if cb < 0.0 {
-                        t1 = fmin(t1, ca / (ca - cb));
-                    }
-                }
-            }
-            // (A NaN fails.)
-            if !(t0 <= t1) {
-                return Ok(());
-            }
-        }
+        let cut = (klo < wedge.kl, khi > wedge.kh);
+        self.take_met(wedge, j, (a, b), cut, segments, cot_twice)
+    }
+
+    /// [`Self::take`] for a segment whose interval meets the wedge's;
+    /// `cut`: whether it reaches past the low edge's key, and past the
+    /// high edge's.
+    #[inline(always)]
+    pub(crate) fn take_met(
+        &mut self,
+        wedge: &Wedge,
+        j: usize,
+        (a, b): (&WVertex, &WVertex),
+        cut: (bool, bool),
+        segments: usize,
+        cot_twice: f32,
+    ) -> Result<(), Status> {
         let dl = b.lam - a.lam;
-        let l0 = if t0 == 0.0 { a.lam } else { a.lam + t0 * dl };
-        let l1 = if t1 == 1.0 { b.lam } else { a.lam + t1 * dl };
-        let (lo, hi) = if l0 <= l1 { (l0, l1) } else { (l1, l0) };
-        // (A NaN fails.)
-        if !(hi >= wedge.lam_lo) {
-            return Ok(());
+        // The part's ends, and whether each is the segment's own end.
+        let (mut l0, mut l1, mut whole0, mut whole1) = (a.lam, b.lam, true, true);
+        if cut.0 || cut.1 {
+            let Some((t0, t1)) = wedge.clip(a, b, cut) else {
+                return Ok(());
+            };
+            if t0 != 0.0 {
+                (l0, whole0) = (a.lam + t0 * dl, false);
+            }
+            if t1 != 1.0 {
+                (l1, whole1) = (a.lam + t1 * dl, false);
+            }
         }
-        let lo = fmax(lo, wedge.lam_lo);
+        let (lo, hi) = if l0 <= l1 { (l0, l1) } else { (l1, l0) };
+        // At λ ≥ −(r₁ + e₂) only. (A NaN fails.)
+        let lo = if lo > wedge.lam_lo {
+            lo
+        } else if hi >= wedge.lam_lo {
+            wedge.lam_lo
+        } else {
+            return Ok(());
+        };
         if self.next == j {
             self.lo = fmin(self.lo, lo);
             self.hi = fmax(self.hi, hi);
@@ -304,10 +333,14 @@ impl WedgeWalk {
             }
             self.lo = lo;
             self.hi = hi;
-            // The first vertex is in the wedge when no edge cut it off.
-            self.open |= j == 0 && t0 == 0.0 && a.lam >= wedge.lam_lo;
+            if j == 0 {
+                // The first vertex is in the wedge when no edge cut it off.
+                self.open |= end_inside(whole0, a.lam, wedge.lam_lo);
+            }
         }
-        self.open |= j + 1 == segments && t1 == 1.0 && b.lam >= wedge.lam_lo;
+        if j + 1 == segments {
+            self.open |= end_inside(whole1, b.lam, wedge.lam_lo);
+        }
         self.next = j + 1;
         if self.hi - self.lo > wedge.t * (wedge.rho + self.lo) * cot_twice {
             return Err(Status::Grazing);
@@ -338,6 +371,15 @@ impl WedgeWalk {
             hi: self.hi,
         }
     }
+}
+
+/// Whether an end vertex of the polyline lies in the wedge: no edge cut
+/// it off (`whole`) and its `λ` is at least `lam_lo`. (Out of line: the
+/// walk's usual segment is no end.)
+#[cold]
+#[inline(never)]
+fn end_inside(whole: bool, lam: f32, lam_lo: f32) -> bool {
+    whole && lam >= lam_lo
 }
 
 /// A wedge walk as an index [`Visitor`] (the loose index, and the

@@ -214,19 +214,35 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             // Step 1, with each point's key margin where the fold index
             // wants it, and whether the keys are strictly ordered.
             let mut order = KeyOrder::NEW;
-            for ((slot, &p1), m) in slots.iter_mut().zip(b1).zip(index.margins_mut().iter_mut()) {
-                let (k, e) = match compensate_point(&pair, &keying, p1, &mut r1_max) {
-                    Ok((r, key)) => {
-                        *slot = r;
-                        key
+            let margins = index.margins_mut();
+            match (pair.certified_r1, keying.pencil) {
+                (Some(r1), Pencil::Half { foe, side, min_t }) => {
+                    let ks = keying.key_scale;
+                    let key = |p| half_key(p, (foe, side, min_t), ks);
+                    compensate_certified(&pair, r1, (slots, b1, margins), &mut order, key);
+                    r1_max = if slots.is_empty() { 0.0 } else { r1 };
+                }
+                (Some(r1), _) => {
+                    let key = |p| keying.key(p);
+                    compensate_certified(&pair, r1, (slots, b1, margins), &mut order, key);
+                    r1_max = if slots.is_empty() { 0.0 } else { r1 };
+                }
+                (None, _) => {
+                    for ((slot, &p1), m) in slots.iter_mut().zip(b1).zip(margins.iter_mut()) {
+                        let (k, e) = match compensate_point(&pair, &keying, p1, &mut r1_max) {
+                            Ok((r, key)) => {
+                                *slot = r;
+                                key
+                            }
+                            Err(status) => {
+                                *slot = PointResult::flagged(p1, status);
+                                (NO_KEY, 0.0)
+                            }
+                        };
+                        *m = e;
+                        order.push(k, e);
                     }
-                    Err(status) => {
-                        *slot = PointResult::flagged(p1, status);
-                        (NO_KEY, 0.0)
-                    }
-                };
-                *m = e;
-                order.push(k, e);
+                }
             }
             if order.strict(keying.period) {
                 // No key meets a segment but its own two: nothing folds,
@@ -291,6 +307,9 @@ struct Pair<'c> {
     /// `r₁` for every point when the stretch bound is frame-wide and no
     /// rotation error is configured.
     frame_r1: Option<f32>,
+    /// `frame_r1` when, moreover, every pixel of the frame-1 image passes
+    /// step 1's checks ([`PairGeometry::certifies_image`]).
+    certified_r1: Option<f32>,
     /// `Δ`, the bound on `q_z`'s change ([`PairGeometry::depth_scale_error`]).
     depth_scale_error: f32,
     /// The translation-error bound per component (with the turn of the
@@ -325,17 +344,20 @@ impl<'c> Pair<'c> {
         };
         let scale = geom.coordinate_scale();
         let slack = scale * 9.54e-7;
+        let frame_r1 = match geom.frame_stretch() {
+            Some(st) if !rotation => Some(config.e1 * st + slack),
+            _ => None,
+        };
+        let depth_scale_error = geom.depth_scale_error(config.e1, config.rotation_error);
         Self {
             config,
             foe: geom.focus_of_expansion().map(Pixel::arr),
             reach: crate::math::sqrt(cam2.reach2()),
             scale,
             slack,
-            frame_r1: match geom.frame_stretch() {
-                Some(st) if !rotation => Some(config.e1 * st + slack),
-                _ => None,
-            },
-            depth_scale_error: geom.depth_scale_error(config.e1, config.rotation_error),
+            frame_r1,
+            certified_r1: frame_r1.filter(|_| geom.certifies_image(cam1, depth_scale_error)),
+            depth_scale_error,
             translation,
             spread_w,
             geom,
@@ -431,6 +453,35 @@ fn compensate_point(
             },
             key,
         ))
+    }
+}
+
+/// Step 1 for every point of `b1` when the pair certifies the whole image
+/// ([`Pair::certified_r1`]): [`compensate_point`] without its checks (they
+/// pass), `r₁` the frame's, the keys from `key`; each point's key margin in
+/// `margins`, the key order in `order`.
+#[inline(always)]
+fn compensate_certified(
+    pair: &Pair,
+    r1: f32,
+    (slots, b1, margins): (&mut [PointResult], &[Pixel], &mut [f32]),
+    order: &mut KeyOrder,
+    key: impl Fn([f32; 2]) -> (f32, f32),
+) {
+    let stretch = pair.geom.frame_stretch().unwrap_or(0.0);
+    for ((slot, &p1), m) in slots.iter_mut().zip(b1).zip(margins.iter_mut()) {
+        let c = pair.geom.compensate_certified(p1, stretch);
+        let (k, e) = key(c.pixel);
+        *slot = PointResult {
+            pixel1: p1,
+            pixel2: Pixel::new(c.pixel[0], c.pixel[1]),
+            z: c.inv_depth_scale,
+            z_near: r1,
+            z_far: k,
+            status: Status::NoIntersection,
+        };
+        *m = e;
+        order.push(k, e);
     }
 }
 
@@ -544,8 +595,7 @@ fn match_boundary<const N: usize>(
 }
 
 /// The wedge path through a tight index: every point's run walked in
-/// locals ([`wedge_run`]). (Out of line: a small loop keeps its values in
-/// registers.)
+/// locals ([`TightWalk::point`]).
 #[inline(never)]
 fn match_wedge_tight<const N: usize>(
     pair: &Pair,
@@ -556,27 +606,71 @@ fn match_wedge_tight<const N: usize>(
     index: &mut Index<N>,
     work: &mut Work,
 ) {
-    let orient = index.orient();
     let mut hint = index.hint();
-    let (e2, cot_twice, key_scale) = (pair.e2(), pair.config.cot_twice, keying.key_scale);
-    let segments = b2.len().saturating_sub(1);
-    let Some((segs, _)) = index.tight() else {
+    let Some((segs, orient)) = index.tight() else {
         return;
     };
+    let walk = TightWalk {
+        pair,
+        segs,
+        b2,
+        foe,
+        side,
+        e2: pair.e2(),
+        key_scale: keying.key_scale,
+        orient,
+        cot_twice: pair.config.cot_twice,
+        segments: b2.len().saturating_sub(1),
+    };
     for r in slots.iter_mut() {
-        if r.status != Status::NoIntersection {
-            continue;
+        if r.status == Status::NoIntersection {
+            (*r, hint) = walk.point(r, hint, work);
         }
-        let (p1, p, iz, r1) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near);
-        let Ok(wedge) = Wedge::new(p, (foe, side), (r1, e2), key_scale, orient) else {
-            *r = PointResult::flagged(p1, Status::AtFoe);
-            continue;
-        };
-        let (outcome, a) = wedge_run(&wedge, (segs, b2), hint, segments, cot_twice, work);
-        hint = a;
-        *r = conclude_wedge(pair, p1, iz, r1, &wedge, outcome);
     }
     index.set_hint(hint);
+}
+
+/// What every point of a boundary shares on the tight wedge path.
+struct TightWalk<'a> {
+    pair: &'a Pair<'a>,
+    segs: &'a [crate::search::Seg],
+    b2: &'a [Pixel],
+    foe: [f32; 2],
+    side: f32,
+    e2: f32,
+    key_scale: f32,
+    orient: f32,
+    cot_twice: f32,
+    segments: usize,
+}
+
+impl TightWalk<'_> {
+    /// Step 4 for the point left by steps 1–2 in `r`: its wedge, the walk
+    /// over its run (from the last run's start `hint`), the result; and
+    /// where the run started. (Out of line: the walk's values stay in
+    /// registers.)
+    #[inline(never)]
+    fn point(&self, r: &PointResult, hint: usize, work: &mut Work) -> (PointResult, usize) {
+        let (p1, p, iz, r1) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near);
+        let Ok(wedge) = Wedge::new(
+            p,
+            (self.foe, self.side),
+            (r1, self.e2),
+            self.key_scale,
+            self.orient,
+        ) else {
+            return (PointResult::flagged(p1, Status::AtFoe), hint);
+        };
+        let (outcome, a) = wedge_run(
+            &wedge,
+            (self.segs, self.b2),
+            hint,
+            self.segments,
+            self.cot_twice,
+            work,
+        );
+        (conclude_wedge(self.pair, p1, iz, r1, &wedge, outcome), a)
+    }
 }
 
 /// The wedge path through a loose index (the general visit) or the
@@ -657,7 +751,7 @@ fn raw_interval(keying: &Keying, a: [f32; 2], b: [f32; 2]) -> (f32, f32) {
 /// and [`WedgeWalker`] takes it: each segment looked at costs a unit, each
 /// one whose interval meets the query [`CLIP_UNITS`] more), with the
 /// walk's values in locals. Returns the outcome and where the run started.
-#[inline(never)]
+#[inline(always)]
 fn wedge_run(
     wedge: &Wedge,
     (segs, b2): (&[crate::search::Seg], &[Pixel]),

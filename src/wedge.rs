@@ -120,34 +120,34 @@ impl Wedge {
         }
         let inv = 1.0 / rho;
         let t = re / (rho - re) * (1.0 + 1.53e-5);
-        let perp = [-d[1], d[0]];
-        let em = [d[0] - t * perp[0], d[1] - t * perp[1]];
-        let ep = [d[0] + t * perp[0], d[1] + t * perp[1]];
-        // Keys of the edge directions; an edge outside the half-plane
-        // stands for the key limit where the wedge crosses the FOE's row,
-        // on the side of d (the wedge is narrower than 53°).
-        let limit = orient * if d[0] >= 0.0 { 1.0 } else { -1.0 };
-        let key = |e: [f32; 2]| {
-            let te = side * e[1];
-            if te > 0.0 {
-                let i = 1.0 / (e[0].abs() + te);
-                (orient * (e[0] * i), key_scale * i + ULP20, true)
+        // The edge directions d ∓ s T d⊥ (d⊥ = (−d_v, d_u)), named so that
+        // the first has the lower key: turning d by +90° moves its key by
+        // −side, then the orientation (s = ±1, so the products are those
+        // of d ± T d⊥ exactly).
+        let s = if side * orient > 0.0 { -1.0 } else { 1.0 };
+        let st = s * t;
+        let el = [d[0] + st * d[1], d[1] - st * d[0]];
+        let eh = [d[0] - st * d[1], d[1] + st * d[0]];
+        let (tl, th) = (side * el[1], side * eh[1]);
+        let (kl, kh, nl, nh) = if tl > 0.0 && th > 0.0 {
+            // Both edges in the half-plane (the usual wedge).
+            let (il, ih) = (1.0 / (el[0].abs() + tl), 1.0 / (eh[0].abs() + th));
+            let (k0, k1) = (orient * (el[0] * il), orient * (eh[0] * ih));
+            if k0 < k1 {
+                // Inward normals: s perp(e_l) and −s perp(e_h) point
+                // towards d.
+                (
+                    k0 - (key_scale * il + ULP20),
+                    k1 + (key_scale * ih + ULP20),
+                    [-s * el[1], s * el[0]],
+                    [s * eh[1], -s * eh[0]],
+                )
             } else {
-                (limit, 0.0, false)
+                edge_keys(d, (el, eh, s), side, key_scale, orient)
             }
-        };
-        let ((km, mm, im), (kp, mp, ip)) = (key(em), key(ep));
-        // Inward normals: perp(e₋) and −perp(e₊) point towards d.
-        let (nm, np) = ([-em[1], em[0]], [ep[1], -ep[0]]);
-        let (mut kl, nl, mut kh, nh) = if km <= kp {
-            (km - mm, nm, kp + mp, np)
         } else {
-            (kp - mp, np, km + mm, nm)
+            edge_keys(d, (el, eh, s), side, key_scale, orient)
         };
-        if !(side * d[1] > 0.0 || im || ip) {
-            // The whole wedge lies beyond the FOE's row: no keyed point.
-            (kl, kh) = (f32::INFINITY, f32::NEG_INFINITY);
-        }
         Ok(Self {
             foe,
             p,
@@ -225,6 +225,49 @@ impl Wedge {
         let s_near = w + w * ((self.rho - r1) / (hi - self.lam_lo));
         Some((s, s_near, s_far))
     }
+}
+
+/// The wedge's key interval and the inward normals of the edges whose
+/// keys bound it, in general: the keys of the edge directions `el`, `eh`
+/// (named as in [`Wedge::new`]), each widened by its margin; an edge
+/// outside the half-plane stands for the key limit where the wedge crosses
+/// the FOE's row, on the side of `d` (the wedge is narrower than 53°); the
+/// lower key is the low end (the first edge's on a tie), and the interval
+/// is empty when the whole wedge lies beyond the row.
+#[cold]
+#[inline(never)]
+fn edge_keys(
+    d: [f32; 2],
+    (el, eh, s): ([f32; 2], [f32; 2], f32),
+    side: f32,
+    key_scale: f32,
+    orient: f32,
+) -> (f32, f32, [f32; 2], [f32; 2]) {
+    let limit = orient * if d[0] >= 0.0 { 1.0 } else { -1.0 };
+    let key = |e: [f32; 2]| {
+        let te = side * e[1];
+        if te > 0.0 {
+            let i = 1.0 / (e[0].abs() + te);
+            (orient * (e[0] * i), key_scale * i + ULP20, true)
+        } else {
+            (limit, 0.0, false)
+        }
+    };
+    let ((k0, m0, in0), (k1, m1, in1)) = (key(el), key(eh));
+    // Inward normals: s perp(e_l) and −s perp(e_h) point towards d.
+    let (n0, n1) = ([-s * el[1], s * el[0]], [s * eh[1], -s * eh[0]]);
+    // The first edge's is the lower key on a tie when it is d − T d⊥'s.
+    let first_low = if s > 0.0 { k0 <= k1 } else { k0 < k1 };
+    let (kl, nl, kh, nh) = if first_low {
+        (k0 - m0, n0, k1 + m1, n1)
+    } else {
+        (k1 - m1, n1, k0 + m0, n0)
+    };
+    if !(side * d[1] > 0.0 || in0 || in1) {
+        // The whole wedge lies beyond the FOE's row: no keyed point.
+        return (f32::INFINITY, f32::NEG_INFINITY, nl, nh);
+    }
+    (kl, kh, nl, nh)
 }
 
 /// A frame-2 vertex in a wedge's frame ([`Wedge::vertex`]).

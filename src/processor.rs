@@ -771,10 +771,8 @@ fn wedge_run(
     let mut cached = usize::MAX;
     let mut va = WVertex::NONE;
     let mut stop = None;
-    let run = segs.get(a..).unwrap_or(&[]).iter();
-    let ends = b2.get(a..).unwrap_or(&[]).windows(2);
-    for (j, (g, ends)) in (a..).zip(run.zip(ends)) {
-        let [v0, v1] = ends else {
+    for j in a..segs.len().min(b2.len().saturating_sub(1)) {
+        let (Some(g), Some(v1)) = (segs.get(j), b2.get(j + 1)) else {
             break;
         };
         // The interval's low end decides first: below `kl` the segment
@@ -808,7 +806,9 @@ fn wedge_run(
         }
         c -= CLIP_UNITS;
         if cached != j {
-            va = wedge.vertex(v0.arr());
+            if let Some(v0) = b2.get(j) {
+                va = wedge.vertex(v0.arr());
+            }
         }
         let vb = wedge.vertex(v1.arr());
         if let Err(s) = walk.take_met(wedge, j, (&va, &vb), (cut_lo, cut_hi), segments, cot_twice) {

@@ -175,6 +175,59 @@ impl Wedge {
         }
     }
 
+    /// The part of segment `a → b` in the wedge, as [`WedgeWalk::take`]
+    /// takes a segment whose key interval meets the wedge's (`cut`: it
+    /// reaches past the low edge's key, the high edge's): clipped by those
+    /// edges, its `λ` range cut at `λ ≥ −(r₁ + e₂)`; `None` when nothing is
+    /// left.
+    #[inline(always)]
+    pub(crate) fn part(&self, a: &WVertex, b: &WVertex, cut: (bool, bool)) -> Option<Part> {
+        let dl = b.lam - a.lam;
+        // The part's ends, and whether each is the segment's own end.
+        let (mut l0, mut l1, mut whole) = (a.lam, b.lam, (true, true));
+        if cut.0 || cut.1 {
+            let (t0, t1) = self.clip(a, b, cut)?;
+            if t0 != 0.0 {
+                (l0, whole.0) = (a.lam + t0 * dl, false);
+            }
+            if t1 != 1.0 {
+                (l1, whole.1) = (a.lam + t1 * dl, false);
+            }
+        }
+        let (lo, hi) = if l0 <= l1 { (l0, l1) } else { (l1, l0) };
+        // At λ ≥ −(r₁ + e₂) only. (A NaN fails.)
+        let lo = if lo > self.lam_lo {
+            lo
+        } else if hi >= self.lam_lo {
+            self.lam_lo
+        } else {
+            return None;
+        };
+        Some(Part { lo, hi, whole })
+    }
+
+    /// Whether a piece with the `λ` range `[lo, hi]` is grazing (module
+    /// docs); it stays so as the piece grows.
+    #[inline(always)]
+    pub(crate) fn grazing(&self, lo: f32, hi: f32, cot_twice: f32) -> bool {
+        hi - lo > self.t * (self.rho + lo) * cot_twice
+    }
+
+    /// `best` lowered to the exact line's crossing of segment `a → b`, if
+    /// it has one (its ends on the line's two sides) nearer than `best`
+    /// and beyond `λ = −(r₁ + e₂)`.
+    #[inline(always)]
+    pub(crate) fn crossing(&self, a: &WVertex, b: &WVertex, best: f32) -> f32 {
+        let (sa, sb) = (a.side, b.side);
+        if crate::depth::side_bit(sa) != crate::depth::side_bit(sb) {
+            let lam = a.lam + sa / (sa - sb) * (b.lam - a.lam);
+            if lam < best && lam > self.lam_lo {
+                return lam;
+            }
+        }
+        best
+    }
+
     /// The part of the segment `a → b` inside the edges' lines where `cut`
     /// says (low edge, high edge; the side towards `d` is inside), as its
     /// range `(t0, t1)` along the segment; `None` when it has none.
@@ -287,6 +340,15 @@ impl WVertex {
     };
 }
 
+/// A segment's part in a wedge ([`Wedge::part`]): its `λ` range, and
+/// whether each end is the segment's own (no edge cut it off).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Part {
+    pub(crate) lo: f32,
+    pub(crate) hi: f32,
+    whole: (bool, bool),
+}
+
 /// The walk over a polyline's segments through one wedge (the rules of
 /// [`crate::matching`]).
 #[derive(Debug, Clone, Copy)]
@@ -344,29 +406,10 @@ impl WedgeWalk {
         segments: usize,
         cot_twice: f32,
     ) -> Result<(), Status> {
-        let dl = b.lam - a.lam;
-        // The part's ends, and whether each is the segment's own end.
-        let (mut l0, mut l1, mut whole0, mut whole1) = (a.lam, b.lam, true, true);
-        if cut.0 || cut.1 {
-            let Some((t0, t1)) = wedge.clip(a, b, cut) else {
-                return Ok(());
-            };
-            if t0 != 0.0 {
-                (l0, whole0) = (a.lam + t0 * dl, false);
-            }
-            if t1 != 1.0 {
-                (l1, whole1) = (a.lam + t1 * dl, false);
-            }
-        }
-        let (lo, hi) = if l0 <= l1 { (l0, l1) } else { (l1, l0) };
-        // At λ ≥ −(r₁ + e₂) only. (A NaN fails.)
-        let lo = if lo > wedge.lam_lo {
-            lo
-        } else if hi >= wedge.lam_lo {
-            wedge.lam_lo
-        } else {
+        let Some(part) = wedge.part(a, b, cut) else {
             return Ok(());
         };
+        let (lo, hi) = (part.lo, part.hi);
         if self.next == j {
             self.lo = fmin(self.lo, lo);
             self.hi = fmax(self.hi, hi);
@@ -378,24 +421,17 @@ impl WedgeWalk {
             self.hi = hi;
             if j == 0 {
                 // The first vertex is in the wedge when no edge cut it off.
-                self.open |= end_inside(whole0, a.lam, wedge.lam_lo);
+                self.open |= end_inside(part.whole.0, a.lam, wedge.lam_lo);
             }
         }
         if j + 1 == segments {
-            self.open |= end_inside(whole1, b.lam, wedge.lam_lo);
+            self.open |= end_inside(part.whole.1, b.lam, wedge.lam_lo);
         }
         self.next = j + 1;
-        if self.hi - self.lo > wedge.t * (wedge.rho + self.lo) * cot_twice {
+        if wedge.grazing(self.lo, self.hi, cot_twice) {
             return Err(Status::Grazing);
         }
-        // The exact line's crossing: the ends on its two sides.
-        let (sa, sb) = (a.side, b.side);
-        if crate::depth::side_bit(sa) != crate::depth::side_bit(sb) {
-            let lam = a.lam + sa / (sa - sb) * dl;
-            if lam < self.best && lam > wedge.lam_lo {
-                self.best = lam;
-            }
-        }
+        self.best = wedge.crossing(a, b, self.best);
         Ok(())
     }
 

@@ -624,7 +624,7 @@ fn match_wedge_tight<const N: usize>(
     };
     for r in slots.iter_mut() {
         if r.status == Status::NoIntersection {
-            (*r, hint) = walk.point(r, hint, work);
+            hint = walk.point(r, hint, work);
         }
     }
     index.set_hint(hint);
@@ -646,11 +646,11 @@ struct TightWalk<'a> {
 
 impl TightWalk<'_> {
     /// Step 4 for the point left by steps 1–2 in `r`: its wedge, the walk
-    /// over its run (from the last run's start `hint`), the result; and
-    /// where the run started. (Out of line: the walk's values stay in
-    /// registers.)
+    /// over its run (from the last run's start `hint`), the result in `r`;
+    /// returns where the run started. (Out of line: the walk's values stay
+    /// in registers.)
     #[inline(never)]
-    fn point(&self, r: &PointResult, hint: usize, work: &mut Work) -> (PointResult, usize) {
+    fn point(&self, r: &mut PointResult, hint: usize, work: &mut Work) -> usize {
         let (p1, p, iz, r1) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near);
         let Ok(wedge) = Wedge::new(
             p,
@@ -659,7 +659,8 @@ impl TightWalk<'_> {
             self.key_scale,
             self.orient,
         ) else {
-            return (PointResult::flagged(p1, Status::AtFoe), hint);
+            *r = PointResult::flagged(p1, Status::AtFoe);
+            return hint;
         };
         let (outcome, a) = wedge_run(
             &wedge,
@@ -669,7 +670,8 @@ impl TightWalk<'_> {
             self.cot_twice,
             work,
         );
-        (conclude_wedge(self.pair, p1, iz, r1, &wedge, outcome), a)
+        *r = conclude_wedge(self.pair, p1, iz, r1, &wedge, outcome);
+        a
     }
 }
 

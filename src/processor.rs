@@ -6,10 +6,12 @@
 //! 1. **Compensate** every frame-1 point ([`crate::epipolar`]): `p₁'`, `1/q_z`,
 //!    its error radius `r₁`, and the key of its epipolar line
 //!    ([`crate::pencil`]); points behind the frame-2 camera or far out of
-//!    its view are flagged.
+//!    its view are flagged (checks a frame skips when its whole image
+//!    passes them, `PairGeometry::certifies_image`).
 //! 2. **Fold test**: index the compensated frame-1 polyline by key and flag
 //!    the points whose own epipolar line meets it again away from them
-//!    ([`Status::Folded`]).
+//!    ([`Status::Folded`]); when the keys are strictly ordered along the
+//!    polyline nothing folds, and no index is built.
 //! 3. **Index** the corresponding frame-2 polyline ([`crate::search`]).
 //! 4. **Match** every remaining point: its error band ([`crate::depth`]),
 //!    the segments the index offers for the band's key interval, the walk
@@ -219,12 +221,12 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 (Some(r1), Pencil::Half { foe, side, min_t }) => {
                     let ks = keying.key_scale;
                     let key = |p| half_key(p, (foe, side, min_t), ks);
-                    compensate_certified(&pair, r1, (slots, b1, margins), &mut order, key);
+                    compensate_all_certified(&pair, r1, (slots, b1, margins), &mut order, key);
                     r1_max = if slots.is_empty() { 0.0 } else { r1 };
                 }
                 (Some(r1), _) => {
                     let key = |p| keying.key(p);
-                    compensate_certified(&pair, r1, (slots, b1, margins), &mut order, key);
+                    compensate_all_certified(&pair, r1, (slots, b1, margins), &mut order, key);
                     r1_max = if slots.is_empty() { 0.0 } else { r1 };
                 }
                 (None, _) => {
@@ -461,7 +463,7 @@ fn compensate_point(
 /// pass), `r₁` the frame's, the keys from `key`; each point's key margin in
 /// `margins`, the key order in `order`.
 #[inline(always)]
-fn compensate_certified(
+fn compensate_all_certified(
     pair: &Pair,
     r1: f32,
     (slots, b1, margins): (&mut [PointResult], &[Pixel], &mut [f32]),
@@ -779,9 +781,11 @@ fn wedge_run(
         };
         // The interval's low end decides first: below `kl` the segment
         // reaches past the low edge, above `kh` it misses (and past the
-        // suffix minimum the run ends).
+        // suffix minimum, at most the low end, the run ends).
         let cut_lo = g.lo < kl;
-        if !cut_lo && !(g.lo <= kh) {
+        // (A NaN fails.)
+        let lo_meets = cut_lo || g.lo <= kh;
+        if !lo_meets {
             if g.sm > kh {
                 break;
             }
@@ -798,7 +802,8 @@ fn wedge_run(
         }
         c -= 1;
         let cut_hi = g.hi > kh;
-        if !cut_hi && !(g.hi >= kl) {
+        let hi_meets = cut_hi || g.hi >= kl;
+        if !hi_meets {
             continue;
         }
         if c < CLIP_UNITS {

@@ -200,7 +200,8 @@ pub(crate) struct Index<const N: usize> {
     hint: usize,
     /// Every vertex is keyed and its widened key lies wholly above the one
     /// before, or wholly below (no period): no vertex's key meets a
-    /// segment but its own two.
+    /// segment but its own two. (`false` too where the build did not test
+    /// the order: [`Builder::push_all`]'s lean loop.)
     strict: bool,
 }
 
@@ -452,7 +453,7 @@ impl<const N: usize> Index<N> {
     }
 
     /// Whether no vertex's key meets a segment other than its own two (so
-    /// no vertex of this polyline folds).
+    /// no vertex of this polyline folds); `false` says nothing.
     pub(crate) fn strict(&self) -> bool {
         self.strict
     }

@@ -241,7 +241,13 @@ impl Band {
     /// `1/(ρ₁ − r₁ − e₂) = W'/(|a| − W'(r₁ + e₂))` and `h = W' r₁ / A₋ ≤ r₁
     /// W'/(|a| − W'(r₁ + e₂))`, one division; no far limit.
     #[inline(always)]
-    pub(crate) fn forward(p: [f32; 2], a: [f32; 2], w: f32, r1: f32, e2: f32) -> Result<Self, NoBand> {
+    pub(crate) fn forward(
+        p: [f32; 2],
+        a: [f32; 2],
+        w: f32,
+        r1: f32,
+        e2: f32,
+    ) -> Result<Self, NoBand> {
         let a2 = dot(a, a);
         // `a2 > 1e-30` keeps the square root's input in its range (and
         // refuses NaN).

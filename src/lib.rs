@@ -32,6 +32,9 @@
     test,
     allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)
 )]
+// Tests that a NaN must fail are written `!(a > b)`, each with a "(A NaN
+// fails.)" comment: `partial_cmp` would hide that intent.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 #[cfg(feature = "_debug")]
 extern crate std;

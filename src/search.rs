@@ -594,8 +594,7 @@ impl<const N: usize> Index<N> {
         // slice `run`).
         let mut credit = work.credit;
         let mut result = Ok(());
-        let mut j = a;
-        for g in run {
+        for (j, g) in (a..).zip(run) {
             if g.sm > qh {
                 break;
             }
@@ -615,7 +614,6 @@ impl<const N: usize> Index<N> {
                     break;
                 }
             }
-            j += 1;
         }
         work.credit = credit;
         result
@@ -718,15 +716,15 @@ impl<const N: usize> Index<N> {
             // A loose index: skip the blocks of the run no copy meets (the
             // aside and near entries in them keep their own streams, which
             // the merge below still takes in index order).
-            if self.levels > 0 && !everything {
-                if self.seg.get(j).is_some_and(|g| j < s && g.sm <= top) {
-                    let k =
-                        self.skip_at(j, |l, h| copies.iter().any(|&(cl, ch)| l <= ch && h >= cl));
-                    if k > 0 {
-                        j += k;
-                        work.spend(1)?;
-                        continue;
-                    }
+            if self.levels > 0
+                && !everything
+                && self.seg.get(j).is_some_and(|g| j < s && g.sm <= top)
+            {
+                let k = self.skip_at(j, |l, h| copies.iter().any(|&(cl, ch)| l <= ch && h >= cl));
+                if k > 0 {
+                    j += k;
+                    work.spend(1)?;
+                    continue;
                 }
             }
             let next_aside = self

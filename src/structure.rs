@@ -74,10 +74,7 @@ impl Status {
     pub fn has_match(self) -> bool {
         matches!(
             self,
-            Status::Ok
-                | Status::NonPositiveDepth
-                | Status::BeyondMaxDepth
-                | Status::Unbounded
+            Status::Ok | Status::NonPositiveDepth | Status::BeyondMaxDepth | Status::Unbounded
         )
     }
     /// Whether the point is flagged (anything but [`Status::Ok`]).

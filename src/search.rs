@@ -218,7 +218,8 @@ pub(crate) struct Index<const N: usize> {
     hint: usize,
     /// Every vertex is keyed and its widened key lies wholly above the one
     /// before, or wholly below (no period): no vertex's key meets a
-    /// segment but its own two.
+    /// segment but its own two. (`false` too where the build did not test
+    /// the order: [`Builder::push_all`]'s lean loop.)
     strict: bool,
 }
 
@@ -272,17 +273,13 @@ impl<const N: usize> Index<N> {
             period,
             unkeyed,
             n: 0,
-            prev: NO_KEY,
-            prev_e: 0.0,
+            order: KeyOrder::NEW,
             keyed: NO_KEY,
             offset: 0.0,
             first: NO_KEY,
             last: NO_KEY,
             run: f32::NEG_INFINITY,
             sum: 0.0,
-            odd: false,
-            up: true,
-            down: true,
             index: self,
         }
     }
@@ -495,7 +492,7 @@ impl<const N: usize> Index<N> {
     }
 
     /// Whether no vertex's key meets a segment other than its own two (so
-    /// no vertex of this polyline folds).
+    /// no vertex of this polyline folds); `false` says nothing.
     pub(crate) fn strict(&self) -> bool {
         self.strict
     }
@@ -559,6 +556,12 @@ impl<const N: usize> Index<N> {
     /// times it).
     pub(crate) fn orient(&self) -> f32 {
         self.orient
+    }
+
+    /// The vertices' key margins, for a caller that writes them before
+    /// the build ([`Builder::push_all_stored`]).
+    pub(crate) fn margins_mut(&mut self) -> &mut [f32; N] {
+        &mut self.margin
     }
 
     /// The key margin of vertex `i` (0 when out of range).
@@ -984,6 +987,64 @@ impl Visitor for Met {
     }
 }
 
+/// Whether the widened keys of a polyline's vertices, in order, each lie
+/// wholly above the one before (`up`) or wholly below (`down`), and
+/// whether one of them is unkeyed (`odd`): fed one vertex at a time.
+/// Strictly ordered keys ([`KeyOrder::strict`]) meet no segment but their
+/// own two, so nothing folds and the envelopes are the intervals
+/// themselves.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct KeyOrder {
+    /// The previous vertex's key and its widened ends.
+    prev: f32,
+    plo: f32,
+    phi: f32,
+    first: bool,
+    up: bool,
+    down: bool,
+    odd: bool,
+}
+
+impl KeyOrder {
+    pub(crate) const NEW: KeyOrder = KeyOrder {
+        prev: NO_KEY,
+        plo: 0.0,
+        phi: 0.0,
+        first: true,
+        up: true,
+        down: true,
+        odd: false,
+    };
+
+    /// The next vertex's key ([`NO_KEY`] where none) and margin; whether
+    /// it and the one before are both keyed, with their widened ends
+    /// `((previous lo, previous hi), (lo, hi))`.
+    #[inline(always)]
+    pub(crate) fn push(&mut self, k: f32, e: f32) -> Option<((f32, f32), (f32, f32))> {
+        let (vlo, vhi) = (k - e, k + e);
+        let (plo, phi) = (self.plo, self.phi);
+        let both = (k + self.prev).is_finite();
+        let first = self.first;
+        (self.prev, self.plo, self.phi, self.first) = (k, vlo, vhi, false);
+        if first {
+            return None;
+        }
+        if !both {
+            self.odd = true;
+            return None;
+        }
+        self.up &= vlo > phi;
+        self.down &= vhi < plo;
+        Some(((plo, phi), (vlo, vhi)))
+    }
+
+    /// Every vertex keyed and the widened keys strictly ordered one way,
+    /// for keys without a period (`period` 0).
+    pub(crate) fn strict(&self, period: f32) -> bool {
+        !self.odd && period <= 0.0 && (self.up || self.down)
+    }
+}
+
 /// Builds an [`Index`] one vertex at a time (pass 1 of the module docs:
 /// oriented, unwrapped keys, intervals, prefix maxima and the widths' sum,
 /// in locals while the vertices come).
@@ -993,27 +1054,118 @@ pub(crate) struct Builder<'a, const N: usize> {
     period: f32,
     unkeyed: Unkeyed,
     n: usize,
-    prev: f32,
-    prev_e: f32,
+    order: KeyOrder,
     keyed: f32,
     offset: f32,
     first: f32,
     last: f32,
     run: f32,
     sum: f32,
-    odd: bool,
-    /// Each vertex's widened key lies wholly above (`up`) or below
-    /// (`down`) the one before, so far.
-    up: bool,
-    down: bool,
 }
 
 impl<const N: usize> Builder<'_, N> {
-    /// The next vertex's raw key ([`NO_KEY`] where none) and margin; at
-    /// most `N` count.
+    /// Push every vertex `keys` gives, raw key ([`NO_KEY`] where none) and
+    /// margin, in order (through [`Self::push_run`]); at most `N` count.
     #[inline(always)]
-    pub(crate) fn push(&mut self, raw: f32, e: f32) {
+    pub(crate) fn push_all(&mut self, keys: impl Iterator<Item = (f32, f32)>) {
+        let mut keys = keys;
+        self.push_run(|m| {
+            let (raw, e) = keys.next()?;
+            *m = e;
+            Some(raw)
+        });
+    }
+
+    /// [`Self::push_stored`] for every raw key `keys` gives, in order
+    /// (through [`Self::push_run`]).
+    #[inline(always)]
+    pub(crate) fn push_all_stored(&mut self, keys: impl Iterator<Item = f32>) {
+        let mut keys = keys;
+        self.push_run(|_| keys.next());
+    }
+
+    /// Push vertices while `next` gives their raw keys, each with its
+    /// margin put in (or already in) the slot it is handed; at most `N`.
+    /// While the keys have no period and are finite (the usual polyline)
+    /// a lean loop writes the intervals and prefix maxima (the values
+    /// [`Self::push_stored`] gives) without the key-order test (the index
+    /// is then not [`Index::strict`], a shortcut of the fold test only);
+    /// from the first vertex it cannot take on, [`Self::push_stored`].
+    #[inline(always)]
+    fn push_run(&mut self, mut next: impl FnMut(&mut f32) -> Option<f32>) {
+        let mut pending = None;
+        if self.n == 0 && self.period <= 0.0 {
+            let Some(raw) = self.index.margin.first_mut().and_then(&mut next) else {
+                return;
+            };
+            self.push_stored(raw);
+            let k = self.o * raw;
+            let (Some(&e), true) = (self.index.margin.first(), k.is_finite()) else {
+                return self.push_rest(next);
+            };
+            let o = self.o;
+            let (mut prev, mut plo, mut phi) = (k, k - e, k + e);
+            let (mut run, mut sum) = (self.run, self.sum);
+            let mut n = 1usize;
+            let slots = self
+                .index
+                .margin
+                .iter_mut()
+                .skip(1)
+                .zip(self.index.seg.iter_mut());
+            for (m, g) in slots {
+                let Some(raw) = next(m) else {
+                    break;
+                };
+                let k = o * raw;
+                if !(k + prev).is_finite() {
+                    pending = Some(raw);
+                    break;
+                }
+                let e = *m;
+                let (vlo, vhi) = (k - e, k + e);
+                g.lo = fmin(plo, vlo);
+                g.hi = fmax(phi, vhi);
+                sum += g.hi - g.lo;
+                run = fmax(run, g.hi);
+                g.pm = run;
+                (prev, plo, phi) = (k, vlo, vhi);
+                n += 1;
+            }
+            if n > 1 {
+                self.order = KeyOrder {
+                    prev,
+                    plo,
+                    phi,
+                    first: false,
+                    up: false,
+                    down: false,
+                    odd: false,
+                };
+                (self.n, self.run, self.sum, self.last) = (n, run, sum, prev);
+            }
+        }
+        if let Some(raw) = pending {
+            self.push_stored(raw);
+        }
+        self.push_rest(next);
+    }
+
+    /// The rest of [`Self::push_run`], one [`Self::push_stored`] at a time.
+    fn push_rest(&mut self, mut next: impl FnMut(&mut f32) -> Option<f32>) {
+        while let Some(raw) = self.index.margin.get_mut(self.n).and_then(&mut next) {
+            self.push_stored(raw);
+        }
+    }
+
+    /// The next vertex's raw key ([`NO_KEY`] where none), its margin
+    /// already in place (in `margin[n]`); at most `N` count.
+    #[inline(always)]
+    fn push_stored(&mut self, raw: f32) {
         let i = self.n;
+        let Some(&e) = self.index.margin.get(i) else {
+            return;
+        };
         let mut k = self.o * raw;
         if self.period > 0.0 && k.is_finite() {
             // Consecutive keys are less than half a turn apart.
@@ -1028,24 +1180,14 @@ impl<const N: usize> Builder<'_, N> {
             }
             self.keyed = k;
         }
-        if let Some(m) = self.index.margin.get_mut(i) {
-            *m = e;
-        } else {
-            return;
-        }
+        let ends = self.order.push(k, e);
         if let Some(g) = i.checked_sub(1).and_then(|j| self.index.seg.get_mut(j)) {
-            // Both keys finite (their sum is, for keys this small).
-            if (k + self.prev).is_finite() {
-                let (plo, phi) = (self.prev - self.prev_e, self.prev + self.prev_e);
-                let (vlo, vhi) = (k - e, k + e);
-                self.up &= vlo > phi;
-                self.down &= vhi < plo;
+            if let Some(((plo, phi), (vlo, vhi))) = ends {
                 g.lo = fmin(plo, vlo);
                 g.hi = fmax(phi, vhi);
                 self.sum += g.hi - g.lo;
             } else {
                 // An unkeyed end: the rebuild sorts it out.
-                self.odd = true;
                 (g.lo, g.hi) = match self.unkeyed {
                     Unkeyed::MeetAll => (f32::NEG_INFINITY, f32::INFINITY),
                     Unkeyed::MeetNone => (f32::INFINITY, f32::NEG_INFINITY),
@@ -1060,8 +1202,6 @@ impl<const N: usize> Builder<'_, N> {
             }
             self.last = k;
         }
-        self.prev = k;
-        self.prev_e = e;
         self.n = i + 1;
     }
 
@@ -1076,15 +1216,14 @@ impl<const N: usize> Builder<'_, N> {
             first,
             last,
             sum,
-            odd,
-            up,
-            down,
+            order,
             period,
             ..
         } = self;
         let s = n.saturating_sub(1);
         index.segments = s;
-        index.strict = !odd && period <= 0.0 && (up || down);
+        index.strict = order.strict(period);
+        let odd = order.odd;
         // The keys (oriented by `o`) fall overall: orient them the other way.
         let flip = last < first;
         index.orient = o;

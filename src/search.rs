@@ -455,16 +455,14 @@ impl<const N: usize> Index<N> {
     }
 
     /// Whether vertex `i`, whose raw key is `key`, may lie on a ray that
-    /// meets a segment outside `i − w ..= i + w − 1`: `false` is certain
+    /// meets a segment outside `i − w ..= i + w − 1` other than those set
+    /// aside (the envelopes leave them out): `false` is certain
     /// (its widened key lies above every interval before that window and
     /// below every one after it, in the oriented order: the envelopes say
     /// so in `O(1)`, for each copy of a periodic key that can meet the
     /// keys' range), `true` needs the query ([`Self::visit`]) to decide.
     #[inline(always)]
     pub(crate) fn may_fold(&self, i: usize, key: f32, w: usize) -> bool {
-        if !self.aside.is_empty() {
-            return true;
-        }
         let k = self.orient * key;
         let e = self.margin(i);
         let test = |k: f32| {
@@ -499,8 +497,8 @@ impl<const N: usize> Index<N> {
 
     /// The fold test of vertex `i` with raw key `key`: whether its key
     /// (widened by its margin) meets a segment outside `i − w ..= i + w −
-    /// 1` ([`Self::may_fold`], then the query; each segment looked at one
-    /// unit of `work`).
+    /// 1` (the aside list, [`Self::may_fold`] for the rest, then the query;
+    /// each segment looked at one unit of `work`).
     #[inline(always)]
     pub(crate) fn folds(
         &mut self,
@@ -509,11 +507,33 @@ impl<const N: usize> Index<N> {
         w: usize,
         work: &mut Work,
     ) -> Result<bool, OutOfWork> {
-        if self.strict || !self.may_fold(i, key, w) {
+        if self.strict {
             return Ok(false);
         }
         let e = self.margin(i);
         let skip = (i.saturating_sub(w), i.saturating_add(w).saturating_sub(1));
+        if !self.aside.is_empty() {
+            // The segments set aside first (the envelopes leave them out),
+            // all for one unit: a spurious detector point's two segments
+            // meet most keys and settle the test at once.
+            work.spend(1)?;
+            let k = self.orient * key;
+            let mut c = [(0.0f32, 0.0f32); MAX_COPIES];
+            let copies = match self.copies(k - e, k + e, &mut c) {
+                Some(n) => c.get(..n).unwrap_or(&[]),
+                None => return Ok(true),
+            };
+            let outside = |j: u16| usize::from(j) < skip.0 || usize::from(j) > skip.1;
+            let met = self.aside.iter().any(|&(j, lo, hi)| {
+                outside(j) && copies.iter().any(|&(ql, qh)| lo <= qh && hi >= ql)
+            });
+            if met {
+                return Ok(true);
+            }
+        }
+        if !self.may_fold(i, key, w) {
+            return Ok(false);
+        }
         let mut met = Met(false);
         self.visit(
             Query::Keys(key - e, key + e),
@@ -1422,9 +1442,7 @@ mod tests {
             let ks = keys(&mut rng, shape, n, period);
             let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
             let mut b = index.builder((if period { 4.0 } else { 0.0 }, orient), Unkeyed::MeetAll);
-            for &(k, e) in &ks {
-                b.push(k, e);
-            }
+            b.push_all(ks.iter().copied());
             b.finish(None);
             let ivs = intervals(&ks, period);
             for _ in 0..8 {
@@ -1479,9 +1497,7 @@ mod tests {
             let ks = keys(&mut rng, shape, n, period);
             let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
             let mut b = index.builder((if period { 4.0 } else { 0.0 }, orient), Unkeyed::MeetNone);
-            for &(k, e) in &ks {
-                b.push(k, e);
-            }
+            b.push_all(ks.iter().copied());
             b.finish(None);
             let ivs = intervals(&ks, period);
             for (i, &(k, e)) in ks.iter().enumerate() {

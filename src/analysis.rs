@@ -16,8 +16,15 @@
 //!
 //! Substituting these into eq. 2.2 gives eq. 3.2 (see [`disparity_tilted`]);
 //! the host tests check it numerically over a grid of `θ`, `Z`, `W`.
+//!
+//! # Angles
+//! Every angle argument (radians) is reduced correctly for any
+//! `|angle| ≤` [`crate::MAX_ANGLE_RAD`] (a tilt of 6 rad is the tilt of
+//! `6 − 2π`); a NaN, infinite or larger angle is an [`AngleError`]
+//! (`host_tests/tests/angles.rs` checks every function at and beyond its
+//! range against `f64`).
 
-use crate::math::{atan, fmax, sin_cos};
+use crate::math::{atan, fmax, reduce_angle, sin_cos, sin_cos_reduced, AngleError};
 
 /// Vehicle-frame translation `(U, V, W)` → camera frame, camera pitched
 /// down by `tilt` radians (Appendix I).
@@ -26,20 +33,21 @@ use crate::math::{atan, fmax, sin_cos};
 /// use roadstereo::analysis::vehicle_to_camera;
 /// // Driving 1 unit straight ahead with the camera tilted 30° down: in the
 /// // camera's axes the motion goes forward and up (negative y).
-/// let [u, v, w] = vehicle_to_camera([0.0, 0.0, 1.0], 30f32.to_radians());
+/// let [u, v, w] = vehicle_to_camera([0.0, 0.0, 1.0], 30f32.to_radians())?;
 /// assert!(u == 0.0 && (v + 0.5).abs() < 1e-6 && (w - 0.866_025_4).abs() < 1e-6);
+/// # Ok::<(), roadstereo::AngleError>(())
 /// ```
-pub fn vehicle_to_camera(t: [f32; 3], tilt: f32) -> [f32; 3] {
-    let (s, c) = sin_cos(tilt);
-    [t[0], c * t[1] - s * t[2], s * t[1] + c * t[2]]
+pub fn vehicle_to_camera(t: [f32; 3], tilt: f32) -> Result<[f32; 3], AngleError> {
+    let (s, c) = sin_cos_reduced(tilt)?;
+    Ok([t[0], c * t[1] - s * t[2], s * t[1] + c * t[2]])
 }
 
 /// Camera-frame vector → vehicle frame (inverse of [`vehicle_to_camera`]);
 /// also turns reconstructed points (camera coordinates, e.g.
 /// [`crate::Structure::point`]) into the vehicle frame.
-pub fn camera_to_vehicle(p: [f32; 3], tilt: f32) -> [f32; 3] {
-    let (s, c) = sin_cos(tilt);
-    [p[0], c * p[1] + s * p[2], -s * p[1] + c * p[2]]
+pub fn camera_to_vehicle(p: [f32; 3], tilt: f32) -> Result<[f32; 3], AngleError> {
+    let (s, c) = sin_cos_reduced(tilt)?;
+    Ok([p[0], c * p[1] + s * p[2], -s * p[1] + c * p[2]])
 }
 
 /// Eq. 3.1: vertical disparity (pixels) of a ground point at distance `z`
@@ -59,39 +67,66 @@ pub fn disparity_flat(f: f32, h: f32, w: f32, z: f32) -> f32 {
 /// vehicle moving forward by `w` on flat ground:
 /// `d_y = f h w / (Z' (Z' − w cos θ))` with `Z' = h sin θ + z cos θ`.
 /// Infinite when the point is not in front of both cameras.
-pub fn disparity_tilted(f: f32, h: f32, w: f32, z: f32, tilt: f32) -> f32 {
-    let (s, c) = sin_cos(tilt);
+pub fn disparity_tilted(f: f32, h: f32, w: f32, z: f32, tilt: f32) -> Result<f32, AngleError> {
+    let (s, c) = sin_cos_reduced(tilt)?;
     let zp = h * s + z * c;
     let den = zp * (zp - w * c);
-    if zp > 0.0 && den > 0.0 {
+    Ok(if zp > 0.0 && den > 0.0 {
         f * h * w / den
     } else {
         f32::INFINITY
-    }
+    })
 }
 
 /// The stretch of flat ground in the vertical field of view: the nearest
 /// and farthest horizontal distances seen by a camera at height `h`, tilted
 /// down by `tilt`, with half vertical field of view `half_fov` (radians;
 /// `atan(rows / 2 / f_y)`). The far end is infinite when the upper edge of
-/// the view is at or above the horizon. `None` if the ground is not seen.
-pub fn ground_interval(h: f32, tilt: f32, half_fov: f32) -> Option<(f32, f32)> {
+/// the view is at or above the horizon. `Ok(None)` if the ground is not
+/// seen. `half_fov` must be in `(0, π/2)` ([`AngleError::OutOfDomain`]
+/// otherwise); `tilt` is reduced to `[−π, π]`.
+pub fn ground_interval(h: f32, tilt: f32, half_fov: f32) -> Result<Option<(f32, f32)>, AngleError> {
+    if !half_fov.is_finite() {
+        return Err(AngleError::NotFinite);
+    }
+    if !(half_fov > 0.0 && half_fov < core::f32::consts::FRAC_PI_2) {
+        return Err(AngleError::OutOfDomain);
+    }
+    Ok(ground_in_view(h, reduce_angle(tilt)?, half_fov))
+}
+
+/// [`ground_interval`] for a tilt in `[−π, π]` and a half field of view in
+/// `(0, π/2)`: the rays it takes the tangent of are then within
+/// [`sin_cos`]'s range.
+fn ground_in_view(h: f32, tilt: f32, half_fov: f32) -> Option<(f32, f32)> {
     let lower = tilt + half_fov; // steepest ray below the horizon
     let upper = tilt - half_fov;
-    if lower <= 0.0 || lower >= core::f32::consts::FRAC_PI_2 {
+    if !(lower > 0.0 && lower < core::f32::consts::FRAC_PI_2) {
         return None;
     }
-    let near = h / tan(lower);
+    let near = h / tan_small(lower);
     let far = if upper > 0.0 {
-        h / tan(upper)
+        // 0 < upper < lower < π/2.
+        h / tan_small(upper)
     } else {
         f32::INFINITY
     };
     Some((near, far))
 }
 
+/// `tan x` for `|x| ≤ π/2` ([`sin_cos`]'s range).
+fn tan_small(x: f32) -> f32 {
+    tan_of(sin_cos(x))
+}
+
+/// `tan x` for an angle of any size, NaN for one [`sin_cos_reduced`]
+/// rejects (here only a NaN from a NaN length: the angles it gets are
+/// sums of validated ones).
 fn tan(x: f32) -> f32 {
-    let (s, c) = sin_cos(x);
+    sin_cos_reduced(x).map_or(f32::NAN, tan_of)
+}
+
+fn tan_of((s, c): (f32, f32)) -> f32 {
     if c.abs() > 0.0 {
         s / c
     } else {
@@ -102,14 +137,14 @@ fn tan(x: f32) -> f32 {
 /// Eq. 3.4: the ratio `F` of the disparity for motion `n w` to that for
 /// `w`, at `Z' = h sin θ + Z cos θ`: `F = n + n (n − 1) w cos θ / (Z' − n w cos θ)`.
 /// `F → n` when `w ≪ Z'`.
-pub fn motion_factor(n: f32, w: f32, z_prime: f32, tilt: f32) -> f32 {
-    let (_, c) = sin_cos(tilt);
+pub fn motion_factor(n: f32, w: f32, z_prime: f32, tilt: f32) -> Result<f32, AngleError> {
+    let (_, c) = sin_cos_reduced(tilt)?;
     let den = z_prime - n * w * c;
-    if den > 0.0 {
+    Ok(if den > 0.0 {
         n + n * (n - 1.0) * w * c / den
     } else {
         f32::INFINITY
-    }
+    })
 }
 
 /// Motion stereo: the fraction of the image rows that see the ground in
@@ -117,10 +152,24 @@ pub fn motion_factor(n: f32, w: f32, z_prime: f32, tilt: f32) -> f32 {
 /// forward by `w` (flat ground, camera at height `h`, tilted by `tilt`,
 /// `rows` image rows, focal length `f_y`, principal point at the centre).
 /// The rows lost are those of the strip the vehicle drives past.
-pub fn common_rows_motion(h: f32, tilt: f32, f_y: f32, rows: f32, w: f32) -> Option<f32> {
+/// `Ok(None)` if the ground is not seen (or `rows`, `f_y` do not give a
+/// field of view); `tilt` is reduced to `[−π, π]`.
+pub fn common_rows_motion(
+    h: f32,
+    tilt: f32,
+    f_y: f32,
+    rows: f32,
+    w: f32,
+) -> Result<Option<f32>, AngleError> {
+    let tilt = reduce_angle(tilt)?;
     let half = rows * 0.5;
     let half_fov = atan(half / f_y);
-    let (near, far) = ground_interval(h, tilt, half_fov)?;
+    if !(half_fov > 0.0 && half_fov < core::f32::consts::FRAC_PI_2) {
+        return Ok(None);
+    }
+    let Some((near, far)) = ground_in_view(h, tilt, half_fov) else {
+        return Ok(None);
+    };
     // Row (from the centre, down positive) of the ground at distance d.
     let row = |d: f32| f_y * tan(atan(h / d) - tilt);
     // Rows that see the ground at all: from the bottom up to the horizon or
@@ -132,11 +181,7 @@ pub fn common_rows_motion(h: f32, tilt: f32, f_y: f32, rows: f32, w: f32) -> Opt
     };
     let seen = half - top;
     let lost = half - row(near + w);
-    if seen > 0.0 {
-        Some(fmax(1.0 - lost / seen, 0.0))
-    } else {
-        None
-    }
+    Ok((seen > 0.0).then(|| fmax(1.0 - lost / seen, 0.0)))
 }
 
 /// Ordinary stereo: the fraction of the image columns common to two
@@ -155,8 +200,13 @@ pub fn common_columns_stereo(f_x: f32, columns: f32, u: f32, z: f32) -> f32 {
 /// estimated axis turned by `angle` (radians) about `x`:
 /// `y_e = y_t f / (f cos θ − y_t sin θ)`. Infinite at the horizon of the
 /// turned axis.
-pub fn misaligned_row(y_true: f32, f: f32, angle: f32) -> f32 {
-    let (s, c) = sin_cos(angle);
+pub fn misaligned_row(y_true: f32, f: f32, angle: f32) -> Result<f32, AngleError> {
+    let (s, c) = sin_cos_reduced(angle)?;
+    Ok(misaligned_row_sc(y_true, f, s, c))
+}
+
+/// [`misaligned_row`] with the sine and cosine of the angle.
+fn misaligned_row_sc(y_true: f32, f: f32, s: f32, c: f32) -> f32 {
     let den = f * c - y_true * s;
     if den.abs() > 0.0 {
         y_true * f / den
@@ -168,8 +218,13 @@ pub fn misaligned_row(y_true: f32, f: f32, angle: f32) -> f32 {
 /// Appendix II A: the disparity `y_Q − y_P` as seen with the misaligned
 /// axis, from the true rows `y_p` (frame 1) and `y_q` (frame 2):
 /// `dy_e = dy_t f² cos θ / ((f cos θ − y_P sin θ)(f cos θ − y_Q sin θ))`.
-pub fn misaligned_disparity(y_p: f32, y_q: f32, f: f32, angle: f32) -> f32 {
-    let (s, c) = sin_cos(angle);
+pub fn misaligned_disparity(y_p: f32, y_q: f32, f: f32, angle: f32) -> Result<f32, AngleError> {
+    let (s, c) = sin_cos_reduced(angle)?;
+    Ok(misaligned_disparity_sc(y_p, y_q, f, s, c))
+}
+
+/// [`misaligned_disparity`] with the sine and cosine of the angle.
+fn misaligned_disparity_sc(y_p: f32, y_q: f32, f: f32, s: f32, c: f32) -> f32 {
     let den = (f * c - y_p * s) * (f * c - y_q * s);
     if den.abs() > 0.0 {
         (y_q - y_p) * f * f * c / den
@@ -183,7 +238,7 @@ pub fn misaligned_disparity(y_p: f32, y_q: f32, f: f32, angle: f32) -> f32 {
 /// `z`, camera height `h`, tilt `tilt`, forward motion `w` (vehicle frame),
 /// focal length `f`: the depth of Sec. 4.1.1, `Z = (−f V + W y₂)/d_y`
 /// (camera-frame motion), computed from the true and from the misaligned
-/// rows. `None` if the point is not seen in both frames.
+/// rows. `Ok(None)` if the point is not seen in both frames.
 pub fn misalignment_depth_error(
     f: f32,
     h: f32,
@@ -191,21 +246,24 @@ pub fn misalignment_depth_error(
     w: f32,
     z: f32,
     angle: f32,
-) -> Option<f32> {
-    let t = vehicle_to_camera([0.0, 0.0, w], tilt);
-    let p1 = vehicle_to_camera([0.0, h, z], tilt);
+) -> Result<Option<f32>, AngleError> {
+    let t = vehicle_to_camera([0.0, 0.0, w], tilt)?;
+    let p1 = vehicle_to_camera([0.0, h, z], tilt)?;
+    // Before the early return: a bad angle is an error either way.
+    let (s, c) = sin_cos_reduced(angle)?;
     let p2 = [p1[0] - t[0], p1[1] - t[1], p1[2] - t[2]];
     if p1[2] <= 0.0 || p2[2] <= 0.0 {
-        return None;
+        return Ok(None);
     }
     let (y1, y2) = (f * p1[1] / p1[2], f * p2[1] / p2[2]);
     let depth = |y2: f32, dy: f32| (-f * t[1] + t[2] * y2) / dy;
     let z_true = depth(y2, y2 - y1);
     let z_est = depth(
-        misaligned_row(y2, f, angle),
-        misaligned_disparity(y1, y2, f, angle),
+        misaligned_row_sc(y2, f, s, c),
+        misaligned_disparity_sc(y1, y2, f, s, c),
     );
-    (z_true.is_finite() && z_est.is_finite() && z_true != 0.0).then(|| (z_est / z_true - 1.0).abs())
+    Ok((z_true.is_finite() && z_est.is_finite() && z_true != 0.0)
+        .then(|| (z_est / z_true - 1.0).abs()))
 }
 
 /// The relative depth error of Sec. 4.1.1 from a disparity error `e`

@@ -33,11 +33,21 @@
 //! predicted FOE. Gauss–Newton on the point-to-line distances (pixels), started from
 //! the step-by-step result, a bounded number of iterations; it reports the
 //! RMS residual and the standard deviation of each parameter.
+//!
+//! # Inputs and results
+//! Pixel coordinates (flow ends, FOEs) must be finite and within
+//! ±[`MAX_COORD_PX`], translation components within ±1e6 units, the roll
+//! within ±[`crate::MAX_ANGLE_RAD`] (reduced correctly below that);
+//! anything else is a typed error. Every `Ok` result is finite: a result
+//! that would overflow `f32` from such inputs is
+//! [`CalibrationError::Overflow`].
 
 use core::fmt;
 
 use crate::camera::{Camera, CameraError, Pixel};
-use crate::math::{cross, dot, fmax, sin_cos, sqrt, sub};
+use crate::math::{
+    cross, dot, fmax, reduce_angle, sin_cos_reduced, sqrt, sub, AngleError, MAX_TRANSLATION,
+};
 use crate::motion::{Motion, MotionError};
 
 /// One feature point's flow between two frames of a pure translation.
@@ -54,20 +64,32 @@ pub struct Flow {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum CalibrationError {
-    /// A coordinate or translation is NaN or infinite.
+    /// A coordinate or an intrinsic parameter is NaN or infinite.
     NotFinite,
-    /// Fewer than two usable (non-zero) flows, or more than the capacity.
+    /// A pixel coordinate is beyond ±[`MAX_COORD_PX`], or a translation
+    /// component beyond ±1e6 units.
+    OutOfRange,
+    /// Too few usable (non-zero) flows: fewer than two for an FOE, fewer
+    /// than six in all for a joint calibration.
     TooFewFlows,
     /// More flows than the estimator's capacity `N`.
     TooManyFlows,
     /// The flows are (nearly) parallel: the FOE is at infinity.
     Parallel,
-    /// A translation has no forward component (`t_z ≤ 0`) or is zero.
+    /// A translation is NaN or infinite, or has no forward component
+    /// (`t_z ≤ 0`).
     BadTranslation,
-    /// The FOEs are inconsistent with the model (e.g. `r² ≤ 0`).
+    /// The FOEs are inconsistent with the model (e.g. `r² ≤ 0`), or the
+    /// joint fit's equations are singular or its iterations diverged.
     Degenerate,
+    /// A result would not be finite in `f32` (finite but extreme inputs).
+    Overflow,
+    /// The roll angle is rejected.
+    Angle(AngleError),
     /// The result is not a valid camera.
     Camera(CameraError),
+    /// The converted motion is not a valid pipeline motion.
+    Motion(MotionError),
 }
 
 impl core::error::Error for CalibrationError {}
@@ -76,14 +98,59 @@ impl fmt::Display for CalibrationError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::NotFinite => f.write_str("a coordinate is NaN or infinite"),
-            Self::TooFewFlows => f.write_str("fewer than two usable flows"),
+            Self::OutOfRange => f.write_str("a coordinate or translation is out of range"),
+            Self::TooFewFlows => f.write_str("too few usable flows"),
             Self::TooManyFlows => f.write_str("more flows than the capacity"),
             Self::Parallel => f.write_str("flows are parallel: FOE at infinity"),
             Self::BadTranslation => f.write_str("translation without forward component"),
             Self::Degenerate => f.write_str("FOEs inconsistent with the camera model"),
+            Self::Overflow => f.write_str("a result would not be finite"),
+            Self::Angle(e) => write!(f, "roll rejected: {e}"),
             Self::Camera(e) => write!(f, "calibrated camera invalid: {e}"),
+            Self::Motion(e) => write!(f, "converted motion invalid: {e}"),
         }
     }
+}
+
+/// Largest accepted magnitude of a pixel coordinate (flow ends, FOEs),
+/// pixels. The largest valid image is 16 384 px wide, and an FOE of a
+/// calibration motion lies about `f ≤ 1e5` px from the centre; this bound
+/// keeps every square and product of the estimators far below `f32`
+/// overflow.
+pub const MAX_COORD_PX: f32 = 1.0e6;
+
+/// A pixel coordinate is finite and within ±[`MAX_COORD_PX`].
+fn check_pixel(p: Pixel) -> Result<(), CalibrationError> {
+    if !(p.u.is_finite() && p.v.is_finite()) {
+        return Err(CalibrationError::NotFinite);
+    }
+    if p.u.abs() > MAX_COORD_PX || p.v.abs() > MAX_COORD_PX {
+        return Err(CalibrationError::OutOfRange);
+    }
+    Ok(())
+}
+
+/// A calibration translation: finite, within ±1e6 units, `t_z > 0`.
+fn check_translation(t: [f32; 3]) -> Result<(), CalibrationError> {
+    if t.iter().any(|x| !x.is_finite()) || t[2] <= 0.0 {
+        return Err(CalibrationError::BadTranslation);
+    }
+    if t.iter().any(|x| x.abs() > MAX_TRANSLATION) {
+        return Err(CalibrationError::OutOfRange);
+    }
+    Ok(())
+}
+
+/// At most `N` flows, each end a valid pixel coordinate ([`check_pixel`]).
+fn check_flows<const N: usize>(flows: &[Flow]) -> Result<(), CalibrationError> {
+    if flows.len() > N {
+        return Err(CalibrationError::TooManyFlows);
+    }
+    for f in flows {
+        check_pixel(f.from)?;
+        check_pixel(f.to)?;
+    }
+    Ok(())
 }
 
 /// A focus of expansion fitted to flows.
@@ -185,8 +252,11 @@ fn pair(a: &Flow, b: &Flow) -> Option<[f32; 2]> {
 ///    most `max(3 × median, FLOW_TOLERANCE_PX)`, and re-fit by weighted
 ///    least squares on the misalignments.
 ///
-/// Zero-length flows are ignored. `N` is the capacity. Work `O(n²)` for
-/// `n ≤ N` flows (a calibration, not a per-frame task).
+/// Zero-length flows are ignored. `N` is the capacity. Every flow end must
+/// be finite and within ±[`MAX_COORD_PX`] (`NotFinite`, `OutOfRange`);
+/// [`CalibrationError::Overflow`] if the FOE or its spread would not be
+/// finite. Work `O(n²)` for `n ≤ N` flows (a calibration, not a per-frame
+/// task).
 ///
 /// ```
 /// use roadstereo::calibration::{focus_of_expansion, Flow};
@@ -203,25 +273,40 @@ fn pair(a: &Flow, b: &Flow) -> Option<[f32; 2]> {
 /// assert!((fit.foe.u - 300.0).abs() < 0.01 && (fit.foe.v - 200.0).abs() < 0.01);
 /// ```
 pub fn focus_of_expansion<const N: usize>(flows: &[Flow]) -> Result<FoeFit, CalibrationError> {
-    if flows.len() > N {
-        return Err(CalibrationError::TooManyFlows);
-    }
-    if flows.iter().any(|f| {
-        !(f.from.u.is_finite() && f.from.v.is_finite() && f.to.u.is_finite() && f.to.v.is_finite())
-    }) {
-        return Err(CalibrationError::NotFinite);
-    }
-    let mut keep = [false; N];
-    let mut usable = 0;
-    for (k, f) in keep.iter_mut().zip(flows) {
-        *k = f.from != f.to;
-        usable += usize::from(*k);
-    }
-    if usable < 2 {
+    // 1. Validate the flows.
+    check_flows::<N>(flows)?;
+    // 2. The usable flows: those that move.
+    let (usable, count) = usable_flows::<N>(flows);
+    if count < 2 {
         return Err(CalibrationError::TooFewFlows);
     }
-    let usable_mask = keep;
-    // 1. The best-supported pairwise intersection.
+    // 3. A robust start: the best-supported pairwise intersection.
+    let start = best_supported_intersection(flows, &usable).ok_or(CalibrationError::Parallel)?;
+    // 4. Reject the outliers and re-fit, in at most FOE_ROUNDS rounds.
+    let (foe, keep) = reject_and_refit::<N>(flows, &usable, start)?;
+    // 5. The spread of the inliers about the FOE.
+    foe_fit(flows, &keep, foe, count)
+}
+
+/// Step 2 of [`focus_of_expansion`]: the mask of the flows that move, and
+/// their count.
+fn usable_flows<const N: usize>(flows: &[Flow]) -> ([bool; N], usize) {
+    let mut usable = [false; N];
+    let mut count = 0;
+    for (k, f) in usable.iter_mut().zip(flows) {
+        *k = f.from != f.to;
+        count += usize::from(*k);
+    }
+    (usable, count)
+}
+
+/// Step 3 of [`focus_of_expansion`]: among the intersections of flow `i`
+/// with flow `i + n/2` and with flow `i + n/3`, the one most usable flows
+/// agree with (their end within [`FLOW_TOLERANCE_PX`] of the line from it
+/// through their start). `None` if every pair is (nearly) parallel.
+///
+/// Work: `2n` candidates, each checked against the `n` flows.
+fn best_supported_intersection(flows: &[Flow], usable: &[bool]) -> Option<[f32; 2]> {
     let n = flows.len();
     let mut best: Option<([f32; 2], usize)> = None;
     for step in [n / 2, n / 3] {
@@ -237,7 +322,7 @@ pub fn focus_of_expansion<const N: usize>(flows: &[Flow]) -> Result<FoeFit, Cali
             };
             let support = flows
                 .iter()
-                .zip(usable_mask.iter())
+                .zip(usable.iter())
                 .filter(|(f, &k)| k && misalignment(f, p) <= FLOW_TOLERANCE_PX)
                 .count();
             if best.is_none_or(|(_, s)| support > s) {
@@ -245,10 +330,22 @@ pub fn focus_of_expansion<const N: usize>(flows: &[Flow]) -> Result<FoeFit, Cali
             }
         }
     }
-    let Some((mut foe, _)) = best else {
-        return Err(CalibrationError::Parallel);
-    };
-    // 2. Reject and re-fit.
+    best.map(|(p, _)| p)
+}
+
+/// Step 4 of [`focus_of_expansion`]: up to [`FOE_ROUNDS`] rounds of
+/// keeping the usable flows whose misalignment is at most
+/// `max(3 × median, FLOW_TOLERANCE_PX)` (the median over the flows within
+/// `3 × FLOW_TOLERANCE_PX`, if any) and re-fitting by weighted least
+/// squares; stops early when the FOE moves less than 1e-3 px. The FOE and
+/// the flows kept.
+fn reject_and_refit<const N: usize>(
+    flows: &[Flow],
+    usable: &[bool; N],
+    start: [f32; 2],
+) -> Result<([f32; 2], [bool; N]), CalibrationError> {
+    let mut foe = start;
+    let mut keep = *usable;
     let mut dist = [0.0f32; N];
     for _ in 0..FOE_ROUNDS {
         let mut m = 0usize;
@@ -256,7 +353,7 @@ pub fn focus_of_expansion<const N: usize>(flows: &[Flow]) -> Result<FoeFit, Cali
             .iter_mut()
             .zip(keep.iter_mut())
             .zip(flows)
-            .zip(usable_mask.iter())
+            .zip(usable.iter())
         {
             *k = u;
             if u {
@@ -266,7 +363,7 @@ pub fn focus_of_expansion<const N: usize>(flows: &[Flow]) -> Result<FoeFit, Cali
         }
         // The median over the agreeing flows sets the scale of the noise.
         let mut agree = [false; N];
-        for ((a, &d), &u) in agree.iter_mut().zip(dist.iter()).zip(usable_mask.iter()) {
+        for ((a, &d), &u) in agree.iter_mut().zip(dist.iter()).zip(usable.iter()) {
             *a = u && d <= 3.0 * FLOW_TOLERANCE_PX;
         }
         let ma = agree.iter().filter(|&&a| a).count();
@@ -290,6 +387,18 @@ pub fn focus_of_expansion<const N: usize>(flows: &[Flow]) -> Result<FoeFit, Cali
             break;
         }
     }
+    Ok((foe, keep))
+}
+
+/// Step 5 of [`focus_of_expansion`]: the RMS distance of the FOE from the
+/// kept flows' lines, and the counts; [`CalibrationError::Overflow`] if
+/// the FOE or the spread is not finite.
+fn foe_fit(
+    flows: &[Flow],
+    keep: &[bool],
+    foe: [f32; 2],
+    usable: usize,
+) -> Result<FoeFit, CalibrationError> {
     let mut ss = 0.0f32;
     let mut inliers = 0usize;
     for (f, &k) in flows.iter().zip(keep.iter()) {
@@ -302,9 +411,14 @@ pub fn focus_of_expansion<const N: usize>(flows: &[Flow]) -> Result<FoeFit, Cali
     if inliers < 2 {
         return Err(CalibrationError::TooFewFlows);
     }
+    // Checked before the square root, which maps NaN to 0.
+    if !(foe[0].is_finite() && foe[1].is_finite() && ss.is_finite()) {
+        return Err(CalibrationError::Overflow);
+    }
+    let rms = sqrt(ss / inliers as f32);
     Ok(FoeFit {
         foe: Pixel::new(foe[0], foe[1]),
-        rms: sqrt(ss / inliers as f32),
+        rms,
         inliers,
         outliers: usable - inliers,
     })
@@ -363,24 +477,66 @@ pub struct Intrinsics {
 }
 
 impl Intrinsics {
-    /// Aspect ratio `r = f_x / f_y`.
-    pub fn aspect(&self) -> f32 {
-        if self.fy > 0.0 {
-            self.fx / self.fy
-        } else {
-            0.0
+    /// Every parameter finite and the roll within ±[`crate::MAX_ANGLE_RAD`]:
+    /// the sine and cosine of the roll.
+    fn check(&self) -> Result<(f32, f32), CalibrationError> {
+        if ![self.cx, self.cy, self.roll, self.fx, self.fy]
+            .iter()
+            .all(|x| x.is_finite())
+        {
+            return Err(CalibrationError::NotFinite);
         }
+        sin_cos_reduced(self.roll).map_err(CalibrationError::Angle)
     }
 
-    /// The FOE this camera predicts for robot translation `t` (`t_z > 0`).
-    pub fn predicted_foe(&self, t: [f32; 3]) -> Option<Pixel> {
-        let (s, c) = sin_cos(self.roll);
+    /// Aspect ratio `r = f_x / f_y`: [`CalibrationError::Degenerate`] unless
+    /// both focal lengths are positive, [`CalibrationError::Overflow`] if
+    /// the ratio is not finite.
+    ///
+    /// ```
+    /// use roadstereo::calibration::{CalibrationError, Intrinsics};
+    /// let k = Intrinsics { cx: 256.0, cy: 240.0, roll: 0.0, fx: 600.0, fy: 800.0 };
+    /// assert_eq!(k.aspect(), Ok(0.75));
+    /// assert_eq!(Intrinsics { fy: 0.0, ..k }.aspect(), Err(CalibrationError::Degenerate));
+    /// ```
+    pub fn aspect(&self) -> Result<f32, CalibrationError> {
+        if !(self.fx.is_finite() && self.fy.is_finite()) {
+            return Err(CalibrationError::NotFinite);
+        }
+        if !(self.fx > 0.0 && self.fy > 0.0) {
+            return Err(CalibrationError::Degenerate);
+        }
+        let r = self.fx / self.fy;
+        r.is_finite().then_some(r).ok_or(CalibrationError::Overflow)
+    }
+
+    /// The FOE this camera predicts for robot translation `t` (finite,
+    /// within ±1e6 units, `t_z > 0`). The roll may be any angle within
+    /// ±[`crate::MAX_ANGLE_RAD`]; [`CalibrationError::Overflow`] if the FOE
+    /// is not finite (`t_z` tiny against `t_x`, `t_y`).
+    ///
+    /// ```
+    /// use roadstereo::calibration::{CalibrationError, Intrinsics};
+    /// let k = Intrinsics { cx: 256.0, cy: 240.0, roll: 0.0, fx: 600.0, fy: 800.0 };
+    /// let p = k.predicted_foe([1.0, 0.5, 2.0])?;
+    /// assert_eq!((p.u, p.v), (556.0, 440.0));
+    /// assert_eq!(k.predicted_foe([1.0, 0.0, 0.0]), Err(CalibrationError::BadTranslation));
+    /// # Ok::<(), CalibrationError>(())
+    /// ```
+    pub fn predicted_foe(&self, t: [f32; 3]) -> Result<Pixel, CalibrationError> {
+        let (s, c) = self.check()?;
+        check_translation(t)?;
         // R_z(γ)ᵀ (x, y): rotate the robot translation into camera axes.
         let (x, y) = (c * t[0] + s * t[1], -s * t[0] + c * t[1]);
-        (t[2] > 0.0).then(|| Pixel::new(self.cx + self.fx * x / t[2], self.cy + self.fy * y / t[2]))
+        let foe = Pixel::new(self.cx + self.fx * x / t[2], self.cy + self.fy * y / t[2]);
+        if !(foe.u.is_finite() && foe.v.is_finite()) {
+            return Err(CalibrationError::Overflow);
+        }
+        Ok(foe)
     }
 
-    /// The camera model of the pipeline for an image of `width × height`.
+    /// The camera model of the pipeline for an image of `width × height`
+    /// (validated by [`Camera::new`]).
     pub fn camera(&self, width: u16, height: u16) -> Result<Camera, CalibrationError> {
         Camera::new(self.fx, self.fy, self.cx, self.cy, width, height)
             .map_err(CalibrationError::Camera)
@@ -389,8 +545,10 @@ impl Intrinsics {
     /// A robot-frame motion (translation and rotation in the robot's axes,
     /// the conventions of [`crate::motion`]) expressed in the rolled camera
     /// axes, as the pipeline wants it: `T_c = R_zᵀ T`, `R_c = R_zᵀ R R_z`.
-    pub fn camera_motion(&self, robot: &Motion) -> Result<Motion, MotionError> {
-        let (s, c) = sin_cos(self.roll);
+    /// The roll may be any angle within ±[`crate::MAX_ANGLE_RAD`]; the
+    /// result is validated by [`Motion::new`] ([`CalibrationError::Motion`]).
+    pub fn camera_motion(&self, robot: &Motion) -> Result<Motion, CalibrationError> {
+        let (s, c) = self.check()?;
         let rz = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
         let rzt = crate::math::mat3_transpose(&rz);
         let t = crate::math::mat3_vec(&rzt, robot.translation());
@@ -401,7 +559,7 @@ impl Intrinsics {
         let alpha = crate::math::asin(-r12);
         let beta = crate::math::atan2(r02, r22);
         let gamma = crate::math::atan2(r10, r11);
-        Motion::new(t, [alpha, beta, gamma])
+        Motion::new(t, [alpha, beta, gamma]).map_err(CalibrationError::Motion)
     }
 }
 
@@ -409,19 +567,18 @@ impl Intrinsics {
 ///
 /// `straight`: FOE of the translation `(0, 0, t)`; `diagonal`: FOEs of the
 /// translations `(+t, +t, t)`, `(−t, +t, t)`, `(−t, −t, t)`, `(+t, −t, t)`
-/// (in that order: round the image, so neighbours are adjacent).
+/// (in that order: round the image, so neighbours are adjacent). Each
+/// within ±[`MAX_COORD_PX`]; [`CalibrationError::Overflow`] if a result
+/// would not be finite.
 pub fn calibrate_stepwise(
     straight: Pixel,
     diagonal: [Pixel; 4],
 ) -> Result<Intrinsics, CalibrationError> {
-    let c = straight.arr();
-    if !(c[0].is_finite() && c[1].is_finite())
-        || diagonal
-            .iter()
-            .any(|p| !(p.u.is_finite() && p.v.is_finite()))
-    {
-        return Err(CalibrationError::NotFinite);
+    check_pixel(straight)?;
+    for p in diagonal {
+        check_pixel(p)?;
     }
+    let c = straight.arr();
     let d = diagonal.map(|p| sub(p.arr(), c));
     // r² from the four adjacent pairs: a + r² b = 0 in least squares.
     let (mut ab, mut bb) = (0.0f32, 0.0f32);
@@ -460,13 +617,17 @@ pub fn calibrate_stepwise(
     }
     let roll = -crate::math::atan2(sin_sum, cos_sum);
     let fy = fy_sum / 4.0;
-    Ok(Intrinsics {
+    let k = Intrinsics {
         cx: c[0],
         cy: c[1],
         roll,
         fx: r * fy,
         fy,
-    })
+    };
+    if ![roll, k.fx, fy].iter().all(|x| x.is_finite()) {
+        return Err(CalibrationError::Overflow);
+    }
+    Ok(k)
 }
 
 /// The flows of one calibration motion and its robot translation.
@@ -504,165 +665,247 @@ pub const JOINT_ITERATIONS: usize = 10;
 /// `max(3 × median, FLOW_TOLERANCE_PX)` (the rule of
 /// [`focus_of_expansion`]), re-decided at each iteration. `N`: capacity per
 /// motion.
+///
+/// Input: translations as for [`Intrinsics::predicted_foe`], flows as for
+/// [`focus_of_expansion`], `start` finite with its roll within
+/// ±[`crate::MAX_ANGLE_RAD`]. The result's roll is in `[−π, π]`; every
+/// number of the result is finite ([`CalibrationError::Overflow`]
+/// otherwise). Work: at most `JOINT_ITERATIONS + 1` passes over the flows,
+/// each `O(n²)` per motion of `n ≤ N` flows (the median of the masks).
 pub fn calibrate_jointly<const N: usize>(
     motions: &[MotionFlows<'_>],
     start: &Intrinsics,
 ) -> Result<JointFit, CalibrationError> {
-    if motions.iter().any(|m| {
-        m.translation[2].is_nan()
-            || m.translation[2] <= 0.0
-            || m.translation.iter().any(|x| !x.is_finite())
-    }) {
-        return Err(CalibrationError::BadTranslation);
+    // 1. Validate the input.
+    for m in motions {
+        check_translation(m.translation)?;
+        check_flows::<N>(m.flows)?;
     }
-    if motions.iter().any(|m| m.flows.len() > N) {
-        return Err(CalibrationError::TooManyFlows);
-    }
-    // Parameters scaled to similar sizes: c (px), roll (mrad), f (px).
-    let mut p = [start.cx, start.cy, start.roll * 1000.0, start.fx, start.fy];
-    let model = |p: &[f32; 5]| Intrinsics {
-        cx: p[0],
-        cy: p[1],
-        roll: p[2] * 0.001,
-        fx: p[3],
-        fy: p[4],
+    start.check()?;
+    // 2. Gauss–Newton steps from the start (its roll in [−π, π], where
+    //    f32 resolves it finely), the inlier masks from the start model
+    //    first and from the current one afterwards.
+    let start = Intrinsics {
+        roll: roll_in_half_turn(start.roll).map_err(CalibrationError::Angle)?,
+        ..*start
     };
-    // Inlier masks from the start model, per motion.
-    let keep_for = |m: &MotionFlows<'_>, k: &Intrinsics, keep: &mut [bool; N]| -> usize {
-        let Some(foe) = k.predicted_foe(m.translation) else {
-            return 0;
-        };
-        let mut dist = [0.0f32; N];
-        let mut n = 0;
-        for ((d, kk), f) in dist.iter_mut().zip(keep.iter_mut()).zip(m.flows) {
-            *kk = f.from != f.to && f.from.u.is_finite() && f.to.u.is_finite();
-            if *kk {
-                *d = misalignment(f, foe.arr());
-                n += 1;
-            }
-        }
-        let med = median_of_kept(&dist, keep, n);
-        let limit = fmax(3.0 * med, FLOW_TOLERANCE_PX);
-        let mut left = 0;
-        for (kk, &d) in keep.iter_mut().zip(dist.iter()) {
-            if *kk && d > limit {
-                *kk = false;
-            }
-            left += usize::from(*kk);
-        }
-        left
-    };
+    let mut p = Params::of(&start);
+    let mut masks = start;
     let mut iterations = 0;
-    let mut rms = 0.0f32;
-    let mut normal = [[0.0f32; 5]; 5];
-    let mut used = 0usize;
-    let mut converged = false;
-    for it in 0..=JOINT_ITERATIONS {
-        let k = model(&p);
-        let (s, c) = sin_cos(k.roll);
-        let mut jtj = [[0.0f32; 5]; 5];
-        let mut jtr = [0.0f32; 5];
-        let (mut ss, mut n) = (0.0f32, 0usize);
+    for _ in 0..JOINT_ITERATIONS {
+        let eq = Normal::accumulate::<N>(motions, &p.intrinsics(), &masks)?;
+        let step = solve5(eq.jtj, eq.jtr).ok_or(CalibrationError::Degenerate)?;
+        let converged = p.apply(&step)?;
+        iterations += 1;
+        masks = p.intrinsics();
+        if converged {
+            break;
+        }
+    }
+    // 3. The residuals and standard deviations at the result.
+    let eq = Normal::accumulate::<N>(motions, &p.intrinsics(), &masks)?;
+    joint_fit(&p, &eq, iterations)
+}
+
+/// `roll` as the equivalent angle in `[−π, π]` (itself, the same bits, if
+/// it is there already).
+fn roll_in_half_turn(roll: f32) -> Result<f32, AngleError> {
+    if roll.abs() <= core::f32::consts::PI {
+        return Ok(roll);
+    }
+    reduce_angle(roll)
+}
+
+/// The parameters of [`calibrate_jointly`], scaled to similar sizes:
+/// `c` (px), roll (mrad), `f` (px).
+struct Params([f32; 5]);
+
+impl Params {
+    fn of(k: &Intrinsics) -> Self {
+        Self([k.cx, k.cy, k.roll * 1000.0, k.fx, k.fy])
+    }
+
+    fn intrinsics(&self) -> Intrinsics {
+        let p = &self.0;
+        Intrinsics {
+            cx: p[0],
+            cy: p[1],
+            roll: p[2] * 0.001,
+            fx: p[3],
+            fy: p[4],
+        }
+    }
+
+    /// `p ← p − step`: whether the step was small (converged);
+    /// [`CalibrationError::Degenerate`] if a parameter is no longer finite.
+    fn apply(&mut self, step: &[f32; 5]) -> Result<bool, CalibrationError> {
+        let mut big = false;
+        for (pi, si) in self.0.iter_mut().zip(step.iter()) {
+            *pi -= si;
+            big |= si.abs() > 1.0e-4 * fmax(pi.abs(), 1.0);
+        }
+        if self.0.iter().any(|x| !x.is_finite()) {
+            return Err(CalibrationError::Degenerate);
+        }
+        Ok(!big)
+    }
+}
+
+/// The Gauss–Newton normal equations of the flows' misalignments at one
+/// model, with the sum of squares and the count of the flows used.
+struct Normal {
+    jtj: [[f32; 5]; 5],
+    jtr: [f32; 5],
+    ss: f32,
+    n: usize,
+}
+
+impl Normal {
+    /// The equations at `model`, over each motion's flows kept by the rule
+    /// of [`focus_of_expansion`] at `masks`; [`CalibrationError::TooFewFlows`]
+    /// if fewer than six flows are used in all.
+    fn accumulate<const N: usize>(
+        motions: &[MotionFlows<'_>],
+        model: &Intrinsics,
+        masks: &Intrinsics,
+    ) -> Result<Self, CalibrationError> {
+        // A roll the iterations pushed past the reduction's range: diverged.
+        let (s, c) = sin_cos_reduced(model.roll).map_err(|_| CalibrationError::Degenerate)?;
+        let mut eq = Normal {
+            jtj: [[0.0f32; 5]; 5],
+            jtr: [0.0f32; 5],
+            ss: 0.0,
+            n: 0,
+        };
         for m in motions {
             let mut keep = [false; N];
-            if keep_for(m, &start_or(&k, start, it), &mut keep) < 2 {
+            if inlier_mask(m, masks, &mut keep)? < 2 {
                 continue;
             }
             let t = m.translation;
             let (x, y) = ((c * t[0] + s * t[1]) / t[2], (-s * t[0] + c * t[1]) / t[2]);
             // d/dγ of R_zᵀ (t_x, t_y) / t_z.
             let (dx, dy) = ((-s * t[0] + c * t[1]) / t[2], (-c * t[0] - s * t[1]) / t[2]);
-            let foe = [k.cx + k.fx * x, k.cy + k.fy * y];
+            let foe = [model.cx + model.fx * x, model.cy + model.fy * y];
             // dF/dp for p = (cx, cy, roll_mrad, fx, fy).
             let dfdp = [
                 [1.0, 0.0],
                 [0.0, 1.0],
-                [k.fx * dx * 0.001, k.fy * dy * 0.001],
+                [model.fx * dx * 0.001, model.fy * dy * 0.001],
                 [x, 0.0],
                 [0.0, y],
             ];
             for (f, &kk) in m.flows.iter().zip(keep.iter()) {
-                if !kk {
-                    continue;
+                if kk {
+                    eq.add_flow(f, foe, &dfdp);
                 }
-                // Misalignment of the flow end from the line FOE → start:
-                // res = (d × e) / |e| with e = FOE − start.
-                let d = sub(f.to.arr(), f.from.arr());
-                let e = sub(foe, f.from.arr());
-                let le2 = dot(e, e);
-                if le2.is_nan() || le2 <= 0.0 {
-                    continue;
-                }
-                let le = sqrt(le2);
-                let cr = cross(d, e);
-                let res = cr / le;
-                // ∂res/∂F = n/|e| − (d × e) e/|e|³, n = (−d_y, d_x).
-                let g = [
-                    -d[1] / le - cr * e[0] / (le2 * le),
-                    d[0] / le - cr * e[1] / (le2 * le),
-                ];
-                let j = dfdp.map(|h| dot(g, h));
-                for (row, &ja) in jtj.iter_mut().zip(j.iter()) {
-                    for (cell, &jb) in row.iter_mut().zip(j.iter()) {
-                        *cell += ja * jb;
-                    }
-                }
-                for (g, &ja) in jtr.iter_mut().zip(j.iter()) {
-                    *g += ja * res;
-                }
-                ss += res * res;
-                n += 1;
             }
         }
-        if n < 6 {
+        if eq.n < 6 {
             return Err(CalibrationError::TooFewFlows);
         }
-        rms = sqrt(ss / n as f32);
-        normal = jtj;
-        used = n;
-        if it == JOINT_ITERATIONS || converged {
-            break;
-        }
-        let Some(step) = solve5(jtj, jtr) else {
-            return Err(CalibrationError::Degenerate);
-        };
-        let mut big = false;
-        for (pi, si) in p.iter_mut().zip(step.iter()) {
-            *pi -= si;
-            big |= si.abs() > 1.0e-4 * fmax(pi.abs(), 1.0);
-        }
-        iterations = it + 1;
-        if p.iter().any(|x| !x.is_finite()) {
-            return Err(CalibrationError::Degenerate);
-        }
-        // Converged: one more pass computes the residuals at the result.
-        converged = !big;
+        Ok(eq)
     }
-    let dof = used.saturating_sub(5).max(1) as f32;
-    let var = rms * rms * used as f32 / dof;
-    let inv_diag = inverse_diagonal5(normal).unwrap_or([f32::INFINITY; 5]);
+
+    /// One flow's misalignment from the line FOE → start,
+    /// `res = (d × e) / |e|` with `e = FOE − start`, and its gradient.
+    fn add_flow(&mut self, f: &Flow, foe: [f32; 2], dfdp: &[[f32; 2]; 5]) {
+        let d = sub(f.to.arr(), f.from.arr());
+        let e = sub(foe, f.from.arr());
+        let le2 = dot(e, e);
+        if le2.is_nan() || le2 <= 0.0 {
+            return;
+        }
+        let le = sqrt(le2);
+        let cr = cross(d, e);
+        let res = cr / le;
+        // ∂res/∂F = n/|e| − (d × e) e/|e|³, n = (−d_y, d_x).
+        let g = [
+            -d[1] / le - cr * e[0] / (le2 * le),
+            d[0] / le - cr * e[1] / (le2 * le),
+        ];
+        let j = dfdp.map(|h| dot(g, h));
+        for (row, &ja) in self.jtj.iter_mut().zip(j.iter()) {
+            for (cell, &jb) in row.iter_mut().zip(j.iter()) {
+                *cell += ja * jb;
+            }
+        }
+        for (g, &ja) in self.jtr.iter_mut().zip(j.iter()) {
+            *g += ja * res;
+        }
+        self.ss += res * res;
+        self.n += 1;
+    }
+}
+
+/// The flows of motion `m` whose misalignment from the FOE `model`
+/// predicts is at most `max(3 × median, FLOW_TOLERANCE_PX)`, in `keep`;
+/// their count.
+fn inlier_mask<const N: usize>(
+    m: &MotionFlows<'_>,
+    model: &Intrinsics,
+    keep: &mut [bool; N],
+) -> Result<usize, CalibrationError> {
+    let foe = model.predicted_foe(m.translation)?;
+    let mut dist = [0.0f32; N];
+    let mut n = 0;
+    for ((d, kk), f) in dist.iter_mut().zip(keep.iter_mut()).zip(m.flows) {
+        *kk = f.from != f.to;
+        if *kk {
+            *d = misalignment(f, foe.arr());
+            n += 1;
+        }
+    }
+    let med = median_of_kept(&dist, keep, n);
+    let limit = fmax(3.0 * med, FLOW_TOLERANCE_PX);
+    let mut left = 0;
+    for (kk, &d) in keep.iter_mut().zip(dist.iter()) {
+        if *kk && d > limit {
+            *kk = false;
+        }
+        left += usize::from(*kk);
+    }
+    Ok(left)
+}
+
+/// Step 3 of [`calibrate_jointly`]: the result, its RMS misalignment and
+/// the standard deviations from the normal equations at the result;
+/// [`CalibrationError::Degenerate`] if they are singular there,
+/// [`CalibrationError::Overflow`] if a number is not finite.
+fn joint_fit(p: &Params, eq: &Normal, iterations: usize) -> Result<JointFit, CalibrationError> {
+    // Every square root's argument is checked first: `sqrt` maps NaN to 0.
+    if !eq.ss.is_finite() {
+        return Err(CalibrationError::Overflow);
+    }
+    let rms = sqrt(eq.ss / eq.n as f32);
+    let dof = eq.n.saturating_sub(5).max(1) as f32;
+    let var = rms * rms * eq.n as f32 / dof;
+    let inv_diag = inverse_diagonal5(eq.jtj).ok_or(CalibrationError::Degenerate)?;
     let scale = [1.0, 1.0, 0.001, 1.0, 1.0];
     let mut sigma = [0.0f32; 5];
     for ((sg, id), sc) in sigma.iter_mut().zip(inv_diag.iter()).zip(scale.iter()) {
-        *sg = sqrt(fmax(id * var, 0.0)) * sc;
+        let v = id * var;
+        if !v.is_finite() {
+            return Err(CalibrationError::Overflow);
+        }
+        *sg = sqrt(fmax(v, 0.0)) * sc;
+    }
+    let mut intrinsics = p.intrinsics();
+    // (Within the reduction's range: the last pass took its sine.)
+    intrinsics.roll =
+        roll_in_half_turn(intrinsics.roll).map_err(|_| CalibrationError::Degenerate)?;
+    let k = &intrinsics;
+    let numbers = [k.cx, k.cy, k.roll, k.fx, k.fy, rms];
+    if !numbers.iter().chain(sigma.iter()).all(|x| x.is_finite()) {
+        return Err(CalibrationError::Overflow);
     }
     Ok(JointFit {
-        intrinsics: model(&p),
+        intrinsics,
         rms,
         sigma,
-        flows: used,
+        flows: eq.n,
         iterations,
     })
-}
-
-/// The inlier masks come from the start model on the first iteration and
-/// from the current one afterwards.
-fn start_or(current: &Intrinsics, start: &Intrinsics, iteration: usize) -> Intrinsics {
-    if iteration == 0 {
-        *start
-    } else {
-        *current
-    }
 }
 
 /// Solve the 5×5 symmetric positive definite system `a x = b` (Cholesky).

@@ -53,6 +53,7 @@ pub use epipolar::{
     Crossing, CrossingSearch, Crossings, EpipolarLine, PairGeometry, MAX_CROSSINGS,
     MAX_RAY_CROSSINGS,
 };
+pub use math::{AngleError, MAX_ANGLE_RAD};
 pub use motion::{Motion, MotionError};
 pub use processor::{
     BoundaryStructure, Config, ConfigError, PointResult, ProcessError, Processor, Status, Step,

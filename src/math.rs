@@ -53,7 +53,15 @@ fn sqrt_estimate(x: f32) -> f32 {
     f32::from_bits((x.to_bits() >> 1) + (0x3f80_0000 >> 1))
 }
 
-/// Sine and cosine of an angle in radians, `|x| ≤ π/2` (callers validate).
+/// Sine and cosine of an angle in radians, **`|x| ≤ π/2` only** (no
+/// range reduction: beyond it the result is silently wrong). For any
+/// angle a caller gives, use [`sin_cos_reduced`].
+///
+/// Callers that may use this one, each with its range established before
+/// the call: `Motion::new` (`|angle| ≤` `MAX_ROTATION_RAD`, 60°),
+/// `Config::new` (0.1°–89°), the tilt grid of `geometry` (0°–60°), the
+/// ground interval of `analysis` (rays checked to be in `(0, π/2)`), and
+/// [`sin_cos_reduced`] on its reduced argument (`|r| ≤ π/4 + 1e-3`).
 ///
 /// `libm`'s `sinf`/`cosf` reduce their argument in double precision, which
 /// on the single-precision FPU becomes software `f64` (`__aeabi_d*`), and
@@ -78,6 +86,124 @@ pub(crate) fn sin_cos(x: f32) -> (f32, f32) {
                         + x2 * (-1.0 / 3_628_800.0
                             + x2 * (1.0 / 479_001_600.0 + x2 * (-1.0 / 87_178_291_200.0)))))));
     (s, c)
+}
+
+/// Largest angle magnitude, radians (2¹³ ≈ 1304 turns), that the
+/// library's single-precision range reduction handles; beyond it an angle
+/// is rejected with [`AngleError::TooLarge`]. Every public function taking an angle accepts
+/// at least `[−MAX_ANGLE_RAD, MAX_ANGLE_RAD]` unless its docs say
+/// otherwise.
+pub const MAX_ANGLE_RAD: f32 = 8192.0;
+
+/// Why an angle was rejected.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum AngleError {
+    /// The angle is NaN or infinite.
+    NotFinite,
+    /// `|angle|` exceeds [`MAX_ANGLE_RAD`], the range the single-precision
+    /// reduction is exact for.
+    TooLarge,
+    /// The angle is outside the range the function is defined for (each
+    /// such function documents its range).
+    OutOfDomain,
+}
+
+impl core::error::Error for AngleError {}
+
+impl core::fmt::Display for AngleError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Self::NotFinite => "angle is NaN or infinite",
+            Self::TooLarge => "angle magnitude above 8192 rad",
+            Self::OutOfDomain => "angle outside the function's range",
+        })
+    }
+}
+
+/// π/2 in three parts (Cody–Waite): `PIO2_HI` has 8 significant bits and
+/// `PIO2_MID` 11, so `k · PIO2_HI` and `k · PIO2_MID` are exact for
+/// `|k| < 2¹³`; `PIO2_LO` is the `f32` nearest the rest. Their sum is π/2
+/// to 1.8e-15 (test `pio2_split_is_exact`). Given by their bits: 1.5703125
+/// (201/128), 4.837512969970703125e-4 (8116 · 2⁻²⁴), 7.549790126404332e-8.
+const PIO2_HI: f32 = f32::from_bits(0x3fc9_0000);
+const PIO2_MID: f32 = f32::from_bits(0x39fd_a000);
+const PIO2_LO: f32 = f32::from_bits(0x33a2_2169);
+
+/// `x = k · π/2 + r`: a nearest quarter turn `k` and the remainder `r`,
+/// for `|x| ≤` [`MAX_ANGLE_RAD`]. `k` comes from `x · 2/π` rounded in
+/// `f32`, which can pick the other neighbour within 4e-4 of a half, so
+/// `|r| ≤ π/4 + 1e-3` (well inside [`sin_cos`]'s `π/2`).
+///
+/// Cody–Waite in `f32` without fused multiply-add: `|k| ≤ 5216 < 2¹³`, so
+/// `k · PIO2_HI` and `k · PIO2_MID` are exact; `x − k · PIO2_HI` is exact
+/// (both are multiples of `x`'s last place, and the difference, below
+/// `π/4 + 3.1e-4 |x|`, needs no more bits than `x`), and so is the next
+/// subtraction (multiples of 2⁻²⁴ below 1); only the last step rounds. The
+/// error of `r` is at most half an ulp of `r` plus `|k| · 1.8e-15` (the
+/// split's truncation), below 4e-8 over the whole range. For
+/// `|x| ≤ 0.78`, `k = 0` and `r = x` exactly.
+fn reduce_quarter_turns(x: f32) -> Result<(f32, i32), AngleError> {
+    if !x.is_finite() {
+        return Err(AngleError::NotFinite);
+    }
+    if x.abs() > MAX_ANGLE_RAD {
+        return Err(AngleError::TooLarge);
+    }
+    let q = x * core::f32::consts::FRAC_2_PI;
+    // Nearest integer (half away from zero); |q| ≤ 5216, so the cast is in
+    // range. A `k` off by one where `q` is within rounding of a half only
+    // makes `|r|` exceed π/4 by that rounding.
+    let k = (q + if q < 0.0 { -0.5 } else { 0.5 }) as i32;
+    let kf = k as f32;
+    let r = ((x - kf * PIO2_HI) - kf * PIO2_MID) - kf * PIO2_LO;
+    Ok((r, k))
+}
+
+/// Sine and cosine of any angle `|x| ≤` [`MAX_ANGLE_RAD`] (radians),
+/// reduced in single precision ([`reduce_quarter_turns`]) and evaluated
+/// with [`sin_cos`] on the remainder: absolute error at most 1.2e-7 over
+/// the whole range (tests `sin_cos_reduced_matches_libm` here, against
+/// `libm`'s `sinf`/`cosf`, and `host_tests/tests/angles.rs`, against
+/// `libm`'s `f64` `sin`/`cos`). NaN, infinite or larger
+/// angles are a typed error. For `|x| ≤ 0.78` the bits are those of
+/// [`sin_cos`].
+///
+/// Every public function that takes an angle from its caller uses this
+/// one (or validates the angle into [`sin_cos`]'s range first).
+pub(crate) fn sin_cos_reduced(x: f32) -> Result<(f32, f32), AngleError> {
+    let (r, k) = reduce_quarter_turns(x)?;
+    let (s, c) = sin_cos(r);
+    // sin/cos of r + k π/2, by the quadrant k mod 4 (two's complement:
+    // k & 3 is k mod 4 also for negative k).
+    Ok(match k & 3 {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
+    })
+}
+
+/// The angle equivalent to `x` in `[−π, π]` (radians), for `|x| ≤`
+/// [`MAX_ANGLE_RAD`]: `r + j · π/2` with [`reduce_quarter_turns`]'s
+/// remainder and `j = k mod 4` in `{−1, 0, 1, 2}`. Within 3e-7 of the
+/// exact value; `x` itself (the same bits) for `|x| ≤ 0.78`.
+pub(crate) fn reduce_angle(x: f32) -> Result<f32, AngleError> {
+    use core::f32::consts::{FRAC_PI_2, PI};
+    let (r, k) = reduce_quarter_turns(x)?;
+    Ok(match k & 3 {
+        0 => r,
+        1 => r + FRAC_PI_2,
+        2 => {
+            // r + π, folded into [−π, π].
+            if r > 0.0 {
+                r - PI
+            } else {
+                r + PI
+            }
+        }
+        _ => r - FRAC_PI_2,
+    })
 }
 
 /// `atan(x)` in single precision (no `libm`: its `f32` functions reduce in
@@ -329,6 +455,140 @@ mod tests {
             let (s, c) = sin_cos(x);
             assert!((s - libm::sinf(x)).abs() <= 3.0e-7, "sin({x})");
             assert!((c - libm::cosf(x)).abs() <= 3.0e-7, "cos({x})");
+        }
+    }
+
+    /// `f32` `x ≥ 0` (normal) times 2⁶², exactly, as an integer.
+    fn scaled_2_62(x: f32) -> u128 {
+        let b = x.to_bits();
+        let e = (b >> 23) & 0xff;
+        let m = u128::from((b & 0x7f_ffff) | 0x80_0000);
+        // x = m · 2^(e − 150); times 2^62 is m · 2^(e − 88) (e ≥ 88 here).
+        m << (e - 88)
+    }
+
+    /// The split constants have the bits [`reduce_quarter_turns`] relies
+    /// on, and their sum is π/2 to 1.8e-15 (π/2 · 2⁶² in integers, from
+    /// the digits of π).
+    #[test]
+    fn pio2_split_is_exact() {
+        let significant = |x: f32| 24 - (x.to_bits() & 0x7f_ffff | 0x80_0000).trailing_zeros();
+        assert!(significant(PIO2_HI) <= 8 && significant(PIO2_MID) <= 11);
+        // |k| < 2^13 over the accepted range, so k · PIO2_HI, k · PIO2_MID are exact.
+        const { assert!(MAX_ANGLE_RAD * core::f32::consts::FRAC_2_PI + 1.0 < 8192.0) };
+        const PIO2_TIMES_2_62: u128 = 0x6487_ed51_10b4_611a;
+        let sum = scaled_2_62(PIO2_HI) + scaled_2_62(PIO2_MID) + scaled_2_62(PIO2_LO);
+        // 1.8e-15 · 2^62 = 8301.
+        assert!(sum.abs_diff(PIO2_TIMES_2_62) <= 8301, "{sum:#x}");
+    }
+
+    /// Absolute error of `sin_cos_reduced(x)` against `libm`'s `sinf` and
+    /// `cosf` (which reduce exactly, in `f64`, and round to within an ulp).
+    /// Asserted at most 1.2e-7 (two ulps of 1; measured: 6e-8, one ulp).
+    fn reduced_error(x: f32) -> f32 {
+        let (s, c) = sin_cos_reduced(x).unwrap();
+        fmax((s - libm::sinf(x)).abs(), (c - libm::cosf(x)).abs())
+    }
+
+    /// At and beyond the accepted range: a table of angles, a dense sweep
+    /// of `[−8192, 8192]`, and the worst case for the reduction, the
+    /// `f32`s within 8 ulps of every multiple of π/2 in range.
+    #[test]
+    fn sin_cos_reduced_matches_libm() {
+        use core::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+        let up = |x: f32| f32::from_bits(x.to_bits() + 1);
+        let ok = [
+            0.0f32,
+            -0.0,
+            f32::from_bits(1),
+            -f32::from_bits(1),
+            1.0e-38,
+            FRAC_PI_4,
+            up(FRAC_PI_4),
+            FRAC_PI_2,
+            -FRAC_PI_2,
+            up(FRAC_PI_2),
+            3.0 * FRAC_PI_4,
+            PI,
+            -PI,
+            2.0 * PI,
+            6.0,
+            7.0,
+            -7.0,
+            100.0,
+            -1000.0,
+            8191.5,
+            MAX_ANGLE_RAD,
+            -MAX_ANGLE_RAD,
+        ];
+        for x in ok {
+            assert!(reduced_error(x) <= 1.2e-7, "x = {x}: {}", reduced_error(x));
+        }
+        for (x, want) in [
+            (up(MAX_ANGLE_RAD), AngleError::TooLarge),
+            (-up(MAX_ANGLE_RAD), AngleError::TooLarge),
+            (1.0e5, AngleError::TooLarge),
+            (1.0e30, AngleError::TooLarge),
+            (f32::MAX, AngleError::TooLarge),
+            (-f32::MAX, AngleError::TooLarge),
+            (f32::INFINITY, AngleError::NotFinite),
+            (f32::NEG_INFINITY, AngleError::NotFinite),
+            (f32::NAN, AngleError::NotFinite),
+        ] {
+            assert_eq!(sin_cos_reduced(x), Err(want), "x = {x}");
+            assert_eq!(reduce_angle(x), Err(want), "x = {x}");
+        }
+        // Signs of zero survive.
+        let (s, c) = sin_cos_reduced(-0.0).unwrap();
+        assert!(s == 0.0 && s.is_sign_negative() && c == 1.0);
+        let mut worst = 0.0f32;
+        for i in -400_000..=400_000 {
+            let x = i as f32 * (MAX_ANGLE_RAD / 400_000.0);
+            worst = fmax(worst, reduced_error(x));
+        }
+        for k in (-5215..=5215).filter(|&k| k != 0) {
+            let near = k as f32 * FRAC_PI_2;
+            for d in -8i64..=8 {
+                // Steps of one ulp in magnitude (the sign bit stays).
+                let x = f32::from_bits((i64::from(near.to_bits()) + d) as u32);
+                if x.abs() <= MAX_ANGLE_RAD {
+                    worst = fmax(worst, reduced_error(x));
+                }
+            }
+        }
+        assert!(worst <= 1.2e-7, "worst {worst}");
+    }
+
+    /// Where no reduction happens the reduced functions give the bits of
+    /// the plain ones: the hot path and the checked path agree.
+    #[test]
+    fn reduction_keeps_small_angles_exact() {
+        for i in -78_000..=78_000 {
+            let x = i as f32 * 1.0e-5;
+            let (s, c) = sin_cos(x);
+            let (rs, rc) = sin_cos_reduced(x).unwrap();
+            assert_eq!(
+                (s.to_bits(), c.to_bits()),
+                (rs.to_bits(), rc.to_bits()),
+                "{x}"
+            );
+            assert_eq!(reduce_angle(x).unwrap().to_bits(), x.to_bits(), "{x}");
+        }
+    }
+
+    /// `reduce_angle` gives an angle in `[−π, π]` with the sine and cosine
+    /// of the original: within 4e-7 of `libm`'s (its own error below 2.5e-7
+    /// plus theirs, twice).
+    #[test]
+    fn reduce_angle_is_equivalent_and_in_range() {
+        use core::f32::consts::PI;
+        for i in -400_000..=400_000 {
+            let x = i as f32 * ((MAX_ANGLE_RAD - 1.0e-2) / 400_000.0) + 1.0e-3;
+            let r = reduce_angle(x).unwrap();
+            assert!((-PI..=PI).contains(&r), "{x} -> {r}");
+            let ds = (libm::sinf(r) - libm::sinf(x)).abs();
+            let dc = (libm::cosf(r) - libm::cosf(x)).abs();
+            assert!(ds <= 4.0e-7 && dc <= 4.0e-7, "{x} -> {r}: {ds} {dc}");
         }
     }
 

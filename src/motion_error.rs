@@ -138,10 +138,11 @@ pub(crate) fn spread(
 /// the `x`, `y`, `z` axes) in the rotation moves a rotation-compensated
 /// point at `p` (frame-2 pixels) of a camera with intrinsics
 /// `(f_x, f_y, c_x, c_y)`. See the module docs. Infinite for
-/// `Σ eps > 0.1` rad, where the bound is not claimed.
+/// `Σ |eps| > 0.1` rad (or NaN), where the bound is not claimed; the sign
+/// of a component does not matter (`|ω_k| ≤ |eps_k|`).
 pub fn rotation_shift_bound(p: [f32; 2], cam2: (f32, f32, f32, f32), eps: [f32; 3]) -> f32 {
     let (fx, fy, cx, cy) = cam2;
-    let total = eps[0] + eps[1] + eps[2];
+    let total = eps[0].abs() + eps[1].abs() + eps[2].abs();
     if total.is_nan() || total > 0.1 {
         return f32::INFINITY;
     }

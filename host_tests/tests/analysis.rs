@@ -18,24 +18,28 @@ fn eq_3_2_follows_from_eq_2_2_through_the_tilt_transform() {
         // The transform agrees with an independent rotation about x.
         let (s, c) = (tilt_deg.to_radians().sin(), tilt_deg.to_radians().cos());
         let v = [0.3f32, -0.2, 1.7];
-        let got = vehicle_to_camera(v, tilt);
+        let got = vehicle_to_camera(v, tilt).unwrap();
         let want = [0.3, c * -0.2 - s * 1.7, s * -0.2 + c * 1.7];
         for k in 0..3 {
             assert!((f64::from(got[k]) - want[k]).abs() < 1e-6);
         }
-        let back = camera_to_vehicle(got, tilt);
+        let back = camera_to_vehicle(got, tilt).unwrap();
         for k in 0..3 {
             assert!((back[k] - v[k]).abs() < 1e-6);
         }
         for z in [1.5f64, 3.0, 6.0, 12.0] {
             for w in [0.1f64, 0.2, 0.4] {
-                let p = vehicle_to_camera([0.0, h as f32, z as f32], tilt).map(f64::from);
-                let t = vehicle_to_camera([0.0, 0.0, w as f32], tilt).map(f64::from);
+                let p = vehicle_to_camera([0.0, h as f32, z as f32], tilt)
+                    .unwrap()
+                    .map(f64::from);
+                let t = vehicle_to_camera([0.0, 0.0, w as f32], tilt)
+                    .unwrap()
+                    .map(f64::from);
                 // Eq. 2.2, y component, in the camera frame.
                 let dy = -f * t[1] / (p[2] - t[2]) + f * p[1] * t[2] / (p[2] * (p[2] - t[2]));
-                let lib = f64::from(disparity_tilted(
-                    f as f32, h as f32, w as f32, z as f32, tilt,
-                ));
+                let lib = f64::from(
+                    disparity_tilted(f as f32, h as f32, w as f32, z as f32, tilt).unwrap(),
+                );
                 assert!(
                     (dy - lib).abs() <= 1e-4 * dy.abs() + 1e-5,
                     "θ {tilt_deg}°, Z {z}, W {w}: eq. 2.2 {dy}, eq. 3.2 {lib}"
@@ -54,14 +58,14 @@ fn eq_3_2_follows_from_eq_2_2_through_the_tilt_transform() {
 fn motion_factor_tends_to_n_for_small_motion() {
     let tilt = 23f32.to_radians();
     for n in [1.0f32, 2.0, 3.0, 5.0] {
-        let f_small = motion_factor(n, 0.001, 5.0, tilt);
+        let f_small = motion_factor(n, 0.001, 5.0, tilt).unwrap();
         assert!((f_small - n).abs() < 1e-2 * n, "F({n}) = {f_small}");
         // And it is the ratio of disparities (eq. 3.2) it claims to be.
         let (h, z) = (1.0f32, 4.0f32);
         let zp = h * tilt.sin() + z * tilt.cos();
-        let ratio =
-            disparity_tilted(800.0, h, n * 0.1, z, tilt) / disparity_tilted(800.0, h, 0.1, z, tilt);
-        assert!((motion_factor(n, 0.1, zp, tilt) - ratio).abs() < 1e-4 * ratio);
+        let ratio = disparity_tilted(800.0, h, n * 0.1, z, tilt).unwrap()
+            / disparity_tilted(800.0, h, 0.1, z, tilt).unwrap();
+        assert!((motion_factor(n, 0.1, zp, tilt).unwrap() - ratio).abs() < 1e-4 * ratio);
     }
 }
 
@@ -72,12 +76,18 @@ fn motion_factor_tends_to_n_for_small_motion() {
 fn common_field_motion_stereo_vs_ordinary_stereo() {
     let (h, tilt, f, rows, cols) = (1.0f32, 23f32.to_radians(), 800.0f32, 480.0f32, 512.0f32);
     let half_fov = (rows / 2.0 / f).atan();
-    let (near, far) = ground_interval(h, tilt, half_fov).expect("ground in view");
+    let (near, far) = ground_interval(h, tilt, half_fov)
+        .unwrap()
+        .expect("ground in view");
     println!("ground in view: {near:.2} to {far:.2} (paper: 1.4 to 8.7)");
     // Independent: the lowest ray is tilt + half field below the horizon.
     assert!((f64::from(near) - 1.0 / (f64::from(tilt + half_fov)).tan()).abs() < 1e-4);
-    let m1 = common_rows_motion(h, tilt, f, rows, 0.1).expect("m1");
-    let m2 = common_rows_motion(h, tilt, f, rows, 0.2).expect("m2");
+    let m1 = common_rows_motion(h, tilt, f, rows, 0.1)
+        .unwrap()
+        .expect("m1");
+    let m2 = common_rows_motion(h, tilt, f, rows, 0.2)
+        .unwrap()
+        .expect("m2");
     // Ordinary stereo at the depth where a 0.1 baseline keeps 70 %.
     let z70 = f * 0.1 / (0.3 * cols);
     let s1 = common_columns_stereo(f, cols, 0.1, z70);
@@ -126,7 +136,7 @@ fn reconstructed_points_in_the_vehicle_frame() {
             if pr.status() != roadstereo::Status::Ok {
                 continue;
             }
-            let v = camera_to_vehicle(pc, s.tilt as f32);
+            let v = camera_to_vehicle(pc, s.tilt as f32).unwrap();
             // Truth: the camera-frame truth, rotated by the test's own f64 tilt.
             let t = r.frame1[b][i].camera;
             let (sn, cs) = s.tilt.sin_cos();
@@ -165,10 +175,10 @@ fn axis_misalignment_against_quantisation_error() {
             let a = deg.to_radians();
             // App. II A, computed here in f64.
             let want_e = 800.0 * f64::from(y) / (800.0 * a.cos() - f64::from(y) * a.sin());
-            assert!((f64::from(misaligned_row(y, f, a as f32)) - want_e).abs() < 1e-3);
-            let dq = f64::from(misaligned_disparity(y, y + 10.0, f, a as f32));
-            let de = f64::from(misaligned_row(y + 10.0, f, a as f32))
-                - f64::from(misaligned_row(y, f, a as f32));
+            let row = |y: f32| f64::from(misaligned_row(y, f, a as f32).unwrap());
+            assert!((row(y) - want_e).abs() < 1e-3);
+            let dq = f64::from(misaligned_disparity(y, y + 10.0, f, a as f32).unwrap());
+            let de = row(y + 10.0) - row(y);
             assert!((dq - de).abs() < 1e-3 * de.abs().max(1.0), "{dq} vs {de}");
         }
     }
@@ -180,9 +190,10 @@ fn axis_misalignment_against_quantisation_error() {
             // motion to the far edge (9.06).
             let mut z = 1.2 + w;
             while z <= 9.0 {
-                let mis =
-                    misalignment_depth_error(f, h, tilt, w, z, deg.to_radians()).expect("seen");
-                let q = quantisation_depth_error(disparity_tilted(f, h, w, z, tilt), 1.0);
+                let mis = misalignment_depth_error(f, h, tilt, w, z, deg.to_radians())
+                    .unwrap()
+                    .expect("seen");
+                let q = quantisation_depth_error(disparity_tilted(f, h, w, z, tilt).unwrap(), 1.0);
                 if mis / q > worst_ratio {
                     worst_ratio = mis / q;
                     at = z;

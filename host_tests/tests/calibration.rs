@@ -22,7 +22,7 @@ impl Errors {
         Errors {
             c: (f64::from(k.cx) - t.cx).hypot(f64::from(k.cy) - t.cy),
             roll_deg: (f64::from(k.roll) - t.roll).to_degrees().abs(),
-            r: (f64::from(k.aspect()) / r_true - 1.0).abs(),
+            r: (f64::from(k.aspect().expect("positive focal lengths")) / r_true - 1.0).abs(),
             fx: (f64::from(k.fx) / t.fx - 1.0).abs(),
             fy: (f64::from(k.fy) / t.fy - 1.0).abs(),
         }
@@ -327,4 +327,349 @@ fn calibrated_camera_feeds_the_pipeline() {
     );
     assert!(n >= 100, "{n} depths");
     assert!(worst < 0.02, "worst relative depth error {worst}");
+}
+
+/// Issue 15, item 2: finite inputs used to give `Ok` with infinite
+/// results. The issue's two reproducers are now typed errors (a coordinate
+/// beyond `MAX_COORD_PX`).
+#[test]
+fn issue_15_reproducers_are_typed_errors() {
+    let p = |u: f32, v: f32| Pixel::new(u, v);
+    assert_eq!(
+        calibrate_stepwise(
+            p(256.0, 240.0),
+            [
+                p(1000.0, 1000.0),
+                p(-1e20, 1000.0),
+                p(-500.0, -500.0),
+                p(1000.0, -500.0)
+            ]
+        ),
+        Err(CalibrationError::OutOfRange)
+    );
+    let flows = [
+        Flow {
+            from: p(100.0, 100.0),
+            to: p(90.0, 95.0),
+        },
+        Flow {
+            from: p(400.0, 300.0),
+            to: p(420.0, 310.0),
+        },
+        Flow {
+            from: p(377.5, -1e30),
+            to: p(-9597.0, -1e30),
+        },
+    ];
+    assert_eq!(
+        focus_of_expansion::<8>(&flows),
+        Err(CalibrationError::OutOfRange)
+    );
+}
+
+/// Values to put into every input slot: zeros of both signs, subnormals,
+/// ordinary values, the accepted limit `±MAX_COORD_PX`, just beyond it,
+/// ±1e30, ±f32::MAX, ±inf, NaN.
+fn extremes() -> Vec<f32> {
+    use roadstereo::calibration::MAX_COORD_PX;
+    vec![
+        0.0,
+        -0.0,
+        f32::from_bits(1),
+        -f32::from_bits(1),
+        1.0e-30,
+        1.0,
+        -3.0,
+        300.0,
+        1.0e5,
+        MAX_COORD_PX,
+        -MAX_COORD_PX,
+        MAX_COORD_PX * 1.000_001,
+        1.0e30,
+        -1.0e30,
+        f32::MAX,
+        -f32::MAX,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+    ]
+}
+
+fn finite_foe(f: &roadstereo::calibration::FoeFit) -> bool {
+    f.foe.u.is_finite() && f.foe.v.is_finite() && f.rms.is_finite()
+}
+
+fn finite_intrinsics(k: &Intrinsics) -> bool {
+    [k.cx, k.cy, k.roll, k.fx, k.fy]
+        .iter()
+        .all(|x| x.is_finite())
+}
+
+/// The rule: every result is finite or it is a typed error. Each input
+/// coordinate of `focus_of_expansion`, `calibrate_stepwise` and
+/// `calibrate_jointly` in turn takes every extreme value; a finite value
+/// beyond `±MAX_COORD_PX` is `OutOfRange`, a NaN or infinite one
+/// `NotFinite` (`BadTranslation` in a translation), and every `Ok` has only
+/// finite numbers.
+#[test]
+fn extreme_inputs_give_finite_results_or_typed_errors() {
+    use roadstereo::calibration::MAX_COORD_PX;
+    let cam = TrueCamera::default();
+    let (sets, stepwise, _) = calibrate_run(&cam, &paper_motions(), 15, 0.0, 5).expect("run");
+    let in_range = |x: f32| x.abs() <= MAX_COORD_PX;
+    // The error a bad coordinate must give.
+    let want = |x: f32| {
+        if !x.is_finite() {
+            CalibrationError::NotFinite
+        } else {
+            CalibrationError::OutOfRange
+        }
+    };
+    let (mut ok, mut err) = (0, 0);
+    // focus_of_expansion: every coordinate of the first four flows.
+    let base: Vec<Flow> = sets[1].clone();
+    for slot in 0..16 {
+        for x in extremes() {
+            let mut flows = base.clone();
+            let f = &mut flows[slot / 4];
+            match slot % 4 {
+                0 => f.from.u = x,
+                1 => f.from.v = x,
+                2 => f.to.u = x,
+                _ => f.to.v = x,
+            }
+            match focus_of_expansion::<64>(&flows) {
+                Ok(fit) => {
+                    assert!(in_range(x) && finite_foe(&fit), "slot {slot}, {x}: {fit:?}");
+                    ok += 1;
+                }
+                Err(e) => {
+                    if !in_range(x) {
+                        assert_eq!(e, want(x), "slot {slot}, {x}");
+                    }
+                    err += 1;
+                }
+            }
+        }
+    }
+    // calibrate_stepwise: every coordinate of the five FOEs.
+    let foes: Vec<Pixel> = (0..5)
+        .map(|m| {
+            let f = cam.foe(paper_motions()[m]);
+            Pixel::new(f[0] as f32, f[1] as f32)
+        })
+        .collect();
+    for slot in 0..10 {
+        for x in extremes() {
+            let mut p = foes.clone();
+            if slot % 2 == 0 {
+                p[slot / 2].u = x;
+            } else {
+                p[slot / 2].v = x;
+            }
+            match calibrate_stepwise(p[0], [p[1], p[2], p[3], p[4]]) {
+                Ok(k) => {
+                    assert!(
+                        in_range(x) && finite_intrinsics(&k),
+                        "slot {slot}, {x}: {k:?}"
+                    );
+                    ok += 1;
+                }
+                Err(e) => {
+                    if !in_range(x) {
+                        assert_eq!(e, want(x), "slot {slot}, {x}");
+                    }
+                    err += 1;
+                }
+            }
+        }
+    }
+    // calibrate_jointly: a flow coordinate, a translation component and
+    // every start parameter.
+    let run_joint = |sets: &[Vec<Flow>], t: &[[f32; 3]], start: &Intrinsics| {
+        let mf: Vec<MotionFlows<'_>> = sets
+            .iter()
+            .zip(t)
+            .map(|(f, &translation)| MotionFlows {
+                translation,
+                flows: f,
+            })
+            .collect();
+        calibrate_jointly::<64>(&mf, start)
+    };
+    let translations: Vec<[f32; 3]> = paper_motions()
+        .iter()
+        .map(|t| t.map(|x| x as f32))
+        .collect();
+    let check = |r: Result<roadstereo::calibration::JointFit, CalibrationError>,
+                 what: &str,
+                 ok: &mut usize,
+                 err: &mut usize| match r {
+        Ok(j) => {
+            let finite = finite_intrinsics(&j.intrinsics)
+                && j.rms.is_finite()
+                && j.sigma.iter().all(|s| s.is_finite());
+            assert!(finite, "{what}: {j:?}");
+            *ok += 1;
+        }
+        Err(_) => *err += 1,
+    };
+    for x in extremes() {
+        let mut s = sets.clone();
+        s[2][0].to.v = x;
+        let r = run_joint(&s, &translations, &stepwise);
+        if !in_range(x) {
+            assert_eq!(r, Err(want(x)), "flow {x}");
+        }
+        check(r, &format!("flow {x}"), &mut ok, &mut err);
+        for c in 0..3 {
+            let mut t = translations.clone();
+            t[3][c] = x;
+            let r = run_joint(&sets, &t, &stepwise);
+            if !x.is_finite() || (c == 2 && x <= 0.0) {
+                assert_eq!(r, Err(CalibrationError::BadTranslation), "t[{c}] = {x}");
+            } else if x.abs() > 1.0e6 {
+                assert_eq!(r, Err(CalibrationError::OutOfRange), "t[{c}] = {x}");
+            }
+            check(r, &format!("t[{c}] = {x}"), &mut ok, &mut err);
+        }
+        for field in 0..5 {
+            let mut k = stepwise;
+            *[&mut k.cx, &mut k.cy, &mut k.roll, &mut k.fx, &mut k.fy][field] = x;
+            let r = run_joint(&sets, &translations, &k);
+            if !x.is_finite() {
+                assert_eq!(r, Err(CalibrationError::NotFinite), "start {field} = {x}");
+            }
+            check(r, &format!("start {field} = {x}"), &mut ok, &mut err);
+        }
+    }
+    println!("extreme inputs: {ok} finite results, {err} typed errors");
+    assert!(ok > 100 && err > 100);
+}
+
+/// Extreme but valid cameras: focal lengths at the pipeline's limit
+/// (1e5 px, FOEs 1e5 px from the centre), a principal point at `(0, 0)`
+/// (zeros of both signs in the FOEs), and a tiny one: step by step from
+/// the exact FOEs (computed in `f64`) recovers the camera to 1e-4 relative
+/// (the FOEs are rounded to `f32`).
+#[test]
+fn exact_foes_of_extreme_cameras_give_the_camera() {
+    for cam in [
+        TrueCamera {
+            fx: 1.0e5,
+            fy: 0.8e5,
+            ..TrueCamera::default()
+        },
+        TrueCamera {
+            cx: 0.0,
+            cy: 0.0,
+            roll: 0.0,
+            ..TrueCamera::default()
+        },
+        TrueCamera {
+            fx: 2.0,
+            fy: 3.0,
+            ..TrueCamera::default()
+        },
+    ] {
+        let p: Vec<Pixel> = paper_motions()
+            .iter()
+            .map(|&t| {
+                let f = cam.foe(t);
+                Pixel::new(f[0] as f32, f[1] as f32)
+            })
+            .collect();
+        let k = calibrate_stepwise(p[0], [p[1], p[2], p[3], p[4]]).expect("calibrates");
+        let rel = |a: f32, b: f64| (f64::from(a) - b).abs() / b.abs().max(1.0);
+        assert!(
+            rel(k.cx, cam.cx) < 1e-4 && rel(k.cy, cam.cy) < 1e-4,
+            "{k:?}"
+        );
+        assert!(
+            rel(k.fx, cam.fx) < 1e-4 && rel(k.fy, cam.fy) < 1e-4,
+            "{k:?}"
+        );
+        assert!((f64::from(k.roll) - cam.roll).abs() < 1e-4, "{k:?}");
+        // The prediction of the recovered camera gives the FOEs back.
+        for (&t, q) in paper_motions().iter().zip(&p) {
+            let r = k.predicted_foe(t.map(|x| x as f32)).expect("finite");
+            let scale = f64::from(q.u - k.cx).hypot(f64::from(q.v - k.cy));
+            assert!(f64::from(r.u - q.u).hypot(f64::from(r.v - q.v)) < 1e-4 * scale + 1e-3);
+        }
+    }
+}
+
+/// The intrinsics' own methods: a result is finite or a typed error.
+#[test]
+fn intrinsics_methods_are_finite_or_typed_errors() {
+    let k = Intrinsics {
+        cx: 256.0,
+        cy: 240.0,
+        roll: 0.0,
+        fx: 600.0,
+        fy: 800.0,
+    };
+    assert_eq!(k.aspect(), Ok(0.75));
+    let with = |fx: f32, fy: f32| Intrinsics { fx, fy, ..k };
+    assert_eq!(
+        with(f32::MAX, 1.0e-30).aspect(),
+        Err(CalibrationError::Overflow)
+    );
+    assert_eq!(with(0.0, 800.0).aspect(), Err(CalibrationError::Degenerate));
+    assert_eq!(
+        with(600.0, -0.0).aspect(),
+        Err(CalibrationError::Degenerate)
+    );
+    assert_eq!(
+        with(f32::NAN, 800.0).aspect(),
+        Err(CalibrationError::NotFinite)
+    );
+    assert_eq!(with(1.0e-45, 1.0).aspect(), Ok(1.0e-45));
+    // predicted_foe: finite or typed.
+    assert_eq!(
+        with(f32::MAX, 800.0).predicted_foe([2.0, 0.0, 1.0]),
+        Err(CalibrationError::Overflow)
+    );
+    assert_eq!(
+        k.predicted_foe([1.0e6, 0.0, 1.0e-45]),
+        Err(CalibrationError::Overflow)
+    );
+    assert_eq!(
+        k.predicted_foe([2.0e6, 0.0, 1.0]),
+        Err(CalibrationError::OutOfRange)
+    );
+    assert_eq!(
+        k.predicted_foe([0.0, f32::NAN, 1.0]),
+        Err(CalibrationError::BadTranslation)
+    );
+    assert_eq!(
+        k.predicted_foe([0.0, 0.0, -0.0]),
+        Err(CalibrationError::BadTranslation)
+    );
+    let p = k
+        .predicted_foe([0.0, 0.0, 1.0e-45])
+        .expect("straight ahead");
+    assert_eq!((p.u, p.v), (256.0, 240.0));
+    assert_eq!(
+        Intrinsics {
+            cy: f32::INFINITY,
+            ..k
+        }
+        .predicted_foe([0.0, 0.0, 1.0]),
+        Err(CalibrationError::NotFinite)
+    );
+    // camera: validated by Camera::new.
+    assert!(matches!(
+        with(f32::MAX, 800.0).camera(512, 480),
+        Err(CalibrationError::Camera(_))
+    ));
+    // camera_motion: a result Motion::new rejects is a typed error.
+    let robot = roadstereo::Motion::new([1.0e6, 1.0e6, 0.0], [0.0; 3]).expect("valid");
+    let rolled = Intrinsics { roll: 0.5, ..k };
+    assert_eq!(
+        rolled.camera_motion(&robot),
+        Err(CalibrationError::Motion(
+            roadstereo::MotionError::TranslationTooLarge
+        ))
+    );
 }

@@ -183,3 +183,178 @@ fn key_frames_narrow_the_ranges() {
         }
     }
 }
+
+/// A straight road of width 2.6 on a plane 1.5 below a camera tilted 20°
+/// down (vehicle frame of `roadstereo::analysis`), both edges seen from
+/// 4 to 20 ahead, `n` points each, computed in `f64`: the exact normalised
+/// coordinates and a stick of ±2 % around the exact camera depth.
+fn planar_road(n: usize) -> (Vec<Sample>, Vec<Sample>) {
+    let (h, tilt) = (1.5f64, 20f64.to_radians());
+    let (s, c) = tilt.sin_cos();
+    let edge = |x: f64| -> Vec<Sample> {
+        (0..n)
+            .map(|i| {
+                let z = 4.0 + 16.0 * i as f64 / (n - 1) as f64;
+                let (yc, zc) = (h * c - z * s, z * c + h * s);
+                Sample {
+                    x: (x / zc) as f32,
+                    y: (yc / zc) as f32,
+                    z_near: (zc * 0.98) as f32,
+                    z_far: (zc * 1.02) as f32,
+                }
+            })
+            .collect()
+    };
+    (edge(-1.3), edge(1.3))
+}
+
+/// Runs `f` on another thread and fails the test if it has not returned
+/// within `secs` seconds (a hang is a failure, not a stuck test run).
+fn within_seconds<T: Send + 'static>(secs: u64, f: impl FnOnce() -> T + Send + 'static) -> T {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(f());
+    });
+    rx.recv_timeout(std::time::Duration::from_secs(secs))
+        .expect("road_geometry did not return within the time limit")
+}
+
+/// The planar road gives ranges containing the truth (height 1.5, tilt
+/// 20°, width 2.6), also with extreme samples that are still accepted
+/// (coordinates at ±`MAX_NORMALISED`, sticks from 0 to `MAX_SAMPLE_DEPTH`,
+/// subnormal and signed-zero coordinates), and every range end is finite.
+#[test]
+fn planar_road_gives_the_truth_also_with_extreme_accepted_samples() {
+    use roadstereo::geometry::{MAX_NORMALISED, MAX_SAMPLE_DEPTH};
+    let (left, mut right) = planar_road(12);
+    let check = |g: &RoadGeometry| {
+        for r in [g.height, g.tilt, g.width] {
+            assert!(
+                r.lo.is_finite() && r.hi.is_finite() && r.lo <= r.hi,
+                "{g:?}"
+            );
+        }
+        assert!(g.height.contains(1.5), "{g:?}");
+        assert!(g.tilt.contains(20f32.to_radians()), "{g:?}");
+        assert!(g.width.contains(2.6), "{g:?}");
+        // Not vacuous: well inside what any camera could have.
+        assert!(g.height.lo >= 1.0 && g.height.hi <= 2.0, "{g:?}");
+        assert!(g.width.lo >= 2.0 && g.width.hi <= 3.2, "{g:?}");
+    };
+    let g = within_seconds(30, {
+        let (l, r) = (left.clone(), right.clone());
+        move || road_geometry::<64>(&[(&l, &r)], 0)
+    })
+    .expect("geometry");
+    println!("planar road: {:?}", cells(&g));
+    check(&g);
+    // Vacuous sticks (consistent with every height) at the accepted limits,
+    // on the boundary whose distances the width takes the median of (13 or
+    // more values, at most 5 of them off the true 2.6).
+    let vacuous = |x: f32, y: f32| Sample {
+        x,
+        y,
+        z_near: 0.0,
+        z_far: MAX_SAMPLE_DEPTH,
+    };
+    right.extend([
+        vacuous(MAX_NORMALISED, MAX_NORMALISED),
+        vacuous(-MAX_NORMALISED, 1.0),
+        vacuous(1.0e-40, 0.5),
+        vacuous(-0.0, 0.3),
+    ]);
+    let g = within_seconds(30, {
+        let (l, r) = (left.clone(), right.clone());
+        move || road_geometry::<64>(&[(&l, &r)], 0)
+    })
+    .expect("geometry");
+    check(&g);
+    // A sample whose ray never meets the ground ahead (y = −MAX_NORMALISED)
+    // disagrees at every tilt: one allowed outlier absorbs it.
+    right.push(vacuous(0.0, -MAX_NORMALISED));
+    let g = within_seconds(30, {
+        let (l, r) = (left.clone(), right.clone());
+        move || road_geometry::<64>(&[(&l, &r)], 1)
+    })
+    .expect("geometry");
+    check(&g);
+}
+
+/// Issue 15, item 1: `road_geometry` never returned when a sample had
+/// `z_far = inf`, `z_near = NaN` or `z_far = 3e38` (10 + 10 samples, one
+/// with `y = 1.0`). Every bad sample is now a typed error naming it, and
+/// every call returns within the time limit.
+#[test]
+fn bad_samples_are_typed_errors_and_never_hang() {
+    use roadstereo::geometry::{GeometryError, SampleIndex, MAX_NORMALISED, MAX_SAMPLE_DEPTH};
+    let (left, right) = planar_road(10);
+    let at = |view, boundary, index| SampleIndex {
+        view,
+        boundary,
+        index,
+    };
+    type Edit = fn(&mut Sample);
+    type Want = fn(SampleIndex) -> GeometryError;
+    let table: [(Edit, Want); 14] = [
+        (|p| p.z_far = f32::INFINITY, GeometryError::NotFinite),
+        (|p| p.z_near = f32::NAN, GeometryError::NotFinite),
+        (|p| p.z_far = 3.0e38, GeometryError::OutOfRange),
+        (|p| p.z_far = f32::MAX, GeometryError::OutOfRange),
+        (|p| p.z_near = f32::NEG_INFINITY, GeometryError::NotFinite),
+        (|p| p.x = f32::NAN, GeometryError::NotFinite),
+        (|p| p.y = f32::INFINITY, GeometryError::NotFinite),
+        (|p| p.x = 1.0e30, GeometryError::OutOfRange),
+        (|p| p.y = -1.0e30, GeometryError::OutOfRange),
+        (|p| p.y = MAX_NORMALISED * 1.001, GeometryError::OutOfRange),
+        (
+            |p| p.z_far = MAX_SAMPLE_DEPTH * 1.001,
+            GeometryError::OutOfRange,
+        ),
+        (|p| p.z_near = -1.0e-3, GeometryError::OutOfRange),
+        // An empty stick: near end beyond the far end.
+        (|p| p.z_near = p.z_far * 1.5, GeometryError::OutOfRange),
+        (|p| p.z_far = -1.0, GeometryError::OutOfRange),
+    ];
+    for (row, (edit, want)) in table.iter().enumerate() {
+        for boundary in 0..2 {
+            let (mut l, mut r) = (left.clone(), right.clone());
+            let side = if boundary == 0 { &mut l } else { &mut r };
+            side[3].y = 1.0;
+            edit(&mut side[3]);
+            let got = within_seconds(30, move || road_geometry::<64>(&[(&l, &r)], 0));
+            assert_eq!(got, Err(want(at(0, boundary, 3))), "row {row}");
+        }
+    }
+    // In a later view, reported with that view's index.
+    let (mut l2, r2) = (left.clone(), right.clone());
+    l2[7].z_near = f32::NAN;
+    let views = [(&left[..], &right[..]), (&l2[..], &r2[..])];
+    assert_eq!(
+        road_geometry::<64>(&views, 0),
+        Err(GeometryError::NotFinite(at(1, 0, 7)))
+    );
+    // Counts: too few points, too many points (own variant), too many views.
+    assert_eq!(
+        road_geometry::<64>(&[(&left[..9], &right[..])], 0),
+        Err(GeometryError::TooFewPoints)
+    );
+    assert_eq!(
+        road_geometry::<64>(&[], 0),
+        Err(GeometryError::TooFewPoints)
+    );
+    let (long_l, long_r) = planar_road(65);
+    assert_eq!(
+        road_geometry::<64>(&[(&long_l, &long_r)], 0),
+        Err(GeometryError::TooManyPoints)
+    );
+    let many = vec![(&left[..], &right[..]); roadstereo::geometry::MAX_VIEWS + 1];
+    assert_eq!(
+        road_geometry::<512>(&many, 0),
+        Err(GeometryError::TooManyViews)
+    );
+    // The errors say what and where.
+    assert_eq!(
+        GeometryError::OutOfRange(at(1, 0, 7)).to_string(),
+        "sample 7 of boundary 0 in view 1 is out of range"
+    );
+}

@@ -115,7 +115,7 @@ fn vertical_translation_error_dominates() {
                 for (k, a) in acc.iter_mut().enumerate() {
                     let mut e = [0.0f32; 3];
                     e[k] = 1.0;
-                    let ec = vehicle_to_camera(e, tilt);
+                    let ec = vehicle_to_camera(e, tilt).expect("tilt in range");
                     let d: f32 = (0..3).map(|i| g[i] * ec[i]).sum();
                     *a += f64::from((d / z).abs());
                 }
@@ -315,5 +315,63 @@ fn over_and_under_estimates_match_retriangulation() {
         let med = host_tests::median(r);
         println!("component {comp}: closed form vs pipeline re-run, median relative difference of the change {med:.3} over {n}");
         assert!(n > 100 && med < 0.10, "component {comp}: {med}");
+    }
+}
+
+/// `rotation_shift_bound` at and beyond its range: with `Σ |ε|` at the end
+/// of the claimed range (0.1 rad) it still bounds the shift that brute force measures at every
+/// corner of the error box, whatever the signs of the components; beyond
+/// the end (also through a negative component, which a signed sum let
+/// through) or for NaN it is infinite, the bound not claimed.
+#[test]
+fn rotation_shift_bound_at_and_beyond_its_range() {
+    use roadstereo::motion_error::rotation_shift_bound;
+    use roadstereo::{Camera, PairGeometry, Pixel};
+    let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).unwrap();
+    let intr = (cam.fx(), cam.fy(), cam.cx(), cam.cy());
+    let m = Motion::new([0.0, -0.15, 0.37], [-0.001, 0.08, 0.03]).unwrap();
+    let g0 = PairGeometry::new(&cam, &cam, &m);
+    // Σ |ε| = 0.0999: the end of the range (0.1 / 3 rounds up in f32).
+    let e = 0.0333f32;
+    let mut checked = 0;
+    for signs in [[1.0f32, 1.0, 1.0], [-1.0, 1.0, -1.0]] {
+        let eps = [e * signs[0], e * signs[1], e * signs[2]];
+        for (u, v) in [
+            (0.0f32, 0.0f32),
+            (255.5, 239.5),
+            (511.0, 479.0),
+            (100.0, 400.0),
+        ] {
+            let p1 = Pixel::new(u, v);
+            let Some(c0) = g0.compensate(p1) else {
+                continue;
+            };
+            let bound = rotation_shift_bound(c0.pixel, intr, eps);
+            assert!(bound.is_finite(), "{eps:?}");
+            for corner in 0..8 {
+                let a = m.angles();
+                let da = [0, 1, 2].map(|i| if corner >> i & 1 == 1 { e } else { -e });
+                let mk = Motion::new(m.translation(), [a[0] + da[0], a[1] + da[1], a[2] + da[2]])
+                    .unwrap();
+                let c1 = PairGeometry::new(&cam, &cam, &mk).compensate(p1).unwrap();
+                let shift = (c1.pixel[0] - c0.pixel[0]).hypot(c1.pixel[1] - c0.pixel[1]);
+                assert!(shift <= bound, "({u}, {v}): shift {shift} > bound {bound}");
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 48);
+    for eps in [
+        [0.05f32, 0.05, 1.0e-3],
+        [-1.0, 0.0, 0.0],
+        [-0.06, 0.05, 0.0],
+        [f32::NAN, 0.0, 0.0],
+        [0.0, f32::INFINITY, 0.0],
+    ] {
+        assert_eq!(
+            rotation_shift_bound([255.5, 239.5], intr, eps),
+            f32::INFINITY,
+            "{eps:?}"
+        );
     }
 }

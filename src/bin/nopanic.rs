@@ -98,7 +98,8 @@ fn main() -> ! {
             if let Some(m) = motion.as_ref() {
                 black_box(k.camera_motion(m).ok());
             }
-            black_box(k.predicted_foe(black_box([0.0, 0.0, 1.0])));
+            black_box(k.predicted_foe(black_box([0.0, 0.0, 1.0])).ok());
+            black_box(k.aspect().ok());
         }
     }
 }

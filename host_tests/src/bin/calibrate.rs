@@ -22,7 +22,8 @@ fn errors(k: &Intrinsics, t: &TrueCamera) -> [f64; 5] {
     [
         (f64::from(k.cx) - t.cx).hypot(f64::from(k.cy) - t.cy),
         (f64::from(k.roll) - t.roll).to_degrees().abs(),
-        100.0 * (f64::from(k.aspect()) / (t.fx / t.fy) - 1.0).abs(),
+        100.0
+            * (f64::from(k.aspect().expect("positive focal lengths")) / (t.fx / t.fy) - 1.0).abs(),
         100.0 * (f64::from(k.fx) / t.fx - 1.0).abs(),
         100.0 * (f64::from(k.fy) / t.fy - 1.0).abs(),
     ]
@@ -55,8 +56,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "| aspect r | {:.4} | {:.4} | {:.4} | |",
         cam.fx / cam.fy,
-        s.aspect(),
-        k.aspect()
+        s.aspect()?,
+        k.aspect()?
     );
     println!(
         "| f_x (px) | {:.1} | {:.1} | {:.1} | {:.1} |",

@@ -216,20 +216,17 @@ fn fig3(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
         .enumerate()
     {
         let t = deg.to_radians();
+        let curve = (5..120)
+            .map(|i| {
+                let z = i as f32 * 0.1;
+                disparity_tilted(800.0, 1.0, 0.1, z, t).map(|d| (f64::from(z), f64::from(d)))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
         chart
-            .draw_series(LineSeries::new(
-                (5..120).map(|i| {
-                    let z = i as f32 * 0.1;
-                    (
-                        f64::from(z),
-                        f64::from(disparity_tilted(800.0, 1.0, 0.1, z, t)),
-                    )
-                }),
-                col.stroke_width(2),
-            ))?
+            .draw_series(LineSeries::new(curve, col.stroke_width(2)))?
             .label(format!("tilt {deg}°"))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col));
-        if let Some((near, far)) = ground_interval(1.0, t, half_fov) {
+        if let Some((near, far)) = ground_interval(1.0, t, half_fov)? {
             let y = -1.5 - 1.5 * k as f64;
             chart.draw_series(std::iter::once(PathElement::new(
                 vec![(f64::from(near), y), (f64::from(far.min(12.0)), y)],
@@ -261,17 +258,14 @@ fn fig4(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
     chart.configure_mesh().x_desc("n").y_desc("F").draw()?;
     let t = 23f32.to_radians();
     for (zp, col) in [(1.5f32, RED), (3.0, BLUE), (6.0, GREEN), (12.0, BLACK)] {
+        let curve = (10..=100)
+            .map(|i| {
+                let n = i as f32 * 0.1;
+                motion_factor(n, 0.1, zp, t).map(|f| (f64::from(n), f64::from(f.min(25.0))))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
         chart
-            .draw_series(LineSeries::new(
-                (10..=100).map(|i| {
-                    let n = i as f32 * 0.1;
-                    (
-                        f64::from(n),
-                        f64::from(motion_factor(n, 0.1, zp, t).min(25.0)),
-                    )
-                }),
-                col.stroke_width(2),
-            ))?
+            .draw_series(LineSeries::new(curve, col.stroke_width(2)))?
             .label(format!("Z' = {zp}"))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col));
     }
@@ -318,28 +312,30 @@ fn fig_a2(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
             .map(|i| 1.2 + w + i as f32 * 0.1)
             .filter(|z| *z <= 9.0)
             .collect();
+        let quantisation = zs
+            .iter()
+            .map(|&z| {
+                let q = quantisation_depth_error(disparity_tilted(800.0, 1.0, w, z, t)?, 1.0);
+                Ok((f64::from(z), f64::from(q.min(0.12))))
+            })
+            .collect::<Result<Vec<_>, roadstereo::AngleError>>()?;
         chart
-            .draw_series(AreaSeries::new(
-                zs.iter().map(|&z| {
-                    let q = quantisation_depth_error(disparity_tilted(800.0, 1.0, w, z, t), 1.0);
-                    (f64::from(z), f64::from(q.min(0.12)))
-                }),
-                0.0,
-                BLACK.mix(0.15),
-            ))?
+            .draw_series(AreaSeries::new(quantisation, 0.0, BLACK.mix(0.15)))?
             .label("quantisation, e = 1 px")
             .legend(|(x, y)| {
                 Rectangle::new([(x, y - 4), (x + 20, y + 4)], BLACK.mix(0.15).filled())
             });
         for (deg, col) in [(1.0f32, BLUE), (2.0, RED), (3.0, GREEN)] {
+            let curve = zs
+                .iter()
+                .filter_map(|&z| {
+                    misalignment_depth_error(800.0, 1.0, t, w, z, deg.to_radians())
+                        .map(|e| e.map(|e| (f64::from(z), f64::from(e.min(0.12)))))
+                        .transpose()
+                })
+                .collect::<Result<Vec<_>, _>>()?;
             chart
-                .draw_series(LineSeries::new(
-                    zs.iter().filter_map(|&z| {
-                        misalignment_depth_error(800.0, 1.0, t, w, z, deg.to_radians())
-                            .map(|e| (f64::from(z), f64::from(e.min(0.12))))
-                    }),
-                    col.stroke_width(2),
-                ))?
+                .draw_series(LineSeries::new(curve, col.stroke_width(2)))?
                 .label(format!("axis error {deg}°"))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col));
         }
@@ -361,7 +357,7 @@ fn fig10(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
     let r = s.render();
     let m = r.motion();
     let tilt = s.tilt as f32;
-    let robot = camera_to_vehicle(m.translation(), tilt);
+    let robot = camera_to_vehicle(m.translation(), tilt)?;
     let travel = robot.iter().map(|x| x * x).sum::<f32>().sqrt();
     let top = |mm: &Motion| -> Vec<(f64, f64)> {
         let cam = k.camera();
@@ -378,10 +374,9 @@ fn fig10(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
             .flat_map(|b| b.points().iter())
             .filter(|q| q.status() == Status::Ok)
             .filter_map(|q| st.point(q))
-            .map(|pt| {
-                let v = camera_to_vehicle(pt, tilt);
-                (f64::from(v[0]), f64::from(v[2]))
-            })
+            // The tilt was accepted above, so every call succeeds.
+            .filter_map(|pt| camera_to_vehicle(pt, tilt).ok())
+            .map(|v| (f64::from(v[0]), f64::from(v[2])))
             .collect()
     };
     let path = dir.join("fig10_translation_error.svg");
@@ -411,7 +406,7 @@ fn fig10(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
                 let len = tr.iter().map(|x| x * x).sum::<f32>().sqrt();
                 tr = tr.map(|x| x * travel / len);
             }
-            let mm = Motion::new(vehicle_to_camera(tr, tilt), m.angles())?;
+            let mm = Motion::new(vehicle_to_camera(tr, tilt)?, m.angles())?;
             chart.draw_series(top(&mm).into_iter().map(|p| Circle::new(p, 2, col)))?;
         }
         chart.draw_series(base.iter().map(|&p| Circle::new(p, 1, BLACK.filled())))?;

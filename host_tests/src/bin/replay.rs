@@ -1,11 +1,14 @@
 //! Replay frames from JSON Lines through the processor and write JSON Lines
 //! results: `replay [INPUT.jsonl] [OUTPUT.jsonl]` (default stdin/stdout).
-//! A bad line gives an error line (and a message on stderr) naming the line
-//! and the field; processing goes on with the next line.
+//! A bad line (bad JSON, a bad field, text after the object, bytes that
+//! are not UTF-8) gives an error line (and a message on stderr) naming the
+//! line and the field; processing goes on with the next line. Exit code 0
+//! if every line was accepted, 1 if some were rejected, 2 if reading or
+//! writing failed.
 
 use std::io::{BufRead, BufReader, Write};
 
-use host_tests::jsonl::process_line;
+use host_tests::jsonl::replay;
 use roadstereo::{Config, Processor};
 
 /// Capacity of the replay processor: up to 1024 points per boundary.
@@ -36,32 +39,15 @@ fn main() -> std::process::ExitCode {
         },
     };
     let mut p = Box::new(Processor::<N, B>::new(Config::default()));
-    let mut errors = 0;
-    for (i, line) in input.lines().enumerate() {
-        let text = match line {
-            Ok(t) => t,
-            Err(e) => {
-                eprintln!("replay: read error: {e}");
-                return std::process::ExitCode::from(2);
-            }
-        };
-        if text.trim().is_empty() {
-            continue;
-        }
-        let out = process_line(&mut p, i + 1, &text);
-        if let Some(e) = &out.error {
+    let done = match replay(&mut p, input, &mut output, |e| eprintln!("replay: {e}")) {
+        Ok(done) => done,
+        Err(e) => {
             eprintln!("replay: {e}");
-            errors += 1;
+            let _ = output.flush();
+            return std::process::ExitCode::from(2);
         }
-        match serde_json::to_string(&out) {
-            Ok(s) => {
-                if writeln!(output, "{s}").is_err() {
-                    return std::process::ExitCode::from(2);
-                }
-            }
-            Err(e) => eprintln!("replay: {e}"),
-        }
-    }
+    };
+    let errors = done.errors;
     let _ = output.flush();
     if errors > 0 {
         eprintln!("replay: {errors} line(s) rejected");

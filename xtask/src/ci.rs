@@ -60,6 +60,8 @@ pub fn ci() -> Result<(), String> {
     }
     // The README's test command.
     test()?;
+    // A board's firmware crate links with its own memory map.
+    crate::downstream::downstream()?;
     // The firmware on the emulated controller: the demo, compared frame by
     // frame with the host build, then the benchmark, budgets and proofs.
     demo(true)?;

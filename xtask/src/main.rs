@@ -32,6 +32,7 @@ mod ci;
 mod cycles;
 mod demo;
 mod disasm;
+mod downstream;
 mod firmware;
 mod profile;
 mod setup;
@@ -56,6 +57,7 @@ fn main() -> ExitCode {
         "bench" => bench_args(rest).and_then(|b| bench(&b)),
         "figures" => ci::figures(),
         "ci" => ci::ci(),
+        "downstream" => downstream::downstream(),
         "profile" if rest.iter().any(|a| a == "--help" || a == "-h") => {
             println!("{}", profile::PROFILE_USAGE);
             Ok(())
@@ -65,7 +67,7 @@ fn main() -> ExitCode {
         "setup" => setup::setup_emulator(),
         _ => {
             eprintln!(
-                "usage: cargo xtask <test|demo [--check]|stream FILE [options]|bench [options]|profile [options]|figures|ci|setup>"
+                "usage: cargo xtask <test|demo [--check]|stream FILE [options]|bench [options]|profile [options]|figures|downstream|ci|setup>"
             );
             return ExitCode::from(2);
         }

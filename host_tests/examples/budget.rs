@@ -12,7 +12,9 @@ fn main() {
             let c = p.structure().status_counts();
             let o = c[Status::OverBudget as usize];
             over += o;
-            if o > worst.0 { worst = (o, seed); }
+            if o > worst.0 {
+                worst = (o, seed);
+            }
             ok += c[Status::Ok as usize];
             total += c.iter().sum::<usize>();
         }

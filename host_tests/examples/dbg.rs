@@ -1,6 +1,8 @@
 use roadstereo::{Config, Frame, Motion, Pixel, Processor};
 fn main() {
-    let path = std::env::args().nth(1).unwrap_or("../src/bin/data/bench_256.bin".into());
+    let path = std::env::args()
+        .nth(1)
+        .unwrap_or("../src/bin/data/bench_256.bin".into());
     let b = std::fs::read(path).unwrap();
     let (cam, frames) = host_tests::drive::decode(&b).unwrap();
     let mut p = Processor::<512, 2>::new(Config::DEFAULT);
@@ -14,7 +16,9 @@ fn main() {
         if let Ok(roadstereo::Step::Structure(s)) = p.process(&fr, m.as_ref()) {
             for b in s.boundaries() {
                 let mut c = std::collections::BTreeMap::new();
-                for r in b.points() { *c.entry(format!("{:?}", r.status())).or_insert(0) += 1; }
+                for r in b.points() {
+                    *c.entry(format!("{:?}", r.status())).or_insert(0) += 1;
+                }
                 println!("{c:?}");
             }
         }

@@ -14,13 +14,37 @@ fn main() {
             let delta = 0.05 * travel;
             let mut g = synth::Rng(seed ^ 0xA5A5);
             let used = t.map(|x| x + (g.uniform(-1.0, 1.0) as f32) * delta);
-            (Motion::new(used, m.angles()).unwrap(), Config::default().with_translation_error(delta).unwrap().with_work_budget(std::env::var("WB").ok().and_then(|s| s.parse().ok()).unwrap_or(40)).unwrap())
+            (
+                Motion::new(used, m.angles()).unwrap(),
+                Config::default()
+                    .with_translation_error(delta)
+                    .unwrap()
+                    .with_work_budget(
+                        std::env::var("WB")
+                            .ok()
+                            .and_then(|s| s.parse().ok())
+                            .unwrap_or(40),
+                    )
+                    .unwrap(),
+            )
         } else if mode == "r" {
             let eps = 0.3f32.to_radians();
             let mut g = synth::Rng(seed ^ 0x5A5A);
             let a = m.angles();
             let used = [0, 1, 2].map(|i| a[i] + (g.uniform(-1.0, 1.0) as f32) * eps);
-            (Motion::new(m.translation(), used).unwrap(), Config::default().with_rotation_error([eps; 3]).unwrap().with_work_budget(std::env::var("WB").ok().and_then(|s| s.parse().ok()).unwrap_or(40)).unwrap())
+            (
+                Motion::new(m.translation(), used).unwrap(),
+                Config::default()
+                    .with_rotation_error([eps; 3])
+                    .unwrap()
+                    .with_work_budget(
+                        std::env::var("WB")
+                            .ok()
+                            .and_then(|s| s.parse().ok())
+                            .unwrap_or(40),
+                    )
+                    .unwrap(),
+            )
         } else {
             (m, Config::default())
         };
@@ -34,7 +58,9 @@ fn main() {
         }
     }
     for (c, s) in tot.iter().zip(Status::ALL) {
-        if *c > 0 { print!("{}={} ", s.name(), c); }
+        if *c > 0 {
+            print!("{}={} ", s.name(), c);
+        }
     }
     println!();
 }

@@ -11,7 +11,9 @@ fn main() {
     let s = if let Some(seed) = name.strip_prefix("random_") {
         scenarios::random(seed.parse().unwrap())
     } else if let Some((fam, seed)) = name.split_once(':') {
-        scenarios::Family::from_name(fam).unwrap().scenario(seed.parse().unwrap())
+        scenarios::Family::from_name(fam)
+            .unwrap()
+            .scenario(seed.parse().unwrap())
     } else {
         scenarios::named()
             .into_iter()

@@ -9,7 +9,10 @@ use host_tests::{frame, scenarios, synth, B, N};
 use roadstereo::{Config, PointResult, Processor, Status, Step, Structure};
 
 /// The first point where two structures differ, for the message.
-fn first_difference(a: &Structure<N, B>, b: &Structure<N, B>) -> Option<(usize, usize, PointResult, PointResult)> {
+fn first_difference(
+    a: &Structure<N, B>,
+    b: &Structure<N, B>,
+) -> Option<(usize, usize, PointResult, PointResult)> {
     for (k, (x, y)) in a.boundaries().iter().zip(b.boundaries()).enumerate() {
         for (i, (p, q)) in x.points().iter().zip(y.points()).enumerate() {
             if p != q {
@@ -17,7 +20,12 @@ fn first_difference(a: &Structure<N, B>, b: &Structure<N, B>) -> Option<(usize, 
             }
         }
         if x.points().len() != y.points().len() {
-            return Some((k, x.points().len().min(y.points().len()), PointResult::default(), PointResult::default()));
+            return Some((
+                k,
+                x.points().len().min(y.points().len()),
+                PointResult::default(),
+                PointResult::default(),
+            ));
         }
     }
     None
@@ -35,7 +43,10 @@ fn both(s: &synth::Scenario, quantised: bool) {
     let mut p = Box::new(Processor::<N, B>::new(unlimited));
     assert!(matches!(p.process(&f1, None), Ok(Step::First)));
     let fast = p.process_against_kept(&f2, &m).expect("structure").clone();
-    let slow = p.reference_against_kept(&f2, &m).expect("structure").clone();
+    let slow = p
+        .reference_against_kept(&f2, &m)
+        .expect("structure")
+        .clone();
     if let Some((k, i, a, b)) = first_difference(&fast, &slow) {
         panic!(
             "{} (quantised: {quantised}): boundary {k} point {i}: indexed {a:?}, reference {b:?}",

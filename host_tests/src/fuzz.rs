@@ -40,7 +40,7 @@ impl<'a> Source<'a> {
     /// The seeded generator.
     pub fn seeded(seed: u64) -> Source<'static> {
         Source {
-            kind: Kind::Rng(seed ^ 0x5EED_0F_F022_u64.rotate_left(17)),
+            kind: Kind::Rng(seed ^ 0x0005_EED0_FF02_u64.rotate_left(17)),
             record: None,
         }
     }
@@ -199,6 +199,8 @@ pub struct Outcome {
     /// Calls of the frame path made (`process`, `process_against_kept`,
     /// `reset`), or entry-point calls for the other targets.
     pub calls: u64,
+    /// Frame-path calls that gave a structure (0 for the other targets).
+    pub reconstructions: u64,
     /// Feature bits of the case (statuses seen, error kinds, paths): a
     /// case with a bit no earlier case had is kept as interesting.
     pub features: u128,
@@ -329,6 +331,8 @@ pub struct Tally {
     pub cases: u64,
     /// Calls made.
     pub calls: u64,
+    /// Reconstructions (frame path).
+    pub reconstructions: u64,
     /// Cases that broke an oracle: seed and message.
     pub findings: Vec<(u64, String)>,
     /// Seconds spent.
@@ -425,6 +429,7 @@ fn pass_target(p: &Pass, target: Target, time: Duration) -> Tally {
                     match r {
                         Ok(o) => {
                             t.calls += o.calls;
+                            t.reconstructions += o.reconstructions;
                             t.known[0] += u64::from(o.features >> frame::KNOWN_F1 & 1 == 1);
                             t.known[1] += u64::from(o.features >> frame::KNOWN_F4 & 1 == 1);
                             if o.features & !t.features != 0 {
@@ -456,6 +461,7 @@ fn pass_target(p: &Pass, target: Target, time: Duration) -> Tally {
         let t = h.join().unwrap_or_default();
         all.cases += t.cases;
         all.calls += t.calls;
+        all.reconstructions += t.reconstructions;
         all.findings.extend(t.findings);
         all.features |= t.features;
         all.known[0] += t.known[0];

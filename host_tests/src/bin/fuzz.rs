@@ -140,6 +140,14 @@ fn main() -> std::process::ExitCode {
             r.slowest.0,
             r.slowest.1
         );
+        if r.reconstructions > 0 {
+            println!(
+                "fuzz: {:<11} {} reconstructions ({:.0}/s)",
+                t.name(),
+                r.reconstructions,
+                r.reconstructions as f64 / r.seconds.max(1e-9)
+            );
+        }
         if r.known != [0, 0] {
             println!(
                 "fuzz: {:<11} known matching-stage findings (indexed != reference, counted, not failed; \

@@ -17,6 +17,9 @@ use roadstereo::{Motion, Pixel};
 
 use super::{Outcome, Source};
 
+/// A flow as drawn: `[from, to]`, each `[u, v]`.
+pub type FlowIn = [[f32; 2]; 2];
+
 /// Capacity of the flows of one motion.
 pub const CAP: usize = 48;
 
@@ -29,7 +32,7 @@ pub enum Case {
     Stepwise([f32; 2], [[f32; 2]; 4]),
     /// [`calibrate_jointly`]: motions (translation, flows) and the start
     /// (`cx, cy, roll, fx, fy`).
-    Joint(Vec<([f32; 3], Vec<[[f32; 2]; 2]>)>, [f32; 5]),
+    Joint(Vec<([f32; 3], Vec<FlowIn>)>, [f32; 5]),
     /// The methods of [`Intrinsics`] (`cx, cy, roll, fx, fy`): `aspect`,
     /// `predicted_foe(t)`, `camera(w, h)`, `camera_motion(robot)`.
     Methods([f32; 5], [f32; 3], (u16, u16), ([f32; 3], [f32; 3])),
@@ -429,5 +432,9 @@ pub fn check(case: &Case) -> Outcome {
             }
         }
     }
-    Outcome { calls, features }
+    Outcome {
+        calls,
+        features,
+        ..Outcome::default()
+    }
 }

@@ -149,7 +149,7 @@ impl Pose {
     }
 
     /// A world point in this camera's axes.
-    fn to_camera(&self, p: [f64; 3]) -> [f64; 3] {
+    fn camera_point(&self, p: [f64; 3]) -> [f64; 3] {
         let d = [p[0] - self.t[0], p[1] - self.t[1], p[2] - self.t[2]];
         [0, 1, 2].map(|j| (0..3).map(|i| self.r[i][j] * d[i]).sum())
     }
@@ -387,7 +387,7 @@ fn boundary(
             let mut out = Vec::with_capacity(n);
             for i in 0..n {
                 let s = near * (far / near).powf(i as f64 / (n - 1).max(1) as f64);
-                let q = pose.to_camera(scene.point(e, s));
+                let q = pose.camera_point(scene.point(e, s));
                 if q[2] <= 1.0e-3 {
                     continue;
                 }
@@ -887,16 +887,12 @@ fn check_structure<const N: usize, const B: usize>(
             set(features, bit::SAMPLES);
         }
     }
-    let _ = samples(
-        s,
-        s.boundaries().len(),
-        &mut heapless::Vec::<Sample, N>::new(),
-    );
 }
 
 /// The indexed matcher with the largest budget and the reference, on a
 /// fresh processor keeping `kept`: they must agree bit for bit; the
-/// reference's structure is returned.
+/// indexed structure is returned (equal to the reference's but for the
+/// known findings, see [`known`]).
 fn matchers<const N: usize, const B: usize>(
     kept: &Frame<N, B>,
     frame: &Frame<N, B>,
@@ -940,6 +936,8 @@ fn matchers<const N: usize, const B: usize>(
 pub const KNOWN_F1: u32 = 127;
 /// The feature bit of the other known matcher differences (F4).
 pub const KNOWN_F4: u32 = 126;
+/// A call that gave a structure (a reconstruction).
+pub const RECONSTRUCTED: u32 = 124;
 
 /// Known findings of the matching stage, reported to its owner and left
 /// to it (that stage is being reworked; tests/fuzz_findings.rs has them
@@ -953,9 +951,12 @@ pub const KNOWN_F4: u32 = 126;
 ///   spread), the index misses a segment the band meets at an end of the
 ///   frame-2 boundary: indexed `no_intersection`, reference
 ///   `boundary_end`.
-/// * F4: other differences, about 1 case in 2 500 of the pass (most
+/// * F4: other differences, about 1 case in 4 000 of the pass (most
 ///   often `unbounded` / `no_intersection` / `ambiguous` where the
-///   reference has `boundary_end`, `ambiguous`, `grazing` or `ok`).
+///   reference has `boundary_end`, `ambiguous`, `grazing` or `ok`); and,
+///   about 1 case in 600, differences other than `over_budget` between
+///   the case's own (smaller) budget and the largest one, mostly
+///   `no_intersection` for `boundary_end` with a motion error configured.
 fn known(
     p: &roadstereo::PointResult,
     q: &roadstereo::PointResult,
@@ -972,8 +973,9 @@ fn known(
     true
 }
 
-/// `got` (the case's budget) against the reference: each point equal, or
-/// over budget; with the largest budget, equal.
+/// `got` (the case's budget) against the indexed matcher with the largest
+/// budget (which equals the reference, see [`matchers`]): each point
+/// equal, or over budget; with the largest budget, equal.
 fn against_reference<const N: usize, const B: usize>(
     got: &Structure<N, B>,
     reference: &Structure<N, B>,
@@ -988,7 +990,7 @@ fn against_reference<const N: usize, const B: usize>(
         .enumerate()
     {
         for (i, (p, q)) in x.points().iter().zip(y.points()).enumerate() {
-            if p != q && !known(p, q, config, features) {
+            if p != q && p.status() != Status::OverBudget && !known(p, q, config, features) {
                 assert_eq!(
                     p.status(),
                     Status::OverBudget,
@@ -1032,6 +1034,7 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
     let mut a = Box::new(Processor::<N, B>::new(config));
     let mut shadow = Box::new(Processor::<N, B>::new(config));
     let mut calls = 0;
+    let mut reconstructions = 0;
     let mut last_camera = None;
     for (n, call) in case.calls.iter().enumerate() {
         calls += 1;
@@ -1078,6 +1081,7 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
                             panic!("{what}: a structure without a kept frame and a motion");
                         };
                         set(&mut features, bit::STRUCTURE);
+                        reconstructions += 1;
                         assert!(
                             a.previous() == Some(&frame),
                             "{what}: the new frame was not kept"
@@ -1117,6 +1121,7 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
                             panic!("{what}: a structure without a kept frame");
                         };
                         set(&mut features, bit::KEPT);
+                        reconstructions += 1;
                         check_structure(&s, k, &config, &mut features);
                         against_reference(&s, r, &config, &mut features);
                         assert!(
@@ -1141,8 +1146,15 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
         }
         assert_same_state(&a, &shadow, &what);
     }
-    Outcome { calls, features }
+    Outcome {
+        calls,
+        reconstructions,
+        features,
+    }
 }
+
+/// A frame's raw polylines.
+type Polylines = Vec<Vec<[f32; 2]>>;
 
 /// Shrink a failing case: drop calls, boundaries, points and
 /// configuration options, and round coordinates, while `fails` still
@@ -1172,7 +1184,7 @@ pub fn shrink(case: &Case, fails: &dyn Fn(&Case) -> bool) -> Case {
                 Call::Reset => continue,
             };
             for (b, pts) in n.iter().enumerate() {
-                let edit = |c: &mut Case, g: &dyn Fn(&mut Vec<Vec<[f32; 2]>>)| {
+                let edit = |c: &mut Case, g: &dyn Fn(&mut Polylines)| {
                     if let Call::Process(f, _) | Call::AgainstKept(f, _) = &mut c.calls[i] {
                         g(&mut f.boundaries);
                     }

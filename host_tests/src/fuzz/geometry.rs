@@ -225,5 +225,6 @@ pub fn check(case: &Case) -> Outcome {
     Outcome {
         calls: 1,
         features: 1u128 << bit,
+        ..Outcome::default()
     }
 }

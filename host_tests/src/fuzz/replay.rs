@@ -266,5 +266,6 @@ pub fn check_input(input: &[u8]) -> Outcome {
     Outcome {
         calls: lines as u64,
         features,
+        ..Outcome::default()
     }
 }

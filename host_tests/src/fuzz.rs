@@ -40,7 +40,7 @@ impl<'a> Source<'a> {
     /// The seeded generator.
     pub fn seeded(seed: u64) -> Source<'static> {
         Source {
-            kind: Kind::Rng(seed ^ 0x0005_EED0_FF02_u64.rotate_left(17)),
+            kind: Kind::Rng(seed ^ 0x005E_ED0F_F022_u64.rotate_left(17)),
             record: None,
         }
     }
@@ -201,6 +201,9 @@ pub struct Outcome {
     pub calls: u64,
     /// Frame-path calls that gave a structure (0 for the other targets).
     pub reconstructions: u64,
+    /// Kept points matched in those reconstructions, and how many got a
+    /// depth.
+    pub points: [u64; 2],
     /// Feature bits of the case (statuses seen, error kinds, paths): a
     /// case with a bit no earlier case had is kept as interesting.
     pub features: u128,
@@ -333,6 +336,8 @@ pub struct Tally {
     pub calls: u64,
     /// Reconstructions (frame path).
     pub reconstructions: u64,
+    /// Points matched and depths given in them.
+    pub points: [u64; 2],
     /// Cases that broke an oracle: seed and message.
     pub findings: Vec<(u64, String)>,
     /// Seconds spent.
@@ -430,6 +435,8 @@ fn pass_target(p: &Pass, target: Target, time: Duration) -> Tally {
                         Ok(o) => {
                             t.calls += o.calls;
                             t.reconstructions += o.reconstructions;
+                            t.points[0] += o.points[0];
+                            t.points[1] += o.points[1];
                             t.known[0] += u64::from(o.features >> frame::KNOWN_F1 & 1 == 1);
                             t.known[1] += u64::from(o.features >> frame::KNOWN_F4 & 1 == 1);
                             if o.features & !t.features != 0 {
@@ -462,6 +469,8 @@ fn pass_target(p: &Pass, target: Target, time: Duration) -> Tally {
         all.cases += t.cases;
         all.calls += t.calls;
         all.reconstructions += t.reconstructions;
+        all.points[0] += t.points[0];
+        all.points[1] += t.points[1];
         all.findings.extend(t.findings);
         all.features |= t.features;
         all.known[0] += t.known[0];

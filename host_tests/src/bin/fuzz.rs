@@ -47,6 +47,32 @@ fn main() -> std::process::ExitCode {
             return std::process::ExitCode::SUCCESS;
         }
     }
+    // `fuzz --pair SEED`: the first frame pair of a (small) frame case
+    // where the indexed matcher and the reference differ, reduced.
+    if let [flag, seed] = args.as_slice() {
+        if flag == "--pair" {
+            use host_tests::fuzz::frame;
+            let Ok(seed) = seed.parse() else {
+                return std::process::ExitCode::from(2);
+            };
+            let case = frame::generate(&mut host_tests::fuzz::Source::seeded(seed));
+            match frame::first_differing_pair(&case) {
+                None => println!("fuzz: seed {seed}: the matchers agree (or a large case)"),
+                Some(p) => {
+                    let p = p.shrink();
+                    println!("{p:?}");
+                    if let Some((a, b)) = p.statuses() {
+                        for (i, (x, y)) in a.iter().zip(&b).enumerate() {
+                            if x != y {
+                                println!("point {i}: indexed {x:?}, reference {y:?}");
+                            }
+                        }
+                    }
+                }
+            }
+            return std::process::ExitCode::SUCCESS;
+        }
+    }
     // `fuzz --shrink SEED`: shrink a failing frame case.
     if let [flag, seed] = args.as_slice() {
         if flag == "--shrink" {
@@ -128,24 +154,27 @@ fn main() -> std::process::ExitCode {
     host_tests::fuzz::quiet_panics();
     let results = pass(&p);
     let mut findings = 0;
-    println!("fuzz: target       cases      calls    seconds   cases/s  slowest case");
+    println!("fuzz: target       cases      calls    seconds   cases/s  features  slowest case");
     for (t, r) in &results {
         println!(
-            "fuzz: {:<11} {:>9} {:>10} {:>10.1} {:>9.0}  {:.3} s (seed {})",
+            "fuzz: {:<11} {:>9} {:>10} {:>10.1} {:>9.0} {:>9}  {:.3} s (seed {})",
             t.name(),
             r.cases,
             r.calls,
             r.seconds,
             r.cases as f64 / r.seconds.max(1e-9),
+            r.features.count_ones(),
             r.slowest.0,
             r.slowest.1
         );
         if r.reconstructions > 0 {
             println!(
-                "fuzz: {:<11} {} reconstructions ({:.0}/s)",
+                "fuzz: {:<11} {} reconstructions ({:.0}/s) of {} points, {} with a depth",
                 t.name(),
                 r.reconstructions,
-                r.reconstructions as f64 / r.seconds.max(1e-9)
+                r.reconstructions as f64 / r.seconds.max(1e-9),
+                r.points[0],
+                r.points[1]
             );
         }
         if r.known != [0, 0] {

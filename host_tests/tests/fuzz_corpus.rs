@@ -101,3 +101,15 @@ fn seeded_smoke_pass() {
         }
     }
 }
+
+/// The per-case time limit catches a case that does not return.
+#[test]
+fn a_case_past_the_time_limit_is_a_failure() {
+    let r = std::panic::catch_unwind(|| {
+        within(Duration::from_millis(50), || {
+            std::thread::sleep(Duration::from_secs(2));
+        })
+    });
+    let msg = host_tests::fuzz::panic_message(&*r.expect_err("must time out"));
+    assert!(msg.contains("hang"), "{msg}");
+}

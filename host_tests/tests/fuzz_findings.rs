@@ -192,3 +192,27 @@ fn f4b_indexed_search_misses_a_grazing_piece() {
     );
     assert_eq!(fast, slow);
 }
+
+/// Issue 11's overflow: a frame-2 boundary that starts exactly at the FOE
+/// made `process` add with overflow (`ceil_i32(+inf)`) in a build with
+/// overflow checks. This file runs in the `checked` profile, so the test
+/// fails on any overflow on that path; the matchers agree there too.
+#[test]
+fn the_issue_11_overflow_case_runs_with_overflow_checks() {
+    let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).unwrap();
+    let (fast, slow) = pair(
+        Config::DEFAULT,
+        cam,
+        cam,
+        &[[100.0, 400.0], [150.0, 300.0]],
+        &[[255.5, 239.5], [255.50043, 239.4991]],
+        ([0.0, 0.0, 0.4], [0.0; 3]),
+    );
+    assert_eq!(fast, slow);
+    let mut p = Processor::<16, 2>::new(Config::DEFAULT);
+    let f1 = frame::<16>(cam, &[&[[100.0, 400.0], [150.0, 300.0]]]);
+    let f2 = frame::<16>(cam, &[&[[255.5, 239.5], [255.50043, 239.4991]]]);
+    let m = Motion::new([0.0, 0.0, 0.4], [0.0; 3]).unwrap();
+    assert!(matches!(p.process(&f1, None), Ok(Step::First)));
+    assert!(matches!(p.process(&f2, Some(&m)), Ok(Step::Structure(_))));
+}

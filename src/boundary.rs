@@ -109,7 +109,9 @@ impl<const N: usize> Boundary<N> {
                     return Err(BoundaryError::Duplicate { index });
                 }
                 let dv = p.v - q.v;
-                if dv == 0.0 || dv * direction < 0.0 {
+                // Compare signs, not the product: two tiny steps (near
+                // v = 0) multiply to -0.0 and would let a turn through.
+                if dv == 0.0 || (direction != 0.0 && (dv > 0.0) != (direction > 0.0)) {
                     return Err(BoundaryError::Unordered { index });
                 }
                 direction = dv;

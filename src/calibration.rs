@@ -491,7 +491,8 @@ impl Intrinsics {
 
     /// Aspect ratio `r = f_x / f_y`: [`CalibrationError::Degenerate`] unless
     /// both focal lengths are positive, [`CalibrationError::Overflow`] if
-    /// the ratio is not finite.
+    /// the ratio is not finite and positive (it overflows, or underflows
+    /// to 0).
     ///
     /// ```
     /// use roadstereo::calibration::{CalibrationError, Intrinsics};
@@ -507,7 +508,9 @@ impl Intrinsics {
             return Err(CalibrationError::Degenerate);
         }
         let r = self.fx / self.fy;
-        r.is_finite().then_some(r).ok_or(CalibrationError::Overflow)
+        (r.is_finite() && r > 0.0)
+            .then_some(r)
+            .ok_or(CalibrationError::Overflow)
     }
 
     /// The FOE this camera predicts for robot translation `t` (finite,

@@ -5,6 +5,7 @@
 pub mod calib;
 pub mod certify;
 pub mod drive;
+pub mod fuzz;
 pub mod jsonl;
 pub mod link;
 pub mod scenarios;

@@ -1,4 +1,4 @@
-//! The host-side tasks: `test`, `figures` and `ci` (everything `.ci/run`
+//! The host-side tasks: `test`, `fuzz`, `figures` and `ci` (everything `.ci/run`
 //! runs).
 
 use crate::bench::{bench, bench_args};
@@ -9,12 +9,33 @@ use crate::stream::stream;
 use crate::util::{root, run, THUMB};
 
 /// The README's test command: the library's unit and doc tests on the host,
-/// then `host_tests`.
+/// then `host_tests` in its `checked` profile (optimised, with overflow
+/// checks and debug assertions on in every crate: an overflow anywhere is
+/// a failing test, issue 15 item 5; the library's own unit tests run in
+/// the dev profile, which has them on too).
 pub fn test() -> Result<(), String> {
     let r = root();
     run(&r, "cargo", &["test", "--target", "host-tuple", "--lib"])?;
     run(&r, "cargo", &["test", "--target", "host-tuple", "--doc"])?;
-    run(&r.join("host_tests"), "cargo", &["test"])
+    run(
+        &r.join("host_tests"),
+        "cargo",
+        &["test", "--profile", "checked"],
+    )
+}
+
+/// Seconds of the fuzz pass in CI, on every core (two on the CI machine):
+/// with its build, about two minutes. The pass is the stable seeded
+/// generator; cargo-fuzz (`fuzz/`, nightly) is for long local runs.
+pub const CI_FUZZ_SECONDS: &str = "110";
+
+/// The seeded fuzz pass (`host_tests/src/bin/fuzz.rs`, stable, the
+/// `checked` profile): `args` go to the pass (`--seconds`, `--threads`,
+/// `--seed`, `--targets`, `--save`, ...); fails on any finding.
+pub fn fuzz(args: &[String]) -> Result<(), String> {
+    let mut all = vec!["run", "--profile", "checked", "--bin", "fuzz", "--"];
+    all.extend(args.iter().map(String::as_str));
+    run(&root().join("host_tests"), "cargo", &all)
 }
 
 /// Re-render `docs/` (figures and the replay example).
@@ -62,6 +83,8 @@ pub fn ci() -> Result<(), String> {
     test()?;
     // A board's firmware crate links with its own memory map.
     crate::downstream::downstream()?;
+    // The fuzz pass, bounded (see `CI_FUZZ_SECONDS`).
+    fuzz(&["--seconds".to_string(), CI_FUZZ_SECONDS.to_string()])?;
     // The firmware on the emulated controller: the demo, compared frame by
     // frame with the host build, then the benchmark, budgets and proofs.
     demo(true)?;

@@ -22,9 +22,15 @@
 //!   beside the instructions, and an annotated disassembly written to
 //!   `target/profile/annotated.txt`; fails when the representative window
 //!   costs more than 718 estimated cycles per point (see `--help`).
+//! * `fuzz`    — the seeded fuzz pass of `host_tests` (frame path,
+//!   calibration, road geometry, replay parser) with its oracles, in the
+//!   overflow-checked `checked` profile; arguments go to the pass
+//!   (`--seconds S --threads T --seed X --targets frame:6,replay:1 --save
+//!   DIR`, `--describe TARGET SEED`, `--shrink SEED`); fails on a finding.
 //! * `figures` — re-render `docs/` (figures and the replay example).
 //! * `ci`      — what `.ci/run` runs: toolchain setup, formatting, clippy,
-//!   thumb builds with and without `defmt`, `test`, then `demo --check`,
+//!   thumb builds with and without `defmt`, `test`, a bounded `fuzz`
+//!   pass, then `demo --check`,
 //!   `bench` and `profile`.
 
 mod bench;
@@ -49,6 +55,7 @@ fn main() -> ExitCode {
     let rest = args.get(1..).unwrap_or(&[]);
     let result = match task.as_str() {
         "test" => ci::test(),
+        "fuzz" => ci::fuzz(rest),
         "demo" => demo::demo(rest.iter().any(|a| a == "--check")),
         "bench" if rest.iter().any(|a| a == "--help" || a == "-h") => {
             println!("{BENCH_USAGE}");
@@ -67,7 +74,7 @@ fn main() -> ExitCode {
         "setup" => setup::setup_emulator(),
         _ => {
             eprintln!(
-                "usage: cargo xtask <test|demo [--check]|stream FILE [options]|bench [options]|profile [options]|figures|downstream|ci|setup>"
+                "usage: cargo xtask <test|fuzz [options]|demo [--check]|stream FILE [options]|bench [options]|profile [options]|figures|downstream|ci|setup>"
             );
             return ExitCode::from(2);
         }

@@ -293,7 +293,9 @@ impl Band {
     #[inline(always)]
     pub(crate) fn key_half_width(&self, near_foe: f32, exhaustive: bool, key_scale: f32) -> Reach {
         const FLOOR: f32 = 4.0 * 9.536_743e-7;
-        if self.w > 0.0 {
+        // (The band reaches behind the FOE when ρ₁ ≤ r₁ + e₂, where
+        // `foe_inv` is not positive: every key. A NaN fails.)
+        if self.w > 0.0 && self.foe_inv > 0.0 && self.foe_inv < f32::INFINITY {
             Reach::Within(
                 self.half_angle * (1.0 + 1.0e-5),
                 key_scale * self.foe_inv * (1.0 + 1.0e-5) + FLOOR,

@@ -44,7 +44,7 @@
 //! vertex's key by its own margin. The unit test `keys_are_within_their_margin`
 //! checks the margins against keys computed in `f64`.
 
-use crate::math::{dot, fmax, sub};
+use crate::math::{dot, fmax, fmin, sub};
 
 /// "No key": the point is too close to the FOE (or its row) to be keyed
 /// reliably, or is not a finite point.
@@ -223,35 +223,53 @@ impl Keying {
         if k.is_finite() {
             return Some((k - m, k + m));
         }
-        let Pencil::Half { foe, side, .. } = self.pencil else {
-            // A pseudo-angle key is missing only within a pixel of the
-            // FOE, which the processor flags before it asks.
-            return None;
+        // The ray through p has no key of its own: a half-plane key's
+        // point is within t_min of the FOE's row or beyond it, a
+        // pseudo-angle's within a pixel of the FOE.
+        let (foe, side) = match self.pencil {
+            Pencil::Half { foe, side, .. } => (foe, Some(side)),
+            Pencil::Angular { foe } => (foe, None),
+            Pencil::Projective { .. } => return None,
         };
-        // The ray through p has no half-plane key (it is within t_min of
-        // the FOE's row or on the other side). Its two edge directions
-        // d ± t·perp(d) (at exactly ±atan t) bound the range; a direction
-        // outside the half-plane stands for the key limit ±1 on its side.
         let d = sub(p, foe);
+        let n2 = dot(d, d);
+        // (A NaN fails.)
+        if !(n2 > 0.0) {
+            return Some((f32::NEG_INFINITY, f32::INFINITY));
+        }
+        let Some(side) = side else {
+            // The pseudo-angle of d itself, with the margin `key` would
+            // give it (valid at any distance from the FOE).
+            let (k, inv) = pseudo_angle_with_inverse(d);
+            let m = t + (self.key_scale * inv + 4.0 * ULP20);
+            return Some((k - m, k + m));
+        };
+        // The rays within atan t of d (less than a half-turn in all) meet
+        // the half-plane in one arc, whose ends are edge directions
+        // d ± t·perp(d) inside the half-plane or the row's directions
+        // (keys −1 and +1, left and right) inside the wedge: the key range
+        // spans those ends.
         let perp = [-d[1], d[0]];
-        let edge = |s: f32| {
+        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+        for s in [-1.0f32, 1.0] {
             let e = [d[0] + s * t * perp[0], d[1] + s * t * perp[1]];
             let tt = side * e[1];
             if tt > 0.0 {
-                (e[0] / (e[0].abs() + tt), true)
-            } else if e[0] >= 0.0 {
-                (1.0, false)
-            } else {
-                (-1.0, false)
+                let key = e[0] / (e[0].abs() + tt);
+                (lo, hi) = (fmin(lo, key), fmax(hi, key));
             }
-        };
-        let ((k0, in0), (k1, in1)) = (edge(-1.0), edge(1.0));
-        if !in0 && !in1 && k0 == k1 {
-            // Both edges outside, on the same side: the rays miss it.
-            return None;
         }
-        let (lo, hi) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
-        Some((lo - self.eps, hi + self.eps))
+        // The row's direction (±1, 0) is within atan t of d when its cosine
+        // to d, ±d_u/|d|, is at least 1/√(1 + t²) (a little lower, for
+        // rounding).
+        let within = d[0] * d[0] * (1.0 + t * t) * (1.0 + 1.0e-5) >= n2;
+        for (row, key) in [(d[0] > 0.0, 1.0f32), (d[0] < 0.0, -1.0)] {
+            if within && row {
+                (lo, hi) = (fmin(lo, key), fmax(hi, key));
+            }
+        }
+        // (Empty: the rays miss the half-plane.)
+        (lo <= hi).then_some((lo - self.eps, hi + self.eps))
     }
 }
 
@@ -413,5 +431,82 @@ mod tests {
             }
         }
         assert!(checked.iter().all(|&c| c > 10_000), "{checked:?}");
+    }
+
+    /// `Keying::around` for a point without a key of its own (beyond or
+    /// near the FOE's row for half-plane keys, within a pixel of the FOE
+    /// for pseudo-angles) holds the exact key of every direction within
+    /// `atan t` of the point's, for narrow and very wide wedges (`f64`).
+    #[test]
+    fn around_holds_every_direction_of_the_wedge() {
+        let mut rng = Rng(0xa20d_0003);
+        let mut checked = 0;
+        for case in 0..20_000 {
+            let foe = [512.0 * rng.next(), 480.0 * rng.next()];
+            let half = case % 2 == 0;
+            let side = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+            let keying = Keying {
+                pencil: if half {
+                    Pencil::Half {
+                        foe,
+                        side,
+                        min_t: 4.0,
+                    }
+                } else {
+                    Pencil::Angular { foe }
+                },
+                eps: ULP20 * (1024.0 / 4.0 + 4.0),
+                key_scale: ULP20 * 1024.0,
+                period: if half { 0.0 } else { 4.0 },
+            };
+            // A point with no key: for half-plane keys within t_min of the
+            // row or beyond it; for pseudo-angles within a pixel of the FOE.
+            let ang = rng.next() * core::f32::consts::TAU;
+            let r = if half {
+                3.0 + 60.0 * rng.next()
+            } else {
+                0.05 + 0.9 * rng.next()
+            };
+            let p = [foe[0] + r * libm::cosf(ang), foe[1] + r * libm::sinf(ang)];
+            let (k, _) = keying.key(p);
+            if k.is_finite() {
+                continue;
+            }
+            let t = if rng.next() < 0.5 {
+                0.01 * rng.next()
+            } else {
+                5.0 * rng.next()
+            };
+            let range = keying.around(p, k, t, 0.0);
+            let d = [f64::from(p[0] - foe[0]), f64::from(p[1] - foe[1])];
+            let a0 = d[1].atan2(d[0]);
+            let half_angle = f64::from(t).atan() * 0.9999;
+            for i in 0..=64 {
+                let a = a0 + half_angle * (f64::from(i) / 32.0 - 1.0);
+                let q = [
+                    f64::from(foe[0]) + 100.0 * a.cos(),
+                    f64::from(foe[1]) + 100.0 * a.sin(),
+                ];
+                let qf = [q[0] as f32, q[1] as f32];
+                let Some(ke) = exact(&keying, qf) else {
+                    continue;
+                };
+                assert!(
+                    range.is_some(),
+                    "case {case}: no range, but key {ke} of a direction in the wedge"
+                );
+                let (lo, hi) = range.unwrap_or((0.0, 0.0));
+                let inside = (-2..=2).any(|m| {
+                    let kk = ke + 4.0 * f64::from(m) * f64::from(u8::from(!half));
+                    kk >= f64::from(lo) - 1e-6 && kk <= f64::from(hi) + 1e-6
+                });
+                assert!(
+                    inside,
+                    "case {case}: key {ke} outside [{lo}, {hi}] (t {t}, half {half})"
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked > 100_000, "{checked}");
     }
 }

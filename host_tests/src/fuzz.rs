@@ -346,9 +346,6 @@ pub struct Tally {
     pub slowest: (f64, u64),
     /// Feature bits seen.
     pub features: u128,
-    /// Cases with the known findings F1 and F4 (see `frame::known`),
-    /// counted, not failed.
-    pub known: [u64; 2],
 }
 
 /// Most findings a target reports before its worker stops.
@@ -437,8 +434,6 @@ fn pass_target(p: &Pass, target: Target, time: Duration) -> Tally {
                             t.reconstructions += o.reconstructions;
                             t.points[0] += o.points[0];
                             t.points[1] += o.points[1];
-                            t.known[0] += u64::from(o.features >> frame::KNOWN_F1 & 1 == 1);
-                            t.known[1] += u64::from(o.features >> frame::KNOWN_F4 & 1 == 1);
                             if o.features & !t.features != 0 {
                                 t.features |= o.features;
                                 if let Some(dir) = &save {
@@ -473,8 +468,6 @@ fn pass_target(p: &Pass, target: Target, time: Duration) -> Tally {
         all.points[1] += t.points[1];
         all.findings.extend(t.findings);
         all.features |= t.features;
-        all.known[0] += t.known[0];
-        all.known[1] += t.known[1];
         if t.slowest.0 > all.slowest.0 {
             all.slowest = t.slowest;
         }

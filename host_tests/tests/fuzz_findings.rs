@@ -11,11 +11,15 @@ fn frame<const N: usize>(cam: Camera, bs: &[&[[f32; 2]]]) -> Frame<N, 2> {
     f
 }
 
-/// F1 (matching stage, reported): with a rotation error configured, the
-/// indexed search misses a frame-2 segment that the band meets at the end
-/// of the boundary: indexed `no_intersection`, reference `boundary_end`.
+/// F1 (fixed in `Keying::around`, src/pencil.rs): with a rotation error
+/// configured, the indexed search missed a frame-2 segment that the band
+/// meets at the end of the boundary (indexed `no_intersection`, reference
+/// `boundary_end`). The point lies beyond the FOE's row, and its band is
+/// 126° wide: the key range took the wrong side's limit, which holds only
+/// for wedges narrower than a right angle to the row. The range now spans
+/// the ends of the band's arc in the half-plane: edge directions inside it
+/// and the row's directions inside the band.
 #[test]
-#[ignore = "F1: a matching-stage finding, reported to the stage's owner; fails until fixed"]
 fn f1_indexed_search_misses_a_boundary_end_with_a_rotation_error() {
     let cam = Camera::new(798.17523, 798.17523, 313.77997, 240.62936, 640, 480).unwrap();
     let config = Config::DEFAULT
@@ -148,12 +152,15 @@ fn pair(
     (fast, slow)
 }
 
-/// F4a (matching stage, reported): no motion error, two different
-/// cameras: the indexed search misses a depth the reference finds
-/// (indexed `no_intersection`; reference `ok`, z = 1.488 at (265.6, 240.6)).
-/// Fuzz seed 55662, reduced with `fuzz --pair 55662`.
+/// F4a (fixed in `Keying::around`, src/pencil.rs): no motion error, two
+/// different cameras: the indexed search missed a depth the reference
+/// finds (indexed `no_intersection`; reference `ok`, z = 1.488 at (265.6,
+/// 240.6)). The point is 0.9 px from the FOE, where pseudo-angle keys are
+/// not given, and its band is still valid (its errors are small): its key
+/// range was taken as empty. It is now its own direction's pseudo-angle
+/// with the margin `Keying::key` would give it. Fuzz seed 55662, reduced
+/// with `fuzz --pair 55662`.
 #[test]
-#[ignore = "F4: a matching-stage finding, reported to the stage's owner; fails until fixed"]
 fn f4a_indexed_search_misses_a_depth() {
     let c1 = Camera::new(250.94536, 250.94536, -0.0, 136.09424, 256, 256).unwrap();
     let c2 = Camera::new(11.33587, 11.33587, 262.34665, 240.22495, 512, 480).unwrap();
@@ -172,10 +179,10 @@ fn f4a_indexed_search_misses_a_depth() {
     assert_eq!(fast, slow);
 }
 
-/// F4b (matching stage, reported): no motion error, a 1 px focal length:
-/// indexed `no_intersection`, reference `grazing`. Fuzz seed 65892.
+/// F4b (fixed with F4a): no motion error, a 1 px focal length: indexed
+/// `no_intersection`, reference `grazing` (a point within a pixel of the
+/// FOE). Fuzz seed 65892.
 #[test]
-#[ignore = "F4: a matching-stage finding, reported to the stage's owner; fails until fixed"]
 fn f4b_indexed_search_misses_a_grazing_piece() {
     let c = Camera::new(1.0000001, 1.0000001, 227.42157, 116.37078, 320, 240).unwrap();
     let config = Config::new(0.0, 0.0, 10.0, 1000.0).unwrap();
@@ -215,4 +222,32 @@ fn the_issue_11_overflow_case_runs_with_overflow_checks() {
     let m = Motion::new([0.0, 0.0, 0.4], [0.0; 3]).unwrap();
     assert!(matches!(p.process(&f1, None), Ok(Step::First)));
     assert!(matches!(p.process(&f2, Some(&m)), Ok(Step::Structure(_))));
+}
+
+/// F5 (fixed in `Band::key_half_width`, src/depth.rs): a translation error
+/// and a localisation error of 100 px: the band reaches behind the FOE
+/// (`ρ₁ ≤ r₁ + e₂`), where the key half-width's `1/(ρ₁ − r₁ − e₂)` turned
+/// negative and the query missed the segments (indexed `no_intersection`,
+/// reference `boundary_end`). Such a band now searches every key. Fuzz seed
+/// 1214507, reduced with `fuzz --pair 1214507`.
+#[test]
+fn f5_a_band_behind_the_foe_searches_every_key() {
+    let c1 = Camera::new(595.0, 609.955, 259.2145, 235.27821, 512, 480).unwrap();
+    let c2 = Camera::new(95.70208, 95.70208, 132.48987, 244.57388, 256, 256).unwrap();
+    let config = Config::new(100.0, 100.0, 10.0, 1000.0)
+        .unwrap()
+        .with_translation_error(1.0)
+        .unwrap();
+    let (fast, slow) = pair(
+        config,
+        c1,
+        c2,
+        &[[49.0, 103.0], [15.0, 97.0]],
+        &[[150.0, 255.0], [151.0, 256.0]],
+        (
+            [46769.465, 0.0, 100000.0],
+            [-0.0018343587, -0.034090184, 0.010205298],
+        ),
+    );
+    assert_eq!(fast, slow);
 }

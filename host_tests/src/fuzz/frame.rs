@@ -913,7 +913,6 @@ fn matchers<const N: usize, const B: usize>(
     frame: &Frame<N, B>,
     m: &Motion,
     config: &Config,
-    features: &mut u128,
 ) -> Box<Structure<N, B>> {
     let unlimited = config
         .with_work_budget(Config::MAX_WORK_PER_POINT)
@@ -923,21 +922,15 @@ fn matchers<const N: usize, const B: usize>(
     let fast = Box::new(r.process_against_kept(frame, m).expect("kept").clone());
     let slow = Box::new(r.reference_against_kept(frame, m).expect("kept").clone());
     if !same(&fast, &slow) {
-        let mut unknown = false;
         for (k, (x, y)) in fast.boundaries().iter().zip(slow.boundaries()).enumerate() {
             for (i, (p, q)) in x.points().iter().zip(y.points()).enumerate() {
-                if p != q && !known(p, q, config, features) {
-                    panic!(
-                        "matcher: boundary {k} point {i}: indexed {p:?}, reference {q:?} (largest budget)"
-                    );
-                }
+                assert!(
+                    p == q,
+                    "matcher: boundary {k} point {i}: indexed {p:?}, reference {q:?} (largest budget)"
+                );
             }
         }
-        unknown |= fast.boundaries().len() != slow.boundaries().len();
-        assert!(
-            !unknown,
-            "matcher: the indexed and reference structures differ"
-        );
+        panic!("matcher: the indexed and reference structures differ");
     }
     assert_eq!(
         r.previous(),
@@ -947,47 +940,8 @@ fn matchers<const N: usize, const B: usize>(
     fast
 }
 
-/// The feature bit of the known finding F1 (see [`known`]).
-pub const KNOWN_F1: u32 = 127;
-/// The feature bit of the other known matcher differences (F4).
-pub const KNOWN_F4: u32 = 126;
 /// A call that gave a structure (a reconstruction).
 pub const RECONSTRUCTED: u32 = 124;
-
-/// Known findings of the matching stage, reported to its owner and left
-/// to it (that stage is being reworked; tests/fuzz_findings.rs has them
-/// as ignored, failing tests): a point where the indexed result `p`
-/// differs from the reference's `q` is counted (feature bits
-/// [`KNOWN_F1`], [`KNOWN_F4`]) instead of failing the case, unless
-/// `ROADSTEREO_FUZZ_STRICT` is set. Both results still go through every
-/// other oracle (finite depths inside their sticks, ...).
-///
-/// * F1: with a translation or rotation error configured (the band with
-///   spread), the index misses a segment the band meets at an end of the
-///   frame-2 boundary: indexed `no_intersection`, reference
-///   `boundary_end`.
-/// * F4: other differences, about 1 case in 4 000 of the pass (most
-///   often `unbounded` / `no_intersection` / `ambiguous` where the
-///   reference has `boundary_end`, `ambiguous`, `grazing` or `ok`).
-///
-/// The budget oracle compares with the indexed matcher's largest-budget
-/// result, so it needs no such allowance: it fails on any difference
-/// other than `over_budget`.
-fn known(
-    p: &roadstereo::PointResult,
-    q: &roadstereo::PointResult,
-    config: &Config,
-    features: &mut u128,
-) -> bool {
-    if std::env::var_os("ROADSTEREO_FUZZ_STRICT").is_some() {
-        return false;
-    }
-    let spread =
-        config.translation_error() > 0.0 || config.rotation_error().iter().any(|&e| e > 0.0);
-    let f1 = spread && p.status() == Status::NoIntersection && q.status() == Status::BoundaryEnd;
-    set(features, if f1 { KNOWN_F1 } else { KNOWN_F4 });
-    true
-}
 
 /// `got` (the case's budget) against the indexed matcher with the largest
 /// budget (which equals the reference, see [`matchers`]): each point
@@ -1083,7 +1037,7 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
                 let motion = m.as_ref().and_then(|m| build_motion(m, &mut features));
                 let kept = a.previous().cloned().map(Box::new);
                 let reference = match (&kept, &motion) {
-                    (Some(k), Some(m)) => Some(matchers(k, &frame, m, &config, &mut features)),
+                    (Some(k), Some(m)) => Some(matchers(k, &frame, m, &config)),
                     _ => None,
                 };
                 let got = match a.process(&frame, motion.as_ref()) {
@@ -1138,9 +1092,7 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
                     continue;
                 };
                 let kept = a.previous().cloned().map(Box::new);
-                let reference = kept
-                    .as_ref()
-                    .map(|k| matchers(k, &frame, &motion, &config, &mut features));
+                let reference = kept.as_ref().map(|k| matchers(k, &frame, &motion, &config));
                 let got = a
                     .process_against_kept(&frame, &motion)
                     .map(|s| Box::new(s.clone()));

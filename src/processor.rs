@@ -100,6 +100,15 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         &self.config
     }
 
+    /// Use `config` from the next call on; the kept frame stays. For a
+    /// caller that pairs one kept frame with frames whose motions carry
+    /// different error bounds: [`crate::fusion`] composes the motion from
+    /// its key frame, and the bound of the composed motion grows with each
+    /// frame.
+    pub fn set_config(&mut self, config: Config) {
+        self.config = config;
+    }
+
     /// The kept previous frame, if any.
     pub fn previous(&self) -> Option<&Frame<N, B>> {
         self.has_previous.then_some(&self.previous)

@@ -269,20 +269,27 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
         }
     }
 
-    /// Start over for the key frame `frame` with id `id`: every point
-    /// [`FusedStatus::Unmatched`].
-    pub(crate) fn start(&mut self, id: u32, frame: &Frame<N, B>) {
+    /// Start over for the key frame with id `id` whose boundaries have
+    /// `lens` points: every point [`FusedStatus::Unmatched`].
+    pub(crate) fn start(&mut self, id: u32, lens: [u16; B]) {
         self.id = id;
         self.partners = 0;
         self.best_matched = 0;
-        for (k, (len, cells)) in self.lens.iter_mut().zip(self.cells.iter_mut()).enumerate() {
-            let n = frame.boundaries().get(k).map_or(0, |b| b.points().len());
-            let n = n.min(N);
-            *len = u16::try_from(n).unwrap_or(u16::MAX);
-            for c in cells.iter_mut().take(n) {
+        self.lens = lens;
+        for (&len, cells) in self.lens.iter().zip(self.cells.iter_mut()) {
+            for c in cells.iter_mut().take(usize::from(len)) {
                 *c = Cell::EMPTY;
             }
         }
+    }
+
+    /// The point counts of `frame`'s boundaries (at most `N`).
+    pub(crate) fn lens_of(frame: &Frame<N, B>) -> [u16; B] {
+        let mut lens = [0u16; B];
+        for (l, b) in lens.iter_mut().zip(frame.boundaries()) {
+            *l = u16::try_from(b.points().len().min(N)).unwrap_or(u16::MAX);
+        }
+        lens
     }
 
     /// Fuse one pair's reconstruction (the key frame against a later

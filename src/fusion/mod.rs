@@ -313,6 +313,9 @@ pub struct Fusion<const N: usize, const B: usize, const M: usize> {
     last: Option<u32>,
     /// The next frame is the key frame's last partner.
     due: bool,
+    /// A key frame the processor keeps whose fusion has not started yet:
+    /// `key` still shows the one that just retired (its id, its lengths).
+    pending: Option<(u32, [u16; B])>,
     map: RoadMap<B, M>,
 }
 
@@ -330,6 +333,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             chain: Chain::IDENTITY,
             last: None,
             due: false,
+            pending: None,
             map: RoadMap::new(config.tilt_sc, scale),
         }
     }
@@ -343,6 +347,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         self.chain = Chain::IDENTITY;
         self.last = None;
         self.due = false;
+        self.pending = None;
         self.map.clear();
     }
 
@@ -406,7 +411,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         // 1. Validate (nothing changes on an error).
         let Some(last) = self.last else {
             self.last = Some(id);
-            out.new_key = self.start_key(id, frame, KeyReason::First);
+            out.new_key = self.start_key(id, frame, KeyReason::First, false);
             return Ok(out);
         };
         let m = motion.ok_or(FusionError::MissingMotion)?;
@@ -423,8 +428,9 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         // 2. The map follows the vehicle.
         let bounds = StepBounds::of(&self.base);
         self.map.carry(&m.motion, &bounds);
+        self.settle();
         if !self.has_key {
-            out.new_key = self.start_key(id, frame, KeyReason::First);
+            out.new_key = self.start_key(id, frame, KeyReason::First, false);
             return Ok(out);
         }
         // 3. The motion from the key frame, and the pair.
@@ -441,7 +447,8 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             Err(reason) => {
                 // No last pair: retire what the key frame has, start anew.
                 out.retired = self.retire(&chain);
-                out.new_key = self.start_key(id, frame, reason);
+                let shown = out.retired.is_some();
+                out.new_key = self.start_key(id, frame, reason, shown);
                 return Ok(out);
             }
         };
@@ -470,7 +477,10 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             } else {
                 KeyReason::FewMatched
             });
-            self.key.start(id, frame);
+            // The processor keeps this frame: the new key frame. Its fusion
+            // starts with the next frame; until then `key` shows the
+            // retired one's final state.
+            self.pending = Some((id, KeyFrame::lens_of(frame)));
             self.chain = Chain::IDENTITY;
             self.due = self.config.max_partners <= 1;
             return Ok(out);
@@ -487,20 +497,39 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     }
 
     /// Make frame `id` the key frame (if it has points): the processor
-    /// keeps it, every point unmatched.
-    fn start_key(&mut self, id: u32, frame: &Frame<N, B>, reason: KeyReason) -> Option<KeyReason> {
+    /// keeps it, every point unmatched. With `show_retired` the fusion
+    /// state keeps showing the key frame that just retired until the next
+    /// frame ([`Fusion::key`]).
+    fn start_key(
+        &mut self,
+        id: u32,
+        frame: &Frame<N, B>,
+        reason: KeyReason,
+        show_retired: bool,
+    ) -> Option<KeyReason> {
         self.processor.reset();
         self.processor.set_config(self.base);
         self.chain = Chain::IDENTITY;
         self.due = self.config.max_partners <= 1;
+        self.pending = None;
         if !has_points(frame) {
             self.has_key = false;
             return None;
         }
         let _ = self.processor.process(frame, None);
-        self.key.start(id, frame);
+        self.pending = Some((id, KeyFrame::lens_of(frame)));
+        if !show_retired {
+            self.settle();
+        }
         self.has_key = true;
         Some(reason)
+    }
+
+    /// Start the fusion of a key frame the processor keeps.
+    fn settle(&mut self) {
+        if let Some((id, lens)) = self.pending.take() {
+            self.key.start(id, lens);
+        }
     }
 
     /// Move the key frame's fused points into the map, posed by `chain`.
@@ -535,6 +564,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         if !(near.is_finite() && far.is_finite() && 0.0 <= near && near <= far) {
             return Err(FusionError::InvalidRange);
         }
+        self.settle();
         let kept = self
             .processor
             .previous()
@@ -559,7 +589,11 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             .ok_or(FusionError::NoSuchPoint)
     }
 
-    /// The current key frame's fusion, if there is a key frame.
+    /// The current key frame's fusion, if there is a key frame. Right
+    /// after a step that retired a key frame ([`FusionStep::retired`]) and
+    /// until the next step, the retired key frame's final state (its
+    /// [`KeyFrame::id`] tells): what went into the map, and what the pairs
+    /// made of every point.
     pub fn key(&self) -> Option<&KeyFrame<N, B>> {
         self.has_key.then_some(&self.key)
     }

@@ -132,6 +132,9 @@ pub struct MapPoint {
     pub radius: f32,
     /// The id of the key frame the point was fused in.
     pub key: u32,
+    /// The point's ray in that key frame: normalised `(x, y)` of its pixel
+    /// ([`crate::Camera::normalise`]).
+    pub ray: (f32, f32),
 }
 
 /// Points that left the map, by reason, since it was made or cleared.
@@ -157,9 +160,11 @@ pub struct Retired {
     pub unverified: u32,
     /// Points left out: inconsistent.
     pub inconsistent: u32,
-    /// Older points dropped to make room (also in [`MapDrops::capacity`]),
-    /// and this key frame's own beyond a boundary's capacity.
+    /// Older points dropped to make room (also in [`MapDrops::capacity`]).
     pub dropped: u32,
+    /// This key frame's own points beyond a boundary's capacity `M` (the
+    /// farthest along the boundary), left out.
+    pub unfit: u32,
 }
 
 /// The fixed-capacity road map: up to `M` points on each of `B`
@@ -299,6 +304,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             far: at(zf),
             radius: b.rho + b.phi * zf * (1.0 + 0.5 * (e.x * e.x + e.y * e.y)),
             key: b.key,
+            ray: (e.x, e.y),
         }
     }
 
@@ -547,7 +553,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         }
         for (k, w) in want.iter_mut().enumerate() {
             if *w > M {
-                out.dropped += (*w - M) as u32;
+                out.unfit += (*w - M) as u32;
                 *w = M;
             }
             let used = self.used.get(k).map_or(0, |&u| usize::from(u));
@@ -637,6 +643,10 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         if let Some(b) = self.batches.get_mut(slot) {
             *b = batch;
             self.count += 1;
+            // Points the camera has passed already leave at once.
+            let w = forward_axis(self.tilt);
+            self.drop_behind(usize::from(self.count) - 1, &batch, w);
+            self.pop_dead();
         }
         out
     }

@@ -413,3 +413,437 @@ fn fused_intervals_narrow_with_the_partners() {
         assert!(g >= 2.5, "{name}: {g:.2}×");
     }
 }
+
+/// Checks of the map against the truth after every frame of a run.
+#[derive(Default, Debug)]
+struct MapCheck {
+    points: usize,
+    /// The largest distance of the true point from its stick beyond the
+    /// stick's radius, relative to its distance from the camera.
+    worst_excess: f64,
+    largest_radius: f64,
+    entered: u64,
+    behind: u64,
+    capacity: u64,
+    live_at_end: u64,
+}
+
+/// Every map point after every frame: the key-frame ray point at the true
+/// depth, carried into the frame's vehicle frame by the **true** poses,
+/// lies within the point's radius of its stick (up to `f32` rounding,
+/// `1e-4` of its distance).
+fn check_map(d: &Drive, input: &host_tests::drives::Input, policy: FusionConfig) -> MapCheck {
+    let k = d.spec.intrinsics;
+    let cam = k.camera();
+    let mut c = MapCheck::default();
+    let r = run(d, input, policy, |j, f| {
+        for b in 0..B {
+            for p in f.map().points(b) {
+                let key = p.key as usize;
+                let i = input.frames[key][b]
+                    .iter()
+                    .position(|px| cam.normalise(*px) == p.ray)
+                    .expect("the map point's ray is a key-frame pixel's");
+                let z = d.z_true(key, b, i);
+                let ray = [f64::from(p.ray.0) * z, f64::from(p.ray.1) * z, z];
+                let kp = &d.frames[key].pose;
+                let world = synth::add(kp.centre, synth::mv(&kp.rot, ray));
+                let truth = d.in_vehicle(j, world);
+                let near = p.near.map(f64::from);
+                let far = p.far.map(f64::from);
+                let dist = Drive::segment_distance(truth, near, far);
+                let scale =
+                    1.0 + (truth[0] * truth[0] + truth[1] * truth[1] + truth[2] * truth[2]).sqrt();
+                let excess = (dist - f64::from(p.radius)) / scale;
+                c.worst_excess = c.worst_excess.max(excess);
+                c.largest_radius = c.largest_radius.max(f64::from(p.radius));
+                c.points += 1;
+                // Nothing wholly behind the camera stays.
+                assert!(near[2].max(far[2]) + f64::from(p.radius) >= 0.0, "{p:?}");
+            }
+        }
+        if j + 1 == d.frames.len() {
+            c.live_at_end = (0..B).map(|b| f.map().len(b) as u64).sum();
+            c.behind = u64::from(f.map().drops().behind);
+            c.capacity = u64::from(f.map().drops().capacity);
+        }
+    });
+    c.entered = r
+        .steps
+        .iter()
+        .filter_map(|s| s.retired)
+        .map(|t| u64::from(t.entered))
+        .sum();
+    c
+}
+
+#[test]
+fn the_map_holds_the_truth_in_the_vehicle_frame() {
+    let mut lines = Vec::new();
+    for (name, motion) in [
+        ("no motion error", None),
+        (
+            "motion errors (0.01, 0.1°) bounded",
+            Some(MotionNoise {
+                delta: 0.01,
+                eps: 0.1f64.to_radians(),
+            }),
+        ),
+    ] {
+        let mut all = MapCheck::default();
+        for family in DriveFamily::ALL {
+            let (ds, _) = drives(family, 4, 24);
+            for (seed, d) in &ds {
+                let input = d.input(Noise::Rounded, motion, *seed);
+                let policy = FusionConfig::DEFAULT
+                    .with_tilt(d.spec.tilt as f32)
+                    .expect("tilt");
+                let c = check_map(d, &input, policy);
+                // Every point that entered is still there or counted.
+                assert_eq!(
+                    c.entered,
+                    c.live_at_end + c.behind + c.capacity,
+                    "{}",
+                    d.spec.name
+                );
+                all.points += c.points;
+                all.worst_excess = all.worst_excess.max(c.worst_excess);
+                all.largest_radius = all.largest_radius.max(c.largest_radius);
+                all.entered += c.entered;
+                all.behind += c.behind;
+                all.capacity += c.capacity;
+            }
+        }
+        lines.push(format!(
+            "map, {name}: {} map points checked over 32 drives of 24 frames, worst distance beyond the radius {:.1e} of the distance, largest radius {:.3}; {} entered, {} dropped behind, {} for room",
+            all.points, all.worst_excess, all.largest_radius, all.entered, all.behind, all.capacity
+        ));
+        assert!(all.points > 10_000, "{all:?}");
+        assert!(all.worst_excess <= 1e-4, "{all:?}");
+        assert!(all.behind > 0, "{all:?}");
+    }
+    println!("{}", lines.join("\n"));
+}
+
+/// A map of 64 points per boundary, key frames retiring every 3 frames:
+/// each retiring key frame makes room by dropping the oldest points, what
+/// does not fit is left out, every point is accounted for, and what stays
+/// is the newest.
+#[test]
+fn map_capacity_exhaustion_drops_the_oldest_and_counts() {
+    const SMALL: usize = 64;
+    let d = fig6_drive(24);
+    let input = d.input(Noise::Rounded, None, 3);
+    let policy = FusionConfig::new(3, 0).expect("policy");
+    let mut f = Box::new(Fusion::<N, B, SMALL>::new(input.config(), policy));
+    let (mut entered, mut unfit, mut dropped) = (0u64, 0u64, 0u64);
+    let mut newest = None;
+    for j in 0..d.frames.len() {
+        let frame = input.frame(&d.spec.intrinsics, j);
+        let m = (j > 0).then(|| ChainedMotion {
+            from: j as u32 - 1,
+            motion: input.given[j - 1],
+        });
+        let s = f.step(j as u32, &frame, m.as_ref()).expect("step");
+        if let Some(r) = s.retired {
+            entered += u64::from(r.entered);
+            unfit += u64::from(r.unfit);
+            dropped += u64::from(r.dropped);
+            newest = Some(r.key);
+        }
+        for b in 0..B {
+            assert!(f.map().len(b) <= SMALL);
+        }
+    }
+    let drops = f.map().drops();
+    let live: u64 = (0..B).map(|b| f.map().len(b) as u64).sum();
+    println!(
+        "map of {SMALL} per boundary: {entered} entered ({unfit} more did not fit), {live} kept, {} dropped for room, {} behind",
+        drops.capacity, drops.behind
+    );
+    assert!(drops.capacity > 0 && unfit > 0);
+    assert_eq!(u64::from(drops.capacity), dropped);
+    assert_eq!(
+        entered,
+        live + u64::from(drops.capacity) + u64::from(drops.behind)
+    );
+    // The newest key frame's points are what is left.
+    let newest = newest.expect("a key frame retired");
+    for b in 0..B {
+        assert!(f.map().points(b).all(|p| p.key == newest));
+    }
+}
+
+fn edge_frame(cam: roadstereo::Camera, n: f32, points: usize) -> Frame<N, B> {
+    let mut f = Frame::new(cam);
+    let pts: Vec<Pixel> = (0..points)
+        .map(|i| {
+            let (x, z) = (-1.0 - 0.05 * n, 7.0 + i as f32 * 0.5 - 0.25 * n);
+            Pixel::new(255.5 + 800.0 * x / z, 239.5 + 800.0 / z)
+        })
+        .collect();
+    if points > 0 {
+        f.push_boundary(&pts).expect("valid");
+    }
+    f
+}
+
+/// Missing motions, motions that do not chain, repeated frames, a key
+/// frame with no points, bad constraints: typed errors, and nothing
+/// changes (the digest, and a twin fed only the good frames agrees).
+#[test]
+fn bad_inputs_are_typed_errors_and_change_nothing() {
+    let cam = synth::Intrinsics::default().camera();
+    let step = Motion::new([0.05, 0.0, 0.25], [0.0; 3]).expect("motion");
+    let chained = |from: u32| ChainedMotion { from, motion: step };
+    let mut f = Box::new(HostFusion::new(Config::DEFAULT, FusionConfig::DEFAULT));
+    let mut twin = Box::new(HostFusion::new(Config::DEFAULT, FusionConfig::DEFAULT));
+    // No key frame yet: constraints have nothing to act on.
+    assert_eq!(f.constrain(0, 0, 1.0, 2.0), Err(FusionError::NoKeyFrame));
+    // A first frame without points is accepted but is no key frame.
+    let s = f
+        .step(0, &edge_frame(cam, 0.0, 0), None)
+        .expect("empty frame");
+    assert_eq!(s.new_key, None);
+    assert!(f.key().is_none());
+    twin.step(0, &edge_frame(cam, 0.0, 0), None)
+        .expect("empty frame");
+    // The next frame with points becomes the key frame.
+    let s = f
+        .step(1, &edge_frame(cam, 1.0, 24), Some(&chained(0)))
+        .expect("key");
+    assert_eq!(s.new_key, Some(KeyReason::First));
+    twin.step(1, &edge_frame(cam, 1.0, 24), Some(&chained(0)))
+        .expect("key");
+    let frame2 = edge_frame(cam, 2.0, 24);
+    for _ in 0..2 {
+        let before = f.digest();
+        assert_eq!(f.step(2, &frame2, None), Err(FusionError::MissingMotion));
+        assert_eq!(
+            f.step(2, &frame2, Some(&chained(7))),
+            Err(FusionError::BrokenChain {
+                expected: 1,
+                given: 7
+            })
+        );
+        assert_eq!(
+            f.step(1, &frame2, Some(&chained(1))),
+            Err(FusionError::RepeatedFrame(1))
+        );
+        assert_eq!(f.constrain(3, 0, 1.0, 2.0), Err(FusionError::NoSuchPoint));
+        assert_eq!(f.constrain(0, 99, 1.0, 2.0), Err(FusionError::NoSuchPoint));
+        for (n, r) in [
+            (f32::NAN, 2.0),
+            (1.0, f32::INFINITY),
+            (3.0, 2.0),
+            (-1.0, 2.0),
+        ] {
+            assert_eq!(f.constrain(0, 0, n, r), Err(FusionError::InvalidRange));
+        }
+        assert_eq!(f.digest(), before, "a rejected input changed the state");
+    }
+    for id in 2..6u32 {
+        let fr = edge_frame(cam, id as f32, 24);
+        f.step(id, &fr, Some(&chained(id - 1))).expect("step");
+        twin.step(id, &fr, Some(&chained(id - 1))).expect("step");
+        assert_eq!(f.digest(), twin.digest());
+    }
+    let key = f.key().expect("key frame");
+    assert_eq!(key.id(), 1);
+    assert!(key.points(0).any(|p| p.status == FusedStatus::Consistent));
+    // An empty frame is paired (nothing matches) but never made a key frame.
+    let s = f
+        .step(6, &edge_frame(cam, 6.0, 0), Some(&chained(5)))
+        .expect("empty");
+    assert_eq!(s.paired.map(|p| p.matched), Some(0));
+    assert_eq!(f.key().map(|k| k.id()), Some(1));
+    // The error texts say what and where.
+    assert_eq!(
+        FusionError::BrokenChain {
+            expected: 1,
+            given: 7
+        }
+        .to_string(),
+        "the motion starts from frame 7, the last frame was 1"
+    );
+}
+
+/// A range sensor's return along a key-frame point's ray (the truth ± 1 %
+/// as a distance from the camera) narrows the fused interval and keeps the
+/// truth in it; a return 30 % off flags the point.
+#[test]
+fn range_constraints_narrow_or_flag() {
+    let d = fig6_drive(4);
+    let input = d.input(Noise::Rounded, None, 5);
+    let cam = d.spec.intrinsics.camera();
+    let mut f = Box::new(HostFusion::new(input.config(), FusionConfig::DEFAULT));
+    for j in 0..3 {
+        let m = (j > 0).then(|| ChainedMotion {
+            from: j as u32 - 1,
+            motion: input.given[j - 1],
+        });
+        f.step(j as u32, &input.frame(&d.spec.intrinsics, j), m.as_ref())
+            .expect("step");
+    }
+    let (mut narrowed, mut flagged, mut tried) = (0, 0, 0);
+    for b in 0..B {
+        let n = f.key().map_or(0, |k| k.len(b));
+        for i in (0..n).step_by(5) {
+            let p = f.key().and_then(|k| k.point(b, i)).expect("point");
+            let Some(iv) = p.interval.filter(|_| p.status == FusedStatus::Consistent) else {
+                continue;
+            };
+            tried += 1;
+            let (x, y) = cam.normalise(input.frames[0][b][i]);
+            let z = d.z_true(0, b, i);
+            let r = z * (1.0 + f64::from(x * x + y * y)).sqrt();
+            let q = if i % 10 == 0 {
+                f.constrain(b, i, (r * 0.99) as f32, (r * 1.01) as f32)
+            } else {
+                f.constrain(b, i, (r * 1.3) as f32, (r * 1.35) as f32)
+            }
+            .expect("constraint");
+            if i % 10 == 0 {
+                let new = q.interval.expect("interval");
+                assert_eq!(q.status, FusedStatus::Consistent);
+                assert!(f64::from(new.z_near) <= z && z <= f64::from(new.z_far));
+                assert!(new.z_far - new.z_near <= iv.z_far - iv.z_near);
+                narrowed += usize::from(new.z_far - new.z_near < 0.5 * (iv.z_far - iv.z_near));
+            } else {
+                assert_eq!(q.status, FusedStatus::Inconsistent);
+                flagged += 1;
+            }
+        }
+    }
+    println!("range constraints: {tried} points, {narrowed} narrowed by more than half, {flagged} flagged");
+    assert!(tried > 20 && narrowed > 5 && flagged > 10);
+}
+
+/// The ALV-like set-up of `tests/geometry.rs` (camera height 2, tilt 23°,
+/// road width 2.6, the r = 40 curve, 1 unit of travel a frame, quantised)
+/// as a drive with lateral and heading wobble, no pitch.
+fn alv_drive(frames: usize, seed: u64) -> Drive {
+    let mut s = DriveSpec::new(DriveFamily::Fig6, seed, frames);
+    s.name = format!("alv/{seed}");
+    s.road = Road {
+        curvature_a: 1.0 / 40.0,
+        curvature_b: 1.0 / 40.0,
+        ..Road::straight(2.6)
+    };
+    s.height = 2.0;
+    s.tilt = 23f64.to_radians();
+    s.step = 1.0;
+    s.yaw_bias = 1.5 / 40.0;
+    s.yaw_wobble = 1.5f64.to_radians();
+    s.lateral_wobble = 0.2;
+    // The same mounting in every view (road_geometry's model): no pitch.
+    s.pitch_wobble = 0.0;
+    s.render().expect("both edges in view")
+}
+
+/// Camera height, tilt and road width (`geometry::road_geometry`) from the
+/// fused map: one view per retired key frame in the map (its fused
+/// intervals on its own rays). Next to the figures of the 12 two-view
+/// pairs of `tests/geometry.rs` (0.13, 0.7°, 0.05) and the paper's (0.40,
+/// 4°, 0.60).
+#[test]
+fn road_geometry_from_the_fused_map() {
+    use roadstereo::geometry::{road_geometry, Sample};
+    const CAP: usize = 4096;
+    let mut lines = vec![
+        "| views | height | tilt | width |".to_string(),
+        "|---|---|---|---|".to_string(),
+        "| paper (ALV board) | 1.9–2.3 (0.40) | 20–24° (4°) | 2.4–3.0 (0.60) |".to_string(),
+        "| 12 two-view pairs (`tests/geometry.rs`) | 1.94–2.07 (0.13) | 22.6–23.4° (0.7°) | 2.57–2.62 (0.05) |".to_string(),
+    ];
+    for (partners, frames) in [(4u16, 25usize), (8, 25)] {
+        let d = alv_drive(frames, 1);
+        let input = d.input(Noise::Rounded, None, 1);
+        let cam = d.spec.intrinsics.camera();
+        let policy = FusionConfig::new(partners, 500)
+            .and_then(|p| p.with_tilt(23f32.to_radians()))
+            .expect("policy");
+        // (a) The map at the end of the drive: what is still ahead.
+        let mut map_sets: Vec<(Vec<Sample>, Vec<Sample>)> = Vec::new();
+        // (b) Each key frame's fused points as it retires (also those the
+        // vehicle has passed since, which the map drops).
+        let mut key_sets: Vec<(Vec<Sample>, Vec<Sample>)> = Vec::new();
+        let r = run(&d, &input, policy, |j, f| {
+            if let Some(key) = f.key() {
+                let kid = key.id() as usize;
+                if key.partners() >= partners {
+                    let side = |b: usize| -> Vec<Sample> {
+                        key.points(b)
+                            .enumerate()
+                            .filter(|(_, p)| p.status == FusedStatus::Consistent)
+                            .filter_map(|(i, p)| {
+                                let iv = p.interval?;
+                                let (x, y) = cam.normalise(input.frames[kid][b][i]);
+                                Some(Sample {
+                                    x,
+                                    y,
+                                    z_near: iv.z_near,
+                                    z_far: iv.z_far,
+                                })
+                            })
+                            .collect()
+                    };
+                    let (l, r) = (side(0), side(1));
+                    if l.len() >= 10 && r.len() >= 10 && key_sets.len() < 16 {
+                        key_sets.push((l, r));
+                    }
+                }
+            }
+            if j + 1 < d.frames.len() {
+                return;
+            }
+            let map = f.map();
+            for batch in 0..map.batches() {
+                let mut v = heapless::Vec::<Sample, N>::new();
+                map.samples(batch, 0, &mut v);
+                let left = v.to_vec();
+                map.samples(batch, 1, &mut v);
+                if left.len() >= 10 && v.len() >= 10 {
+                    map_sets.push((left, v.to_vec()));
+                }
+            }
+        });
+        let _ = r;
+        for (what, sets) in [
+            ("fused map at the end", &map_sets),
+            ("retiring key frames", &key_sets),
+        ] {
+            let views: Vec<(&[Sample], &[Sample])> = sets
+                .iter()
+                .map(|(l, r)| (l.as_slice(), r.as_slice()))
+                .collect();
+            let points: usize = sets.iter().map(|(l, r)| l.len() + r.len()).sum();
+            assert!(!views.is_empty(), "{what}");
+            let g = road_geometry::<CAP>(&views, 0).expect("geometry");
+            let (tl, th) = (g.tilt.lo.to_degrees(), g.tilt.hi.to_degrees());
+            lines.push(format!(
+                "| {what}: {} key frames of {partners} partners ({points} points) | {:.2}–{:.2} ({:.2}) | {tl:.1}–{th:.1}° ({:.1}°) | {:.2}–{:.2} ({:.2}) |",
+                views.len(),
+                g.height.lo,
+                g.height.hi,
+                g.height.width(),
+                th - tl,
+                g.width.lo,
+                g.width.hi,
+                g.width.width()
+            ));
+            assert!(
+                g.height.contains(2.0)
+                    && g.tilt.contains(23f32.to_radians())
+                    && g.width.contains(2.6),
+                "{what}: {g:?}"
+            );
+            // Under half the paper's ranges.
+            assert!(
+                g.height.width() <= 0.20 && th - tl <= 2.0 && g.width.width() <= 0.30,
+                "{what}: {g:?}"
+            );
+        }
+    }
+    println!("{}", lines.join("\n"));
+}

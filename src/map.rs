@@ -30,28 +30,39 @@
 //! # What leaves the map, all counted ([`MapDrops`])
 //! * **Behind**: a point whose whole stick, widened by its radius, is
 //!   behind the camera (negative forward coordinate in the vehicle frame)
-//!   is dropped when the map is carried. A batch wholly ahead of or behind
-//!   the camera (by a bounding sphere) is decided at once; only a batch
-//!   straddling the camera is looked at point by point.
+//!   is left out of every query ([`RoadMap::points`], [`RoadMap::samples`])
+//!   from the frame it gets there. Its slot is reclaimed, and the drop
+//!   counted, by a sweep: a batch wholly behind the camera goes at once (a
+//!   bound on its points' forward coordinates), one wholly ahead is
+//!   skipped, and of the batches the camera is passing at most
+//!   [`SWEEP_PER_FRAME`] points per boundary are tested each frame, from
+//!   the oldest on (except in a frame where a key frame retires, which
+//!   copies its points instead): a bounded cost per frame whatever `M` is.
 //! * **Capacity**: a boundary holds at most `M` points and the map at most
 //!   [`MAP_BATCHES`] batches; a retiring key frame makes room by dropping
 //!   the oldest points first (the oldest batch's, in the order they
-//!   entered).
+//!   entered; any of them already behind count as behind), and leaves out
+//!   its own farthest points beyond `M`.
 //!
 //! Size: `12·B·M` bytes of points and [`MAP_BATCHES`] batches of
-//! `96 + 8·B` bytes (`12 KiB + 0.9 KiB` for `B = 2`, `M = 512`).
+//! `88 + 4·B` bytes (`12 KiB + 0.8 KiB` for `B = 2`, `M = 512`).
 
-use crate::depth::DepthInterval;
 use crate::fusion::code::DepthScale;
-use crate::fusion::Chain;
-use crate::fusion::{FusedStatus, KeyFrame, StepBounds};
+use crate::fusion::{Admit, Chain, KeyFrame, StepBounds};
 use crate::geometry::Sample;
-use crate::math::{fmax, fmin, mat3_transpose, mat3_vec, sqrt, Mat3};
+use crate::math::{fmax, fmin, mat3_mul, mat3_transpose, mat3_vec, sqrt, Mat3};
 use crate::motion::Motion;
 use crate::structure::Structure;
 
 /// The most batches (retired key frames) the map holds at once.
 pub const MAP_BATCHES: usize = 8;
+
+/// Points per boundary the sweep for points behind the camera tests each
+/// frame (module docs).
+pub const SWEEP_PER_FRAME: usize = 32;
+
+/// Rounding allowance of a bound's arithmetic.
+const ROUND_UP: f32 = 1.0 + 1.0 / 65_536.0;
 
 /// One stored point: its key-frame ray and coded interval (12 bytes).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -90,12 +101,11 @@ struct Batch<const B: usize> {
     key: u32,
     /// Slots of each boundary's ring the batch occupies (live or not).
     len: [u16; B],
-    /// Of those, the live ones.
+    /// Of those, the live ones (all 0: the whole batch is gone).
     live: [u16; B],
-    /// A sphere (key-frame coordinates) holding every stick end, and the
-    /// largest `|P_K|` of a stick end.
-    centre: [f32; 3],
-    spread: f32,
+    /// The smallest and largest forward coordinate of a stick end in the
+    /// key frame's vehicle frame, and an upper bound of `|P_K|` over them.
+    forward: (f32, f32),
     reach: f32,
 }
 
@@ -108,13 +118,16 @@ impl<const B: usize> Batch<B> {
         key: 0,
         len: [0; B],
         live: [0; B],
-        centre: [0.0; 3],
-        spread: 0.0,
+        forward: (0.0, 0.0),
         reach: 0.0,
     };
 
     fn live_total(&self) -> u32 {
         self.live.iter().map(|&l| u32::from(l)).sum()
+    }
+
+    fn live_on(&self, boundary: usize) -> bool {
+        self.live.get(boundary).is_some_and(|&l| l > 0)
     }
 }
 
@@ -167,6 +180,76 @@ pub struct Retired {
     pub unfit: u32,
 }
 
+/// The forward axis of the vehicle frame in camera coordinates.
+fn forward_axis(tilt: (f32, f32)) -> [f32; 3] {
+    [0.0, -tilt.0, tilt.1]
+}
+
+fn dot3(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Where a batch is against the camera this frame.
+enum Whole {
+    Ahead,
+    Behind,
+    Passing,
+}
+
+/// A batch's forward coordinates this frame: a key-frame point `P` is
+/// `g · P + g0` ahead of the camera (vehicle frame), `g = Aᵀ w`, `g0 = w · b`
+/// with `w` the forward axis; `dg = |g − w|` bounds how far that is from
+/// the key frame's own forward coordinate `w · P` (`|(g − w) · P| ≤ dg |P|`).
+struct View {
+    g: [f32; 3],
+    g0: f32,
+    dg: f32,
+    rho: f32,
+    phi: f32,
+}
+
+impl View {
+    fn of<const B: usize>(b: &Batch<B>, tilt: (f32, f32)) -> View {
+        let w = forward_axis(tilt);
+        let g = mat3_vec(&mat3_transpose(&b.a), w);
+        let d = [g[0] - w[0], g[1] - w[1], g[2] - w[2]];
+        View {
+            g,
+            g0: dot3(w, b.b),
+            dg: sqrt(dot3(d, d)) * 1.000_01 + 1e-7,
+            rho: b.rho,
+            phi: b.phi,
+        }
+    }
+
+    /// The whole batch ahead, behind (sticks and radii), or neither.
+    fn whole<const B: usize>(&self, b: &Batch<B>) -> Whole {
+        let slack = self.dg * b.reach;
+        let radius = self.rho + self.phi * b.reach;
+        if b.forward.1 + self.g0 + slack + radius < 0.0 {
+            Whole::Behind
+        } else if b.forward.0 + self.g0 - slack >= 0.0 {
+            Whole::Ahead
+        } else {
+            Whole::Passing
+        }
+    }
+
+    /// Whether a point's whole stick, widened by its radius, is behind.
+    #[inline]
+    fn behind(&self, e: &Entry, scale: &DepthScale) -> bool {
+        let dir = self.g[0] * e.x + self.g[1] * e.y + self.g[2];
+        // The stick's forward coordinate is largest at its far end when it
+        // points forward, at its near end otherwise.
+        let ahead = dir * scale.depth(if dir >= 0.0 { e.far } else { e.near }) + self.g0;
+        if self.rho == 0.0 && self.phi == 0.0 {
+            return ahead < 0.0;
+        }
+        let r = self.rho + self.phi * scale.depth(e.far) * (1.0 + 0.5 * (e.x * e.x + e.y * e.y));
+        ahead + r < 0.0
+    }
+}
+
 /// The fixed-capacity road map: up to `M` points on each of `B`
 /// boundaries (module docs).
 #[derive(Debug, Clone)]
@@ -178,19 +261,12 @@ pub struct RoadMap<const B: usize, const M: usize> {
     batches: [Batch<B>; MAP_BATCHES],
     first: u8,
     count: u8,
+    /// Per boundary, the sweep's next slot (counted from the ring's tail).
+    sweep: [u16; B],
     /// Sine and cosine of the mounting tilt.
     tilt: (f32, f32),
     scale: DepthScale,
     drops: MapDrops,
-}
-
-/// The forward axis of the vehicle frame in camera coordinates.
-fn forward_axis(tilt: (f32, f32)) -> [f32; 3] {
-    [0.0, -tilt.0, tilt.1]
-}
-
-fn dot3(a: [f32; 3], b: [f32; 3]) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 impl<const B: usize, const M: usize> RoadMap<B, M> {
@@ -208,6 +284,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             batches: [Batch::EMPTY; MAP_BATCHES],
             first: 0,
             count: 0,
+            sweep: [0; B],
             tilt,
             scale,
             drops: MapDrops {
@@ -223,10 +300,12 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         self.used = [0; B];
         self.first = 0;
         self.count = 0;
+        self.sweep = [0; B];
         self.drops = MapDrops::default();
     }
 
-    /// Points on `boundary` now.
+    /// Points stored on `boundary` now: those [`RoadMap::points`] gives and
+    /// those behind the vehicle the sweep has not reclaimed yet.
     pub fn len(&self, boundary: usize) -> usize {
         self.batch_iter()
             .map(|b| b.live.get(boundary).map_or(0, |&l| usize::from(l)))
@@ -243,16 +322,22 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         usize::from(self.count)
     }
 
+    /// The id of batch `batch`'s key frame (0 = oldest).
+    pub fn batch_key(&self, batch: usize) -> Option<u32> {
+        self.batch_iter().nth(batch).map(|b| b.key)
+    }
+
     /// The points that left the map so far.
     pub fn drops(&self) -> MapDrops {
         self.drops
     }
 
+    fn slot(&self, i: usize) -> usize {
+        (usize::from(self.first) + i) % MAP_BATCHES
+    }
+
     fn batch_iter(&self) -> impl Iterator<Item = &Batch<B>> {
-        (0..usize::from(self.count)).filter_map(move |i| {
-            self.batches
-                .get((usize::from(self.first) + i) % MAP_BATCHES)
-        })
+        (0..usize::from(self.count)).filter_map(move |i| self.batches.get(self.slot(i)))
     }
 
     /// The ring slots of batch `i` (0 = oldest) on `boundary`: start and
@@ -271,22 +356,25 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         (start % M, len)
     }
 
-    /// Each live point of `boundary`, oldest first, in the current vehicle
-    /// frame.
+    /// Each point of `boundary` not behind the vehicle, oldest first, in
+    /// the current vehicle frame.
     ///
-    /// Work: 2 matrix-vector products per point.
+    /// Work: 2 matrix-vector products per stored point.
     pub fn points(&self, boundary: usize) -> impl Iterator<Item = MapPoint> + '_ {
         (0..usize::from(self.count)).flat_map(move |i| {
             let batch = self
                 .batches
-                .get((usize::from(self.first) + i) % MAP_BATCHES)
+                .get(self.slot(i))
                 .copied()
+                .filter(|b| b.live_on(boundary))
                 .unwrap_or(Batch::EMPTY);
             let (start, len) = self.range(i, boundary);
+            let len = if batch.live_on(boundary) { len } else { 0 };
             let ring = self.entries.get(boundary).map_or(&[][..], |e| &e[..]);
             (0..len).filter_map(move |j| {
                 let e = ring.get((start + j) % M)?;
-                e.live().then(|| self.map_point(&batch, e))
+                let p = self.map_point(&batch, e);
+                (e.live() && fmax(p.near[2], p.far[2]) + p.radius >= 0.0).then_some(p)
             })
         })
     }
@@ -308,11 +396,11 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         }
     }
 
-    /// The points of `boundary` in batch `batch` (0 = oldest) as samples
-    /// of [`crate::geometry::road_geometry`]: each point's ray and fused
-    /// interval in its key frame's camera coordinates (one view per key
-    /// frame; the intervals are those of the key frame, not widened by the
-    /// carrying). Fewer if `out` fills up.
+    /// The points of `boundary` in batch `batch` (0 = oldest) not behind
+    /// the vehicle, as samples of [`crate::geometry::road_geometry`]: each
+    /// point's ray and fused interval in its key frame's camera coordinates
+    /// (one view per key frame; the intervals are those of the key frame,
+    /// not widened by the carrying). Fewer if `out` fills up.
     pub fn samples<const N: usize>(
         &self,
         batch: usize,
@@ -320,18 +408,22 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         out: &mut heapless::Vec<Sample, N>,
     ) {
         out.clear();
-        if batch >= usize::from(self.count) {
+        let Some(b) = self.batch_iter().nth(batch).copied() else {
+            return;
+        };
+        if !b.live_on(boundary) {
             return;
         }
         let (start, len) = self.range(batch, boundary);
         let Some(ring) = self.entries.get(boundary) else {
             return;
         };
+        let view = View::of(&b, self.tilt);
         for j in 0..len {
             let Some(e) = ring.get((start + j) % M) else {
                 continue;
             };
-            if e.live() {
+            if e.live() && !view.behind(e, &self.scale) {
                 let _ = out.push(Sample {
                     x: e.x,
                     y: e.y,
@@ -342,96 +434,120 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         }
     }
 
-    /// The id of batch `batch`'s key frame (0 = oldest).
-    pub fn batch_key(&self, batch: usize) -> Option<u32> {
-        self.batch_iter().nth(batch).map(|b| b.key)
-    }
-
     /// Carry every batch into the next frame by the motion `m` (from the
-    /// current frame to the next) with per-frame error bounds `bounds`, and
-    /// drop the points now behind the vehicle.
+    /// current frame to the next) with per-frame error bounds `bounds`,
+    /// and reclaim points behind the vehicle (module docs); the
+    /// point-by-point sweep only if `sweep`.
     ///
-    /// Work: `O(MAP_BATCHES)` plus one test per point of a batch that
-    /// straddles the camera.
-    pub(crate) fn carry(&mut self, m: &Motion, bounds: &StepBounds) {
+    /// Work: `O(MAP_BATCHES)` plus at most [`SWEEP_PER_FRAME`] point tests
+    /// per boundary.
+    pub(crate) fn carry(&mut self, m: &Motion, bounds: &StepBounds, sweep: bool) {
         let rt = mat3_transpose(&m.rotation_matrix());
         let t = m.translation();
-        let w = forward_axis(self.tilt);
         let widen = bounds.any();
+        // By batch slot: whether the camera is passing the batch.
+        let mut passing = [false; MAP_BATCHES];
         for i in 0..usize::from(self.count) {
-            let slot = (usize::from(self.first) + i) % MAP_BATCHES;
-            let Some(b) = self.batches.get_mut(slot) else {
+            let slot = self.slot(i);
+            let (Some(b), Some(pass)) = (self.batches.get_mut(slot), passing.get_mut(slot)) else {
                 continue;
             };
-            let a = b.a;
-            // A ← Rᵀ A column by column is Rᵀ times each column: (Rᵀ A).
-            b.a = crate::math::mat3_mul(&rt, &a);
+            // P' = Rᵀ (A P_K + b − T): A ← Rᵀ A, b ← Rᵀ (b − T).
+            b.a = mat3_mul(&rt, &b.a);
             let d = [b.b[0] - t[0], b.b[1] - t[1], b.b[2] - t[2]];
             b.b = mat3_vec(&rt, d);
             if widen {
                 let nb = sqrt(dot3(b.b, b.b));
-                b.rho =
-                    (b.rho + 1.732_051 * bounds.delta + bounds.omega * nb) * (1.0 + 1.0 / 65_536.0);
-                b.phi = (b.phi + bounds.omega) * (1.0 + 1.0 / 65_536.0);
+                b.rho = (b.rho + 1.732_051 * bounds.delta + bounds.omega * nb) * ROUND_UP;
+                b.phi = (b.phi + bounds.omega) * ROUND_UP;
             }
-            let b = *b;
-            self.drop_behind(i, &b, w);
+            if b.live_total() == 0 {
+                continue;
+            }
+            match View::of(b, self.tilt).whole(b) {
+                Whole::Ahead => {}
+                Whole::Behind => {
+                    self.drops.behind = self.drops.behind.saturating_add(b.live_total());
+                    b.live = [0; B];
+                }
+                Whole::Passing => *pass = true,
+            }
         }
         self.pop_dead();
+        if sweep {
+            for k in 0..B {
+                self.sweep_boundary(k, &passing);
+            }
+            self.pop_dead();
+        }
     }
 
-    /// Drop batch `i`'s points that are behind the camera.
-    fn drop_behind(&mut self, i: usize, b: &Batch<B>, w: [f32; 3]) {
-        // Forward coordinate of a key-frame point P: g·P + g0.
-        let g = mat3_vec(&mat3_transpose(&b.a), w);
-        let g0 = dot3(w, b.b);
-        let margin = b.spread + b.rho + b.phi * b.reach;
-        let fc = dot3(g, b.centre) + g0;
-        if fc - margin >= 0.0 {
-            return;
+    /// Test up to [`SWEEP_PER_FRAME`] points of `boundary` in the batches
+    /// the camera is passing (`passing`, by batch slot), from the sweep's
+    /// slot on; drop those behind.
+    fn sweep_boundary(&mut self, boundary: usize, passing: &[bool; MAP_BATCHES]) {
+        let used = self.used.get(boundary).map_or(0, |&u| usize::from(u));
+        let mut pos = self.sweep.get(boundary).map_or(0, |&c| usize::from(c));
+        if pos >= used {
+            pos = 0;
         }
-        let all = fc + margin < 0.0;
-        let scale = self.scale;
-        let mut dropped = [0u16; B];
-        for (k, dk) in dropped.iter_mut().enumerate() {
-            let (start, len) = self.range(i, k);
-            let Some(ring) = self.entries.get_mut(k) else {
-                continue;
+        let tail = self.tail.get(boundary).map_or(0, |&t| usize::from(t));
+        let mut left = SWEEP_PER_FRAME;
+        let mut offset = 0usize;
+        for i in 0..usize::from(self.count) {
+            let slot = self.slot(i);
+            let Some(b) = self.batches.get(slot).copied() else {
+                break;
             };
-            for j in 0..len {
-                let Some(e) = ring.get_mut((start + j) % M) else {
-                    continue;
-                };
-                if !e.live() {
-                    continue;
-                }
-                let behind = all || {
-                    let dir = g[0] * e.x + g[1] * e.y + g[2];
-                    let (zn, zf) = (scale.depth(e.near), scale.depth(e.far));
-                    let ahead = fmax(dir * zn, dir * zf) + g0;
-                    let r = b.rho + b.phi * zf * (1.0 + 0.5 * (e.x * e.x + e.y * e.y));
-                    ahead + r < 0.0
-                };
-                if behind {
-                    *e = Entry::DEAD;
-                    *dk += 1;
+            let len = b.len.get(boundary).map_or(0, |&l| usize::from(l));
+            let end = offset + len;
+            let pass = passing.get(slot).copied().unwrap_or(false);
+            if pos >= end || left == 0 {
+                offset = end;
+                continue;
+            }
+            if !pass || !b.live_on(boundary) {
+                pos = end;
+                offset = end;
+                continue;
+            }
+            let view = View::of(&b, self.tilt);
+            let n = (end - pos).min(left);
+            let mut dropped = 0u16;
+            if let Some(ring) = self.entries.get_mut(boundary) {
+                for j in pos..pos + n {
+                    if let Some(e) = ring.get_mut((tail + j) % M) {
+                        if e.live() && view.behind(e, &self.scale) {
+                            *e = Entry::DEAD;
+                            dropped += 1;
+                        }
+                    }
                 }
             }
+            if let Some(lv) = self
+                .batches
+                .get_mut(slot)
+                .and_then(|b| b.live.get_mut(boundary))
+            {
+                *lv = lv.saturating_sub(dropped);
+            }
+            self.drops.behind = self.drops.behind.saturating_add(u32::from(dropped));
+            left -= n;
+            pos += n;
+            offset = end;
         }
-        let slot = (usize::from(self.first) + i) % MAP_BATCHES;
-        if let Some(bm) = self.batches.get_mut(slot) {
-            for (l, d) in bm.live.iter_mut().zip(dropped) {
-                *l = l.saturating_sub(d);
-                self.drops.behind = self.drops.behind.saturating_add(u32::from(d));
-            }
+        if pos >= used {
+            pos = 0;
+        }
+        if let Some(c) = self.sweep.get_mut(boundary) {
+            *c = pos as u16;
         }
     }
 
     /// Remove the oldest batches that have no live point left.
     fn pop_dead(&mut self) {
         while self.count > 0 {
-            let slot = usize::from(self.first);
-            let Some(b) = self.batches.get(slot) else {
+            let Some(b) = self.batches.get(usize::from(self.first)) else {
                 return;
             };
             if b.live_total() > 0 {
@@ -445,16 +561,24 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
     /// Remove the oldest batch whose ring lengths are `lens` (its live
     /// points are counted by the caller).
     fn pop_oldest(&mut self, lens: &[u16; B]) {
-        for ((t, u), &l) in self.tail.iter_mut().zip(self.used.iter_mut()).zip(lens) {
+        for (((t, u), c), &l) in self
+            .tail
+            .iter_mut()
+            .zip(self.used.iter_mut())
+            .zip(self.sweep.iter_mut())
+            .zip(lens)
+        {
             *t = ((usize::from(*t) + usize::from(l)) % M) as u16;
             *u = u.saturating_sub(l);
+            *c = c.saturating_sub(l);
         }
         self.first = ((usize::from(self.first) + 1) % MAP_BATCHES) as u8;
         self.count -= 1;
     }
 
     /// Free `need` slots on `boundary` by dropping its oldest points;
-    /// returns the live points dropped.
+    /// returns the live points dropped for room (those found behind count
+    /// as behind).
     fn free_slots(&mut self, boundary: usize, need: usize) -> u32 {
         let mut dropped = 0u32;
         let mut need = need;
@@ -464,35 +588,47 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             if need == 0 {
                 break;
             }
-            let slot = (usize::from(self.first) + i) % MAP_BATCHES;
+            let slot = self.slot(i);
+            let Some(b) = self.batches.get(slot).copied() else {
+                break;
+            };
+            let alive = b.live_on(boundary);
+            let view = View::of(&b, self.tilt);
             let (start, len) = self.range(i, boundary);
             let take = len.min(need);
             let Some(ring) = self.entries.get_mut(boundary) else {
                 break;
             };
-            let mut live = 0u16;
+            let (mut live, mut behind) = (0u16, 0u16);
             for j in 0..take {
                 if let Some(e) = ring.get_mut((start + j) % M) {
-                    if e.live() {
-                        live += 1;
+                    if alive && e.live() {
+                        if view.behind(e, &self.scale) {
+                            behind += 1;
+                        } else {
+                            live += 1;
+                        }
                     }
                     *e = Entry::DEAD;
                 }
             }
-            if let (Some(b), Some(t), Some(u)) = (
+            if let (Some(b), Some(t), Some(u), Some(c)) = (
                 self.batches.get_mut(slot),
                 self.tail.get_mut(boundary),
                 self.used.get_mut(boundary),
+                self.sweep.get_mut(boundary),
             ) {
                 if let (Some(l), Some(lv)) = (b.len.get_mut(boundary), b.live.get_mut(boundary)) {
                     *l = l.saturating_sub(take as u16);
-                    *lv = lv.saturating_sub(live);
+                    *lv = lv.saturating_sub(live + behind);
                 }
                 // This batch's slots start at the ring's tail: every older
                 // batch has none left on this boundary.
                 *t = ((usize::from(*t) + take) % M) as u16;
                 *u = u.saturating_sub(take as u16);
+                *c = c.saturating_sub(take as u16);
             }
+            self.drops.behind = self.drops.behind.saturating_add(u32::from(behind));
             dropped += u32::from(live);
             need -= take;
         }
@@ -500,10 +636,12 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
     }
 
     /// Put a retiring key frame's fused points into the map: the points
-    /// [`FusedStatus::Consistent`] (or [`FusedStatus::Single`] if
-    /// `min_pairs ≤ 1`) with at least `min_pairs` agreeing pairs and a
-    /// bounded interval, as one batch posed by `chain` (the key frame's
-    /// motion to the current frame). The oldest points make room.
+    /// [`crate::fusion::FusedStatus::Consistent`] (or
+    /// [`crate::fusion::FusedStatus::Single`] if `min_pairs ≤ 1`) with at
+    /// least `min_pairs` agreeing pairs and a bounded interval, as one
+    /// batch posed by `chain` (the key frame's motion to the current
+    /// frame). `s` is a reconstruction of the key frame (its pixels). The
+    /// oldest points make room.
     ///
     /// Work: two passes over the key frame's points (`B·N`), plus the
     /// points dropped for room.
@@ -512,34 +650,20 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         key: &KeyFrame<N, B>,
         s: &Structure<N, B>,
         chain: &Chain,
-        min_pairs: u8,
     ) -> Retired {
+        let min_pairs = key.min_pairs();
         let mut out = Retired {
             key: key.id(),
             ..Retired::default()
         };
-        let eligible = |k: usize, i: usize| -> bool {
-            key.cell(k, i).is_some_and(|c| {
-                let st = c.status();
-                let ok =
-                    st == FusedStatus::Consistent || (st == FusedStatus::Single && min_pairs <= 1);
-                ok && c.support() >= min_pairs
-                    && c.interval().is_some_and(|iv| iv.z_far.is_finite())
-            })
-        };
-        // 1. Count, per boundary.
+        // 1. How many, per boundary (the key frame keeps the counts).
         let mut want = [0usize; B];
         for (k, w) in want.iter_mut().enumerate() {
-            for i in 0..key.len(k) {
-                if eligible(k, i) {
-                    *w += 1;
-                } else {
-                    match key.cell(k, i).map(|c| c.status()) {
-                        Some(FusedStatus::Inconsistent) => out.inconsistent += 1,
-                        _ => out.unverified += 1,
-                    }
-                }
-            }
+            let (admitted, inconsistent) = key.admission(k);
+            *w = usize::from(admitted);
+            out.inconsistent += u32::from(inconsistent);
+            out.unverified +=
+                (key.len(k) - usize::from(admitted) - usize::from(inconsistent)) as u32;
         }
         if want.iter().all(|&w| w == 0) {
             return out;
@@ -574,9 +698,11 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             key: key.id(),
             ..Batch::EMPTY
         };
-        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        let (ts, tc) = self.tilt;
+        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
         let mut reach = 0.0f32;
         let cam = s.camera1();
+        let scale = self.scale;
         for (k, &w) in want.iter().enumerate() {
             let start = self.tail.get(k).map_or(0, |&t| usize::from(t))
                 + self.used.get(k).map_or(0, |&u| usize::from(u));
@@ -585,36 +711,29 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
                 continue;
             };
             let mut n = 0usize;
-            for i in 0..key.len(k) {
+            for (c, r) in key.cells(k).iter().zip(results.points()) {
                 if n >= w {
                     break;
                 }
-                if !eligible(k, i) {
+                if c.admit(min_pairs) != Admit::Yes {
                     continue;
                 }
-                let (Some(iv), Some(r)) = (
-                    key.cell(k, i).and_then(|c| c.interval()),
-                    results.points().get(i),
-                ) else {
-                    continue;
-                };
                 let (x, y) = cam.normalise(r.pixel1());
-                let DepthInterval { z_near, z_far } = iv;
+                let (z_near, z_far) = c.ends();
                 let e = Entry {
                     x,
                     y,
-                    near: self.scale.down(z_near),
-                    far: self.scale.up(z_far).max(1),
+                    near: scale.down(z_near),
+                    far: scale.up(z_far).max(1),
                 };
-                let zf = self.scale.depth(e.far);
-                let zn = self.scale.depth(e.near);
-                for p in [[x * zn, y * zn, zn], [x * zf, y * zf, zf]] {
-                    for ((l, h), v) in lo.iter_mut().zip(hi.iter_mut()).zip(p) {
-                        *l = fmin(*l, v);
-                        *h = fmax(*h, v);
-                    }
-                }
-                reach = fmax(reach, zf * (1.0 + 0.5 * (x * x + y * y)));
+                // Forward coordinate (key frame's vehicle frame) of both
+                // ends; the coded ends are within 2⁻¹² of these (widened
+                // below).
+                let dir = tc - ts * y;
+                let (a, b) = (z_near * dir, z_far * dir);
+                lo = fmin(lo, fmin(a, b));
+                hi = fmax(hi, fmax(a, b));
+                reach = fmax(reach, z_far * (1.0 + 0.5 * (x * x + y * y)));
                 if let Some(slot) = ring.get_mut((start + n) % M) {
                     *slot = e;
                 }
@@ -632,21 +751,15 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             }
             out.entered += n as u32;
         }
-        let [l0, l1, l2] = lo;
-        let [h0, h1, h2] = hi;
-        let half = [0.5 * (h0 - l0), 0.5 * (h1 - l1), 0.5 * (h2 - l2)];
-        batch.centre = [0.5 * (h0 + l0), 0.5 * (h1 + l1), 0.5 * (h2 + l2)];
-        // Half the box's diagonal, rounded up a little.
-        batch.spread = sqrt(dot3(half, half)) * 1.0001 + 1e-6;
+        // The coded ends are up to 2⁻¹² beyond the fused ones, and the
+        // products round: widened by 2⁻¹⁰ of the reach.
+        let reach = reach * (1.0 + 1.0 / 1024.0);
+        batch.forward = (lo - reach / 1024.0, hi + reach / 1024.0);
         batch.reach = reach;
-        let slot = (usize::from(self.first) + usize::from(self.count)) % MAP_BATCHES;
+        let slot = self.slot(usize::from(self.count));
         if let Some(b) = self.batches.get_mut(slot) {
             *b = batch;
             self.count += 1;
-            // Points the camera has passed already leave at once.
-            let w = forward_axis(self.tilt);
-            self.drop_behind(usize::from(self.count) - 1, &batch, w);
-            self.pop_dead();
         }
         out
     }

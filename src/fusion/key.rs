@@ -99,8 +99,17 @@ pub struct FusedPoint {
 pub(crate) enum Added {
     /// It agreed with the fused interval (or was the first).
     Agreed,
-    /// It missed it: the point is inconsistent now (or was already).
-    Conflict,
+    /// It missed it: the point is inconsistent now (or was already). Before
+    /// it, whether the point was consistent and with how many pairs.
+    Conflict { was_clean: bool, was_major: u8 },
+}
+
+/// Whether a point enters the map ([`Cell::admit`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Admit {
+    Yes,
+    Inconsistent,
+    Unverified,
 }
 
 /// The state of one point (16 bytes).
@@ -145,8 +154,18 @@ impl Cell {
             self.major = self.major.saturating_add(1);
             return Added::Agreed;
         }
+        let (was_clean, was_major) = (self.clean(), self.major);
         self.conflict(near, far, scale);
-        Added::Conflict
+        Added::Conflict {
+            was_clean,
+            was_major,
+        }
+    }
+
+    /// No interval has missed the majority.
+    #[inline(always)]
+    fn clean(&self) -> bool {
+        self.rival_n == 0 && self.others == 0
     }
 
     /// An interval that missed the majority (out of line: rare).
@@ -184,9 +203,26 @@ impl Cell {
         }
     }
 
-    /// Pairs in the kept interval.
-    pub(crate) fn support(&self) -> u8 {
-        self.major
+    /// Whether the point goes into the map with at least `min_pairs`
+    /// agreeing pairs (no disagreeing one, a bounded interval).
+    /// (Every interval fused is finite, so a fused interval is bounded.)
+    #[inline]
+    pub(crate) fn admit(&self, min_pairs: u8) -> Admit {
+        if self.major == 0 {
+            Admit::Unverified
+        } else if !self.clean() {
+            Admit::Inconsistent
+        } else if self.major >= min_pairs {
+            Admit::Yes
+        } else {
+            Admit::Unverified
+        }
+    }
+
+    /// The fused interval's ends (meaningful when there is one).
+    #[inline]
+    pub(crate) fn ends(&self) -> (f32, f32) {
+        (self.near, self.far)
     }
 
     pub(crate) fn interval(&self) -> Option<DepthInterval> {
@@ -214,6 +250,32 @@ impl Cell {
             u32::from(self.rival[0]) | u32::from(self.rival[1]) << 16,
             u32::from(self.major) | u32::from(self.rival_n) << 8 | u32::from(self.others) << 16,
         ]
+    }
+}
+
+/// Keep a boundary's admitted and inconsistent counts after `added` made
+/// cell `c` what it is: a point is admitted the moment its agreeing pairs
+/// reach `min` (they grow one at a time while it is consistent; `min` is
+/// at most 64, below the count's saturation), and leaves the admitted and
+/// joins the inconsistent at its first conflict.
+#[inline(always)]
+fn count(added: Added, c: &Cell, min: u8, admitted: &mut u16, inconsistent: &mut u16) {
+    match added {
+        Added::Agreed => {
+            if c.major == min && c.clean() {
+                *admitted = admitted.saturating_add(1);
+            }
+        }
+        Added::Conflict {
+            was_clean: true,
+            was_major,
+        } => {
+            *inconsistent = inconsistent.saturating_add(1);
+            if was_major >= min {
+                *admitted = admitted.saturating_sub(1);
+            }
+        }
+        Added::Conflict { .. } => {}
     }
 }
 
@@ -249,6 +311,13 @@ pub struct FusedCounts {
 pub struct KeyFrame<const N: usize, const B: usize> {
     cells: [[Cell; N]; B],
     lens: [u16; B],
+    /// Per boundary, the points with at least `min_pairs` agreeing pairs
+    /// and no disagreeing one (the map's admission), and the inconsistent
+    /// ones: kept as the pairs come, so a retiring key frame need not
+    /// count them.
+    admitted: [u16; B],
+    inconsistent: [u16; B],
+    min_pairs: u8,
     id: u32,
     /// Frames paired with this key frame so far.
     partners: u16,
@@ -258,10 +327,13 @@ pub struct KeyFrame<const N: usize, const B: usize> {
 }
 
 impl<const N: usize, const B: usize> KeyFrame<N, B> {
-    pub(crate) const fn new(scale: DepthScale) -> Self {
+    pub(crate) const fn new(scale: DepthScale, min_pairs: u8) -> Self {
         Self {
             cells: [[Cell::EMPTY; N]; B],
             lens: [0; B],
+            admitted: [0; B],
+            inconsistent: [0; B],
+            min_pairs,
             id: 0,
             partners: 0,
             best_matched: 0,
@@ -276,6 +348,8 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
         self.partners = 0;
         self.best_matched = 0;
         self.lens = lens;
+        self.admitted = [0; B];
+        self.inconsistent = [0; B];
         for (&len, cells) in self.lens.iter().zip(self.cells.iter_mut()) {
             for c in cells.iter_mut().take(usize::from(len)) {
                 *c = Cell::EMPTY;
@@ -300,10 +374,13 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
     pub(crate) fn fuse(&mut self, s: &Structure<N, B>) -> PairFused {
         let mut out = PairFused::default();
         let scale = self.scale;
-        for ((cells, len), b) in self
+        let min = self.min_pairs;
+        for ((((cells, len), adm), inc), b) in self
             .cells
             .iter_mut()
             .zip(self.lens.iter())
+            .zip(self.admitted.iter_mut())
+            .zip(self.inconsistent.iter_mut())
             .zip(s.boundaries())
         {
             let cells = cells.get_mut(..usize::from(*len)).unwrap_or(&mut []);
@@ -312,9 +389,11 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
                     continue;
                 }
                 out.matched += 1;
-                if c.add(r.z_near, r.z_far, &scale) == Added::Conflict {
+                let added = c.add(r.z_near, r.z_far, &scale);
+                if let Added::Conflict { .. } = added {
                     out.conflicts += 1;
                 }
+                count(added, c, min, adm, inc);
             }
         }
         self.partners = self.partners.saturating_add(1);
@@ -336,9 +415,29 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
         if index >= len {
             return None;
         }
-        let scale = self.scale;
+        let (scale, min) = (self.scale, self.min_pairs);
         let c = self.cells.get_mut(boundary)?.get_mut(index)?;
-        Some(c.add(near, far, &scale))
+        let added = c.add(near, far, &scale);
+        if let (Some(adm), Some(inc)) = (
+            self.admitted.get_mut(boundary),
+            self.inconsistent.get_mut(boundary),
+        ) {
+            count(added, c, min, adm, inc);
+        }
+        Some(added)
+    }
+
+    /// Points of `boundary` the map would admit now, and inconsistent ones.
+    pub(crate) fn admission(&self, boundary: usize) -> (u16, u16) {
+        (
+            self.admitted.get(boundary).copied().unwrap_or(0),
+            self.inconsistent.get(boundary).copied().unwrap_or(0),
+        )
+    }
+
+    /// The map's minimum of agreeing pairs.
+    pub(crate) fn min_pairs(&self) -> u8 {
+        self.min_pairs
     }
 
     /// The key frame's id.
@@ -374,6 +473,15 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
     /// Point `index` of `boundary`, if the key frame has it.
     pub fn point(&self, boundary: usize, index: usize) -> Option<FusedPoint> {
         Some(self.cell(boundary, index)?.public())
+    }
+
+    /// The cells of `boundary`'s points.
+    pub(crate) fn cells(&self, boundary: usize) -> &[Cell] {
+        let n = self.len(boundary);
+        self.cells
+            .get(boundary)
+            .and_then(|c| c.get(..n))
+            .unwrap_or(&[])
     }
 
     pub(crate) fn cell(&self, boundary: usize, index: usize) -> Option<&Cell> {
@@ -464,7 +572,7 @@ mod tests {
         for (n, f) in [(2.0, 4.0), (3.0, 5.0), (2.8, 3.6)] {
             c.add(n, f, &sc());
         }
-        assert_eq!(c.add(6.0, 7.0, &sc()), Added::Conflict);
+        assert!(matches!(c.add(6.0, 7.0, &sc()), Added::Conflict { .. }));
         let p = c.public();
         assert_eq!(p.status, FusedStatus::Inconsistent);
         assert_eq!((p.pairs, p.disagreeing), (4, 1));
@@ -473,7 +581,7 @@ mod tests {
         assert_eq!(c.add(3.1, 3.4, &sc()), Added::Agreed);
         assert_eq!(c.interval().map(|i| (i.z_near, i.z_far)), Some((3.1, 3.4)));
         // One missing both counts against both.
-        assert_eq!(c.add(0.5, 1.0, &sc()), Added::Conflict);
+        assert!(matches!(c.add(0.5, 1.0, &sc()), Added::Conflict { .. }));
         assert_eq!((c.public().pairs, c.public().disagreeing), (6, 2));
     }
 

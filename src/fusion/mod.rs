@@ -77,6 +77,7 @@ mod key;
 use core::fmt;
 
 pub(crate) use chain::{Chain, StepBounds};
+pub(crate) use key::Admit;
 pub use key::{FusedCounts, FusedPoint, FusedStatus, KeyFrame, PairFused};
 
 use crate::boundary::Frame;
@@ -112,7 +113,7 @@ pub enum FusionConfigError {
     Partners,
     /// `keep_permille` is above 1000.
     KeepShare,
-    /// The map's minimum of agreeing pairs is 0.
+    /// The map's minimum of agreeing pairs is not in `1..=64`.
     MinPairs,
     /// The tilt is NaN or beyond ±90°.
     Tilt,
@@ -125,7 +126,7 @@ impl fmt::Display for FusionConfigError {
         f.write_str(match self {
             Self::Partners => "partners per key frame must be in 1..=64",
             Self::KeepShare => "the share of matched points must be at most 1000 permille",
-            Self::MinPairs => "the map needs at least one agreeing pair per point",
+            Self::MinPairs => "the map's minimum of agreeing pairs must be in 1..=64",
             Self::Tilt => "the tilt must be finite and within 90 degrees",
         })
     }
@@ -188,10 +189,10 @@ impl FusionConfig {
     }
 
     /// The same policy with points entering the map only with at least
-    /// `pairs` agreeing pairs (1 admits [`FusedStatus::Single`] points,
-    /// which nothing has checked).
+    /// `pairs` agreeing pairs, 1 to 64 (1 admits [`FusedStatus::Single`]
+    /// points, which nothing has checked).
     pub const fn with_map_min_pairs(mut self, pairs: u8) -> Result<Self, FusionConfigError> {
-        if pairs == 0 {
+        if pairs == 0 || pairs > 64 {
             return Err(FusionConfigError::MinPairs);
         }
         self.map_min_pairs = pairs;
@@ -328,7 +329,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             processor: Processor::new(base),
             base,
             config,
-            key: KeyFrame::new(scale),
+            key: KeyFrame::new(scale, config.map_min_pairs),
             has_key: false,
             chain: Chain::IDENTITY,
             last: None,
@@ -425,15 +426,14 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             return Err(FusionError::RepeatedFrame(id));
         }
         self.last = Some(id);
-        // 2. The map follows the vehicle.
         let bounds = StepBounds::of(&self.base);
-        self.map.carry(&m.motion, &bounds);
         self.settle();
         if !self.has_key {
+            self.map.carry(&m.motion, &bounds, true);
             out.new_key = self.start_key(id, frame, KeyReason::First, false);
             return Ok(out);
         }
-        // 3. The motion from the key frame, and the pair.
+        // 2. The motion from the key frame, and the pair.
         let chain = self.chain.then(&m.motion, &bounds);
         let pair = match chain.motion() {
             Err(_) => Err(KeyReason::MotionLimit),
@@ -442,6 +442,11 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
                 Ok(cfg) => Ok((motion, cfg)),
             },
         };
+        let last_partner = self.due && has_points(frame);
+        // 3. The map follows the vehicle; its sweep rests in a frame where
+        // a key frame retires (that frame copies its points instead).
+        self.map
+            .carry(&m.motion, &bounds, !(last_partner || pair.is_err()));
         let (motion, cfg) = match pair {
             Ok(p) => p,
             Err(reason) => {
@@ -455,7 +460,6 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         if bounds.any() {
             self.processor.set_config(cfg);
         }
-        let last_partner = self.due && has_points(frame);
         let fused = if last_partner {
             match self.processor.process(frame, Some(&motion)) {
                 Ok(Step::Structure(s)) => self.key.fuse(s),
@@ -468,6 +472,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
                 Err(_) => PairFused::default(),
             }
         };
+        // 4. The pair fused; a last partner retires the key frame.
         out.paired = Some(fused);
         out.partner = self.key.partners();
         if last_partner {
@@ -486,7 +491,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             return Ok(out);
         }
         self.chain = chain;
-        // 4. The policy: is the next frame the last partner?
+        // 5. The policy: is the next frame the last partner?
         let p = self.key.partners();
         let best = self.key.best_matched();
         let few = u64::from(fused.matched) * 1000
@@ -537,12 +542,10 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         if !self.has_key || self.key.partners() == 0 {
             return None;
         }
-        Some(self.map.retire(
-            &self.key,
-            self.processor.structure(),
-            chain,
-            self.config.map_min_pairs,
-        ))
+        Some(
+            self.map
+                .retire(&self.key, self.processor.structure(), chain),
+        )
     }
 
     /// Intersect point `index` of key-frame boundary `boundary` with a
@@ -581,7 +584,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         // (sqrt is within 2e-7 of the truth; 1e-6 covers it and the division.)
         let (zn, zf) = (near / n * (1.0 - 1.0e-6), far / n * (1.0 + 1.0e-6));
         match self.key.constrain(boundary, index, zn, zf) {
-            Some(Added::Agreed | Added::Conflict) => {}
+            Some(Added::Agreed | Added::Conflict { .. }) => {}
             None => return Err(FusionError::NoSuchPoint),
         }
         self.key

@@ -45,7 +45,7 @@
 //!   its own farthest points beyond `M`.
 //!
 //! Size: `12·B·M` bytes of points and [`MAP_BATCHES`] batches of
-//! `88 + 4·B` bytes (`12 KiB + 0.8 KiB` for `B = 2`, `M = 512`).
+//! `72 + 4·B` bytes (12 968 bytes in all for `B = 2`, `M = 512`).
 
 use crate::fusion::code::DepthScale;
 use crate::fusion::{Admit, Chain, KeyFrame, StepBounds};

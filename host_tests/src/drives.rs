@@ -265,6 +265,23 @@ impl DriveSpec {
     }
 }
 
+/// The paper's Fig. 6 set-up as a drive of `frames` frames: the camera
+/// of Sec. 3 (h = 1, tilt 23°, f = 800), the right curve of radius 15 and
+/// width 1.3, 0.4 forward a frame along it, the heading leading the
+/// road's by the turn over 1.5 and wobbling ±2°.
+pub fn fig6_drive(frames: usize) -> Drive {
+    let mut s = DriveSpec::new(DriveFamily::Fig6, 0, frames);
+    s.name = "fig6 (r = 15, 0.4 a frame)".into();
+    s.road = Road {
+        curvature_a: 1.0 / 15.0,
+        curvature_b: 1.0 / 15.0,
+        ..Road::straight(1.3)
+    };
+    s.step = 0.4;
+    s.yaw_bias = 1.5 / 15.0;
+    s.render().expect("both edges in view")
+}
+
 /// One frame of a rendered drive.
 #[derive(Debug, Clone)]
 pub struct DriveFrame {
@@ -639,12 +656,12 @@ pub struct Run {
 }
 
 /// Run the fusion over the input; `each` sees the fusion after every
-/// frame (with the frame index).
+/// frame (with the frame index and the step's report).
 pub fn run(
     d: &Drive,
     input: &Input,
     policy: FusionConfig,
-    mut each: impl FnMut(usize, &HostFusion),
+    mut each: impl FnMut(usize, &FusionStep, &HostFusion),
 ) -> Run {
     let k = d.spec.intrinsics;
     let mut fusion = Box::new(HostFusion::new(input.config(), policy));
@@ -696,7 +713,7 @@ pub fn run(
                     .collect(),
             );
         }
-        each(j, &fusion);
+        each(j, &step, &fusion);
     }
     Run { keys, steps }
 }

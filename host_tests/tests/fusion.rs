@@ -5,7 +5,8 @@
 //! inputs.
 
 use host_tests::drives::{
-    run, tally, Drive, DriveFamily, DriveSpec, HostFusion, MotionNoise, Noise, Run, Tally,
+    fig6_drive, run, tally, Drive, DriveFamily, DriveSpec, HostFusion, MotionNoise, Noise, Run,
+    Tally,
 };
 use host_tests::synth::{self, Road, Scenario};
 use host_tests::{scenarios, B, N};
@@ -72,7 +73,7 @@ fn containment(noise: Noise, motion: Option<MotionNoise>, per_family: usize) -> 
         let mut t = Tally::default();
         for (seed, d) in &ds {
             let input = d.input(noise, motion, *seed);
-            let r = run(d, &input, policy, |_, _| {});
+            let r = run(d, &input, policy, |_, _, _| {});
             t.add(&tally(d, &r));
         }
         let _ = writeln!(
@@ -201,7 +202,7 @@ fn wrong_matches_on_disjoint_stretches_are_flagged() {
     let mut all = Tally::default();
     for (v, noise) in [Noise::Rounded, Noise::Disc].into_iter().enumerate() {
         let input = d.input(noise, None, v as u64);
-        let r = run(&d, &input, policy, |_, _| {});
+        let r = run(&d, &input, policy, |_, _, _| {});
         let t = tally(&d, &r);
         wrong_match_report(&format!("built on purpose, {}", noise.name()), &t);
         all.add(&t);
@@ -247,7 +248,7 @@ fn wrong_matches_of_the_random_scenarios_are_flagged() {
         let s = scenarios::random(seed);
         let d = Drive::through_scenario(&s, &[0.0, 0.25, 0.5, 0.75, 1.0]).expect("drive");
         let input = d.input(Noise::Rounded, None, seed);
-        let r = run(&d, &input, policy, |_, _| {});
+        let r = run(&d, &input, policy, |_, _, _| {});
         all.add(&tally(&d, &r));
     }
     wrong_match_report("random scenarios, driven through", &all);
@@ -345,23 +346,6 @@ impl Narrowing {
     }
 }
 
-/// The paper's Fig. 6 set-up as a drive: the camera of Sec. 3 (h = 1, tilt
-/// 23°, f = 800), the right curve of radius 15 and width 1.3, 0.4 forward
-/// a frame along it, the heading leading the road's by the turn over 1.5
-/// and wobbling ±2°.
-fn fig6_drive(frames: usize) -> Drive {
-    let mut s = DriveSpec::new(DriveFamily::Fig6, 0, frames);
-    s.name = "fig6 (r = 15, 0.4 a frame)".into();
-    s.road = Road {
-        curvature_a: 1.0 / 15.0,
-        curvature_b: 1.0 / 15.0,
-        ..Road::straight(1.3)
-    };
-    s.step = 0.4;
-    s.yaw_bias = 1.5 / 15.0;
-    s.render().expect("both edges in view")
-}
-
 /// The narrowing table: the median relative width of the first key frame's
 /// fused intervals after 1, 2, 4 and 8 partner frames (the policy keeps it
 /// for 8), over the points with an interval after the first; the goal is
@@ -385,20 +369,22 @@ fn fused_intervals_narrow_with_the_partners() {
             None,
             v,
         );
-        n.add(&fig6, &run(&fig6, &input, policy, |_, _| {}));
+        n.add(&fig6, &run(&fig6, &input, policy, |_, _, _| {}));
     }
     let (row, fig6_gain) = n.row("Fig. 6 set-up (4 noise draws)");
     lines.push(row);
     let mut pooled = Narrowing::default();
     let mut gains = Vec::new();
+    let mut wrong = Tally::default();
     for family in DriveFamily::ALL {
         let (ds, _) = drives(family, 20, FRAMES);
         let mut n = Narrowing::default();
         for (seed, d) in &ds {
             let input = d.input(Noise::Rounded, None, *seed);
-            let r = run(d, &input, policy, |_, _| {});
+            let r = run(d, &input, policy, |_, _, _| {});
             n.add(d, &r);
             pooled.add(d, &r);
+            wrong.add(&tally(d, &r));
         }
         let (row, gain) = n.row(&format!("{} (20)", family.name()));
         lines.push(row);
@@ -407,6 +393,11 @@ fn fused_intervals_narrow_with_the_partners() {
     let (row, pooled_gain) = pooled.row("all random drives (160)");
     lines.push(row);
     println!("{}", lines.join("\n"));
+    // Key frames kept for 8 partners see more wrong two-view matches (their
+    // later partners see less of the key frame's stretch).
+    wrong_match_report("the 160 random drives, 8 partners a key frame", &wrong);
+    assert_eq!(wrong.consistent, wrong.consistent_contained);
+    assert_eq!(wrong.wrong_fused, 0);
     assert!(fig6_gain >= 3.0, "Fig. 6: {fig6_gain:.2}×");
     assert!(pooled_gain >= 3.0, "random drives: {pooled_gain:.2}×");
     for (name, g) in gains {
@@ -436,7 +427,7 @@ fn check_map(d: &Drive, input: &host_tests::drives::Input, policy: FusionConfig)
     let k = d.spec.intrinsics;
     let cam = k.camera();
     let mut c = MapCheck::default();
-    let r = run(d, input, policy, |j, f| {
+    let r = run(d, input, policy, |j, _, f| {
         for b in 0..B {
             for p in f.map().points(b) {
                 let key = p.key as usize;
@@ -520,7 +511,9 @@ fn the_map_holds_the_truth_in_the_vehicle_frame() {
         ));
         assert!(all.points > 10_000, "{all:?}");
         assert!(all.worst_excess <= 1e-4, "{all:?}");
-        assert!(all.behind > 0, "{all:?}");
+        // (With motion errors the sticks reach far ahead: none is wholly
+        // behind within 24 frames.)
+        assert!(motion.is_some() || all.behind > 0, "{all:?}");
     }
     println!("{}", lines.join("\n"));
 }
@@ -768,7 +761,7 @@ fn road_geometry_from_the_fused_map() {
         // (b) Each key frame's fused points as it retires (also those the
         // vehicle has passed since, which the map drops).
         let mut key_sets: Vec<(Vec<Sample>, Vec<Sample>)> = Vec::new();
-        let r = run(&d, &input, policy, |j, f| {
+        let r = run(&d, &input, policy, |j, _, f| {
             if let Some(key) = f.key() {
                 let kid = key.id() as usize;
                 if key.partners() >= partners {

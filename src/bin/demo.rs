@@ -134,7 +134,7 @@ fn main() -> ! {
             counts.inconsistent,
             paired.conflicts,
             (median * 1000.0) as u32,
-            (map.len(0) + map.len(1)) as u32,
+            (map.points(0).count() + map.points(1).count()) as u32,
             map.drops().behind,
             map.drops().capacity,
             fusion.digest()

@@ -63,12 +63,17 @@
 //! # Memory and work
 //! Beside the processor, `Fusion<N, B, M>` holds a [`KeyFrame`] (`16·B·N`
 //! bytes), a [`RoadMap`] (`12·B·M` bytes and [`crate::map::MAP_BATCHES`]
-//! batches) and a few words: 21.4 KiB for `N = 256`, `B = 2`, `M = 512` on
-//! the Cortex-M4F, asserted at compile time there (at most 24 KiB). Per
-//! frame the fusion costs one pass over the key frame's points (`O(1)`
-//! each), `O(MAP_BATCHES)` to carry the map and one test per point of the
-//! batch the camera is passing; a retiring key frame two more passes over
-//! its points. README ("Fusion") gives the instructions measured.
+//! batches) and a few words: 21 340 bytes for `N = 256`, `B = 2`,
+//! `M = 512` on the Cortex-M4F, asserted at compile time there (at most
+//! 24 KiB). Per frame the fusion costs one pass over the key frame's points
+//! (`O(1)` each: an intersection, or the consistency check), `O(MAP_BATCHES)`
+//! to carry the map and at most [`crate::map::SWEEP_PER_FRAME`] point tests
+//! per boundary for points the vehicle has passed; a retiring key frame
+//! one more pass to copy its points into the map. The depths of the map
+//! and of the rival intervals are 16-bit codes relative to a power of two
+//! at or above the configuration's maximum depth (resolution `2⁻¹²` of the
+//! depth for depths within `2¹⁵` of it, rounded outwards). README
+//! ("Fusing many frames") gives the instructions measured.
 
 mod chain;
 pub(crate) mod code;

@@ -36,7 +36,7 @@ pub fn demo(check: bool) -> Result<(), String> {
 /// median relative width, inconsistent points, the road map.
 fn frame_table(frames: &[Record]) {
     println!();
-    println!("| frame | points | ok | flagged | instructions | instr/point | frame budget used | key frame (partner) | fused | median fused width | inconsistent | map points (dropped behind) |");
+    println!("| frame | points | ok | flagged | instructions | instr/point | frame budget used | key frame (partner) | fused | median fused width | inconsistent | map points ahead (dropped behind) |");
     println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for f in frames {
         let points = num(f, "points");

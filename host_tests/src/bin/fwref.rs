@@ -96,7 +96,7 @@ fn main() -> std::process::ExitCode {
             counts.inconsistent,
             step.paired.unwrap_or_default().conflicts,
             (median * 1000.0) as u32,
-            map.len(0) + map.len(1),
+            map.points(0).count() + map.points(1).count(),
             map.drops().behind,
             map.drops().capacity,
             fusion.digest()

@@ -15,7 +15,7 @@ fn main() {
     fs::write(out.join("memory.x"), include_bytes!("memory.x")).expect("write memory.x");
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rustc-link-arg-bins=-Tlink.x");
-    for bin in ["demo", "bench", "profile"] {
+    for bin in ["demo", "bench", "profile", "link"] {
         println!("cargo:rustc-link-arg-bin={bin}=-Tdefmt.x");
     }
 }

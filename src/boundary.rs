@@ -211,6 +211,41 @@ impl<const N: usize, const B: usize> Frame<N, B> {
         }
     }
 
+    /// Start filling this frame in place for `camera`: no boundaries yet.
+    /// (The wire decoder writes points straight into the slots.)
+    pub(crate) fn restart(&mut self, camera: Camera) {
+        self.camera = camera;
+        self.count = 0;
+    }
+
+    /// The storage of the next boundary slot (all `N` points), to be
+    /// written before [`Frame::commit_next_validated`]; `None` when the frame holds
+    /// `B` boundaries.
+    pub(crate) fn next_storage(&mut self) -> Option<&mut [Pixel; N]> {
+        self.slots
+            .get_mut(self.count)
+            .map(|s| s.points.storage_mut())
+    }
+
+    /// Append the first `len` points written into the next slot as the
+    /// next boundary, **already validated** by the caller with checks
+    /// equivalent to [`Frame::push_boundary`]'s (the wire decoder checks
+    /// its fixed-point points as integers, in the same order with the same
+    /// errors; `wire`'s tests and the host fuzz test compare the two on
+    /// every decoded frame). `false` when the frame holds `B` boundaries or
+    /// `len > N` (nothing changes then).
+    pub(crate) fn commit_next_validated(&mut self, len: usize) -> bool {
+        if len > N {
+            return false;
+        }
+        let Some(slot) = self.slots.get_mut(self.count) else {
+            return false;
+        };
+        slot.points.set_len(len);
+        self.count += 1;
+        true
+    }
+
     /// Remove all boundaries (keeps the camera).
     pub fn clear(&mut self) {
         self.count = 0;

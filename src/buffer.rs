@@ -36,6 +36,12 @@ impl<T: Copy, const N: usize> Buffer<T, N> {
         self.items.get_mut(..self.len).unwrap_or(&mut [])
     }
 
+    /// All `N` elements, live or not, to be written in place before
+    /// [`Buffer::set_len`] makes them live (the wire decoder's points).
+    pub(crate) fn storage_mut(&mut self) -> &mut [T; N] {
+        &mut self.items
+    }
+
     /// Make the first `len` elements live (at most `N`); elements that
     /// become live hold whatever they last held.
     pub(crate) fn set_len(&mut self, len: usize) {

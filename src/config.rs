@@ -120,6 +120,27 @@ impl Config {
         })
     }
 
+    /// The same configuration with other localisation errors `e₁` (frame 1,
+    /// the kept frame) and `e₂` (frame 2), pixels, each in `[0, 100]`: how
+    /// the per-boundary error radii of the wire format reach the
+    /// computation ([`crate::wire`]).
+    ///
+    /// ```
+    /// use roadstereo::Config;
+    /// let c = Config::DEFAULT.with_localisation_error(0.25, 1.5)?;
+    /// assert_eq!((c.e1(), c.e2()), (0.25, 1.5));
+    /// assert!(Config::DEFAULT.with_localisation_error(f32::NAN, 0.5).is_err());
+    /// # Ok::<(), roadstereo::ConfigError>(())
+    /// ```
+    pub const fn with_localisation_error(mut self, e1: f32, e2: f32) -> Result<Self, ConfigError> {
+        if !(e1 >= 0.0 && e1 <= 100.0 && e2 >= 0.0 && e2 <= 100.0) {
+            return Err(ConfigError::LocalisationError);
+        }
+        self.e1 = e1;
+        self.e2 = e2;
+        Ok(self)
+    }
+
     /// The same configuration with sticks that also hold when each
     /// component `(U, V, W)` of the translation given to
     /// [`crate::Processor::process`] may be off by up to `delta` (length

@@ -211,6 +211,74 @@ impl PairGeometry {
         })
     }
 
+    /// [`Self::compensate_with`] with the frame-wide stretch bound `stretch`
+    /// for a pixel known to compensate in front ([`Self::certifies_image`]):
+    /// the same values without the test of `q_z`.
+    #[inline(always)]
+    pub(crate) fn compensate_certified(&self, p1: Pixel, stretch: f32) -> Compensated {
+        let [x, y, z] = mat3_vec(&self.h, [p1.u, p1.v, 1.0]);
+        let iz = 1.0 / z;
+        Compensated {
+            pixel: [x * iz, y * iz],
+            inv_depth_scale: iz,
+            stretch,
+        }
+    }
+
+    /// Whether every pixel of `cam`'s image with its margin passes the
+    /// processor's step-1 checks (module `processor`): `q_z > 10⁻⁶`, the
+    /// compensated point [`Self::in_view`], and `dse / q_z ≤ 1/2` for the
+    /// bound `dse` on `q_z`'s change, each computed in `f32`.
+    ///
+    /// On the image rectangle `q_z = h₂₀u + h₂₁v + h₂₂` is affine and, where
+    /// it is positive, the compensated coordinates are linear-fractional,
+    /// so all three take their extremes at the corners. A pixel's computed
+    /// `q_z` is within `2⁻²² A` of the exact value (`A = |h₂₀| u_max +
+    /// |h₂₁| v_max + |h₂₂|`, three roundings), and so is each corner's;
+    /// the corners are required to pass with twice that, and the
+    /// coordinates within twice their own rounding bound of the view's
+    /// edges. Then no point of the image fails, and step 1 can skip the
+    /// checks (the same results, bit for bit).
+    pub(crate) fn certifies_image(&self, cam: &Camera, dse: f32) -> bool {
+        let m = crate::camera::IMAGE_MARGIN_PX;
+        let (u1, v1) = (
+            f32::from(cam.width()) - 1.0 + m,
+            f32::from(cam.height()) - 1.0 + m,
+        );
+        let (umax, vmax) = (fmax(m, u1), fmax(m, v1));
+        let bound = |r: [f32; 3]| r[0].abs() * umax + r[1].abs() * vmax + r[2].abs();
+        let [hx, hy, hz] = self.h;
+        let (ax, ay, az) = (bound(hx), bound(hy), bound(hz));
+        let corners = [[-m, -m], [u1, -m], [-m, v1], [u1, v1]];
+        let mut zmin = f32::INFINITY;
+        for [u, v] in corners {
+            zmin = fmin(zmin, mat3_vec(&self.h, [u, v, 1.0])[2]);
+        }
+        // The smallest q_z any pixel computes, over a relative 2⁻²⁰.
+        let zlow = (zmin - 9.6e-7 * az) * (1.0 - 9.6e-7);
+        // (A NaN fails.)
+        if !(zlow > 1.0e-6 && dse <= 0.5 * zlow * (1.0 - 9.6e-7)) {
+            return false;
+        }
+        let p = corners.map(|[u, v]| {
+            let [x, y, z] = mat3_vec(&self.h, [u, v, 1.0]);
+            let iz = 1.0 / z;
+            [x * iz, y * iz]
+        });
+        let (mut bx, mut by) = (0.0f32, 0.0f32);
+        for [px, py] in p {
+            (bx, by) = (fmax(bx, px.abs()), fmax(by, py.abs()));
+        }
+        // Twice the rounding bound of a computed coordinate, at a pixel or
+        // at a corner: (|Δx| + |p| |Δq_z|)/q_z plus its own rounding.
+        let ex = 4.8e-7 * ((ax + bx * az) / zlow + bx);
+        let ey = 4.8e-7 * ((ay + by * az) / zlow + by);
+        let [u0, u1, v0, v1] = self.view;
+        // (A NaN fails.)
+        p.iter()
+            .all(|&[px, py]| px - ex >= u0 && px + ex <= u1 && py - ey >= v0 && py + ey <= v1)
+    }
+
     /// The frame-wide stretch bound, if there is one.
     pub(crate) fn frame_stretch(&self) -> Option<f32> {
         self.stretch_bound.is_finite().then_some(self.stretch_bound)
@@ -323,6 +391,53 @@ fn stretch_bound(h: &Mat3, cam: &Camera) -> f32 {
 mod tests {
     use super::*;
     use crate::test_rng::Rng;
+
+    /// A certified image passes every step-1 check at every pixel (a grid
+    /// over the image with its margin, its edges and corners included);
+    /// most ordinary geometries certify, and ones that put part of the
+    /// image behind the camera, out of view or with `q_z` too uncertain
+    /// do not.
+    #[test]
+    fn certified_images_pass_every_check() {
+        let mut rng = Rng(0xce27_1f1e);
+        let mut certified = 0;
+        for case in 0..600 {
+            let cam = Camera::new(
+                300.0 + 900.0 * rng.next(),
+                300.0 + 900.0 * rng.next(),
+                200.0 + 100.0 * rng.next(),
+                200.0 + 80.0 * rng.next(),
+                512,
+                480,
+            )
+            .expect("camera");
+            // Rotations up to 60° (some put image corners behind the
+            // camera) and q_z bounds up to 1.
+            let deg = [1.0f32, 10.0, 60.0][case % 3];
+            let a = [0.0; 3].map(|_: f32| (rng.next() - 0.5) * 2.0 * deg.to_radians());
+            let m = Motion::new([0.1, 0.0, 1.0], a).expect("motion");
+            let g = PairGeometry::new(&cam, &cam, &m);
+            let dse = rng.next() * rng.next();
+            if !g.certifies_image(&cam, dse) {
+                continue;
+            }
+            certified += 1;
+            for i in 0..=64 {
+                for j in 0..=64 {
+                    let p = Pixel::new(
+                        -1.0 + 513.0 * i as f32 / 64.0,
+                        -1.0 + 481.0 * j as f32 / 64.0,
+                    );
+                    let c = g.compensate(p).expect("in front");
+                    assert!(g.in_view(c.pixel), "case {case}: {p:?}");
+                    assert!(dse * c.inv_depth_scale <= 0.5, "case {case}: {p:?}");
+                    let f = g.compensate_certified(p, 1.0);
+                    assert_eq!((f.pixel, f.inv_depth_scale), (c.pixel, c.inv_depth_scale));
+                }
+            }
+        }
+        assert!((200..600).contains(&certified), "certified {certified}");
+    }
 
     /// The frame-wide stretch bound is never below a point's own stretch,
     /// anywhere in the image with its margin, and exceeds the largest one

@@ -20,6 +20,9 @@
 //! [`fusion`] (the error ranges of many frames fused on a key frame's rays,
 //! Sec. 5) with its [`map`] (the fused road in the current vehicle frame).
 //!
+//! [`wire`] is the camera front-end link's format and streaming decoder,
+//! [`link`] its embedded-hal / embedded-io drivers.
+//!
 //! See the README for the coordinate conventions and a worked example.
 #![no_std]
 #![forbid(unsafe_code)]
@@ -48,6 +51,7 @@ pub mod depth;
 pub mod epipolar;
 pub mod fusion;
 pub mod geometry;
+pub mod link;
 pub mod map;
 mod matching;
 mod math;
@@ -58,6 +62,7 @@ pub mod processor;
 mod search;
 mod structure;
 mod wedge;
+pub mod wire;
 
 pub use boundary::{Boundary, BoundaryError, Frame};
 pub use camera::{Camera, CameraError, Pixel, IMAGE_MARGIN_PX};

@@ -180,17 +180,7 @@ impl Keying {
     #[inline(always)]
     pub(crate) fn key(&self, q: [f32; 2]) -> (f32, f32) {
         match self.pencil {
-            Pencil::Half { foe, side, min_t } => {
-                let d = sub(q, foe);
-                let t = side * d[1];
-                // NaN fails the test too.
-                if t >= min_t {
-                    let inv = 1.0 / (d[0].abs() + t);
-                    (d[0] * inv, self.key_scale * inv + ULP20)
-                } else {
-                    (NO_KEY, 0.0)
-                }
-            }
+            Pencil::Half { foe, side, min_t } => half_key(q, (foe, side, min_t), self.key_scale),
             Pencil::Angular { foe } => {
                 let d = sub(q, foe);
                 // NaN fails the test too.
@@ -262,6 +252,25 @@ impl Keying {
         }
         let (lo, hi) = if k0 <= k1 { (k0, k1) } else { (k1, k0) };
         Some((lo - self.eps, hi + self.eps))
+    }
+}
+
+/// The half-plane key of `q` ([`Pencil::Half`] with these fields) and its
+/// margin, or [`NO_KEY`] (and 0).
+#[inline(always)]
+pub(crate) fn half_key(
+    q: [f32; 2],
+    (foe, side, min_t): ([f32; 2], f32, f32),
+    key_scale: f32,
+) -> (f32, f32) {
+    let d = sub(q, foe);
+    let t = side * d[1];
+    // NaN fails the test too.
+    if t >= min_t {
+        let inv = 1.0 / (d[0].abs() + t);
+        (d[0] * inv, key_scale * inv + ULP20)
+    } else {
+        (NO_KEY, 0.0)
     }
 }
 

@@ -6,10 +6,12 @@
 //! 1. **Compensate** every frame-1 point ([`crate::epipolar`]): `p₁'`, `1/q_z`,
 //!    its error radius `r₁`, and the key of its epipolar line
 //!    ([`crate::pencil`]); points behind the frame-2 camera or far out of
-//!    its view are flagged.
+//!    its view are flagged (checks a frame skips when its whole image
+//!    passes them, `PairGeometry::certifies_image`).
 //! 2. **Fold test**: index the compensated frame-1 polyline by key and flag
 //!    the points whose own epipolar line meets it again away from them
-//!    ([`Status::Folded`]).
+//!    ([`Status::Folded`]); when the keys are strictly ordered along the
+//!    polyline nothing folds, and no index is built.
 //! 3. **Index** the corresponding frame-2 polyline ([`crate::search`]).
 //! 4. **Match** every remaining point: its error band ([`crate::depth`]),
 //!    the segments the index offers for the band's key interval, the walk
@@ -38,12 +40,12 @@ use crate::depth::{interval, Band, PointErrors};
 use crate::epipolar::PairGeometry;
 use crate::matching::{Outcome, Radial, Walker};
 use crate::motion::Motion;
-use crate::pencil::{Keying, Pencil, NO_KEY};
+use crate::pencil::{half_key, Keying, Pencil, NO_KEY};
 use crate::search::{
-    run_start_in, Flow, Index, OutOfWork, Query, Unkeyed, Visitor, Work, CLIP_UNITS,
+    run_start_in, Flow, Index, KeyOrder, OutOfWork, Query, Unkeyed, Visitor, Work, CLIP_UNITS,
 };
 use crate::structure::{PointResult, ProcessError, Status, Step, Structure, FOLD_WINDOW};
-use crate::wedge::{Wedge, WedgeWalk, WedgeWalker};
+use crate::wedge::{WVertex, Wedge, WedgeWalk, WedgeWalker};
 
 /// The per-frame motion-stereo processor for up to `B` boundaries of up to
 /// `N` points. No heap: everything lives inside this value, so it can be a
@@ -100,11 +102,19 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         &self.config
     }
 
-    /// Use `config` from the next call on; the kept frame stays. For a
-    /// caller that pairs one kept frame with frames whose motions carry
-    /// different error bounds: [`crate::fusion`] composes the motion from
-    /// its key frame, and the bound of the composed motion grows with each
-    /// frame.
+    /// Use `config` from the next call on (e.g. the error bounds that came
+    /// with a frame pair over the link, [`crate::wire`], or those of the
+    /// motion [`crate::fusion`] composes from its key frame). The kept frame
+    /// and the last output are untouched; a [`Config`] is valid by
+    /// construction.
+    ///
+    /// ```
+    /// use roadstereo::{Config, Processor};
+    /// let mut p = Processor::<16, 2>::new(Config::DEFAULT);
+    /// p.set_config(Config::DEFAULT.with_translation_error(0.01)?);
+    /// assert_eq!(p.config().translation_error(), 0.01);
+    /// # Ok::<(), roadstereo::ConfigError>(())
+    /// ```
     pub fn set_config(&mut self, config: Config) {
         self.config = config;
     }
@@ -216,22 +226,56 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 b2.and_then(|b| b.first()),
                 b2.and_then(|b| b.last()),
             );
-            let mut fold_index = index.builder((keying.period, orient), Unkeyed::MeetNone);
-            for (slot, &p1) in slots.iter_mut().zip(b1) {
-                let (k, e) = match compensate_point(&pair, &keying, p1, &mut r1_max) {
-                    Ok((r, key)) => {
-                        *slot = r;
-                        key
+            // Step 1, with each point's key margin where the fold index
+            // wants it, and whether the keys are strictly ordered.
+            let mut order = KeyOrder::NEW;
+            let margins = index.margins_mut();
+            match (pair.certified_r1, keying.pencil) {
+                (Some(r1), Pencil::Half { foe, side, min_t }) => {
+                    let ks = keying.key_scale;
+                    let key = |p| half_key(p, (foe, side, min_t), ks);
+                    compensate_all_certified(&pair, r1, (slots, b1, margins), &mut order, key);
+                    r1_max = if slots.is_empty() { 0.0 } else { r1 };
+                }
+                (Some(r1), _) => {
+                    let key = |p| keying.key(p);
+                    compensate_all_certified(&pair, r1, (slots, b1, margins), &mut order, key);
+                    r1_max = if slots.is_empty() { 0.0 } else { r1 };
+                }
+                (None, _) => {
+                    for ((slot, &p1), m) in slots.iter_mut().zip(b1).zip(margins.iter_mut()) {
+                        let (k, e) = match compensate_point(&pair, &keying, p1, &mut r1_max) {
+                            Ok((r, key)) => {
+                                *slot = r;
+                                key
+                            }
+                            Err(status) => {
+                                *slot = PointResult::flagged(p1, status);
+                                (NO_KEY, 0.0)
+                            }
+                        };
+                        *m = e;
+                        order.push(k, e);
                     }
-                    Err(status) => {
-                        *slot = PointResult::flagged(p1, status);
-                        (NO_KEY, 0.0)
-                    }
-                };
-                fold_index.push(k, e);
+                }
             }
-            fold_index.finish(None);
-            fold(index, slots, config.work_per_point, &mut work);
+            if order.strict(keying.period) {
+                // No key meets a segment but its own two: nothing folds,
+                // and the fold index is not needed.
+                let n = u32::try_from(slots.len()).unwrap_or(u32::MAX);
+                work.grant(config.work_per_point.saturating_mul(n));
+            } else {
+                let mut fold_index = index.builder((keying.period, orient), Unkeyed::MeetNone);
+                fold_index.push_all_stored(slots.iter().map(|r| {
+                    if r.status == Status::NoIntersection {
+                        r.z_far
+                    } else {
+                        NO_KEY
+                    }
+                }));
+                fold_index.finish(None);
+                fold(index, slots, config.work_per_point, &mut work);
+            }
             let Some(b2) = b2 else {
                 for r in slots
                     .iter_mut()
@@ -279,6 +323,9 @@ struct Pair<'c> {
     /// `r₁` for every point when the stretch bound is frame-wide and no
     /// rotation error is configured.
     frame_r1: Option<f32>,
+    /// `frame_r1` when, moreover, every pixel of the frame-1 image passes
+    /// step 1's checks ([`PairGeometry::certifies_image`]).
+    certified_r1: Option<f32>,
     /// `Δ`, the bound on `q_z`'s change ([`PairGeometry::depth_scale_error`]).
     depth_scale_error: f32,
     /// The translation-error bound per component (with the turn of the
@@ -313,17 +360,20 @@ impl<'c> Pair<'c> {
         };
         let scale = geom.coordinate_scale();
         let slack = scale * 9.54e-7;
+        let frame_r1 = match geom.frame_stretch() {
+            Some(st) if !rotation => Some(config.e1 * st + slack),
+            _ => None,
+        };
+        let depth_scale_error = geom.depth_scale_error(config.e1, config.rotation_error);
         Self {
             config,
             foe: geom.focus_of_expansion().map(Pixel::arr),
             reach: crate::math::sqrt(cam2.reach2()),
             scale,
             slack,
-            frame_r1: match geom.frame_stretch() {
-                Some(st) if !rotation => Some(config.e1 * st + slack),
-                _ => None,
-            },
-            depth_scale_error: geom.depth_scale_error(config.e1, config.rotation_error),
+            frame_r1,
+            certified_r1: frame_r1.filter(|_| geom.certifies_image(cam1, depth_scale_error)),
+            depth_scale_error,
             translation,
             spread_w,
             geom,
@@ -422,6 +472,35 @@ fn compensate_point(
     }
 }
 
+/// Step 1 for every point of `b1` when the pair certifies the whole image
+/// ([`Pair::certified_r1`]): [`compensate_point`] without its checks (they
+/// pass), `r₁` the frame's, the keys from `key`; each point's key margin in
+/// `margins`, the key order in `order`.
+#[inline(always)]
+fn compensate_all_certified(
+    pair: &Pair,
+    r1: f32,
+    (slots, b1, margins): (&mut [PointResult], &[Pixel], &mut [f32]),
+    order: &mut KeyOrder,
+    key: impl Fn([f32; 2]) -> (f32, f32),
+) {
+    let stretch = pair.geom.frame_stretch().unwrap_or(0.0);
+    for ((slot, &p1), m) in slots.iter_mut().zip(b1).zip(margins.iter_mut()) {
+        let c = pair.geom.compensate_certified(p1, stretch);
+        let (k, e) = key(c.pixel);
+        *slot = PointResult {
+            pixel1: p1,
+            pixel2: Pixel::new(c.pixel[0], c.pixel[1]),
+            z: c.inv_depth_scale,
+            z_near: r1,
+            z_far: k,
+            status: Status::NoIntersection,
+        };
+        *m = e;
+        order.push(k, e);
+    }
+}
+
 /// Step 2, the fold test, on the index of the compensated frame-1
 /// polyline built from step 1's keys (points flagged there have none):
 /// flag every point whose own key meets a segment more than
@@ -467,9 +546,12 @@ fn index_frame2<const N: usize>(
     radius: f32,
 ) {
     let mut builder = index.builder((keying.period, orient), Unkeyed::MeetAll);
-    for p in b2 {
-        let (k, e) = keying.key(p.arr());
-        builder.push(k, e);
+    match keying.pencil {
+        Pencil::Half { foe, side, min_t } => {
+            let ks = keying.key_scale;
+            builder.push_all(b2.iter().map(|p| half_key(p.arr(), (foe, side, min_t), ks)));
+        }
+        _ => builder.push_all(b2.iter().map(|p| keying.key(p.arr()))),
     }
     let foe = pair.foe.filter(|_| pair.geom.w() < 0.0 && keying.angular());
     match foe {
@@ -529,8 +611,7 @@ fn match_boundary<const N: usize>(
 }
 
 /// The wedge path through a tight index: every point's run walked in
-/// locals ([`wedge_run`]). (Out of line: a small loop keeps its values in
-/// registers.)
+/// locals ([`TightWalk::point`]).
 #[inline(never)]
 fn match_wedge_tight<const N: usize>(
     pair: &Pair,
@@ -541,27 +622,73 @@ fn match_wedge_tight<const N: usize>(
     index: &mut Index<N>,
     work: &mut Work,
 ) {
-    let orient = index.orient();
     let mut hint = index.hint();
-    let (e2, cot_twice, key_scale) = (pair.e2(), pair.config.cot_twice, keying.key_scale);
-    let segments = b2.len().saturating_sub(1);
-    let Some((segs, _)) = index.tight() else {
+    let Some((segs, orient)) = index.tight() else {
         return;
     };
+    let walk = TightWalk {
+        pair,
+        segs,
+        b2,
+        foe,
+        side,
+        e2: pair.e2(),
+        key_scale: keying.key_scale,
+        orient,
+        cot_twice: pair.config.cot_twice,
+        segments: b2.len().saturating_sub(1),
+    };
     for r in slots.iter_mut() {
-        if r.status != Status::NoIntersection {
-            continue;
+        if r.status == Status::NoIntersection {
+            hint = walk.point(r, hint, work);
         }
-        let (p1, p, iz, r1) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near);
-        let Ok(wedge) = Wedge::new(p, (foe, side), (r1, e2), key_scale, orient) else {
-            *r = PointResult::flagged(p1, Status::AtFoe);
-            continue;
-        };
-        let (outcome, a) = wedge_run(&wedge, (segs, b2), hint, segments, cot_twice, work);
-        hint = a;
-        *r = conclude_wedge(pair, p1, iz, r1, &wedge, outcome);
     }
     index.set_hint(hint);
+}
+
+/// What every point of a boundary shares on the tight wedge path.
+struct TightWalk<'a> {
+    pair: &'a Pair<'a>,
+    segs: &'a [crate::search::Seg],
+    b2: &'a [Pixel],
+    foe: [f32; 2],
+    side: f32,
+    e2: f32,
+    key_scale: f32,
+    orient: f32,
+    cot_twice: f32,
+    segments: usize,
+}
+
+impl TightWalk<'_> {
+    /// Step 4 for the point left by steps 1–2 in `r`: its wedge, the walk
+    /// over its run (from the last run's start `hint`), the result in `r`;
+    /// returns where the run started. (Out of line: the walk's values stay
+    /// in registers.)
+    #[inline(never)]
+    fn point(&self, r: &mut PointResult, hint: usize, work: &mut Work) -> usize {
+        let (p1, p, iz, r1) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near);
+        let Ok(wedge) = Wedge::new(
+            p,
+            (self.foe, self.side),
+            (r1, self.e2),
+            self.key_scale,
+            self.orient,
+        ) else {
+            *r = PointResult::flagged(p1, Status::AtFoe);
+            return hint;
+        };
+        let (outcome, a) = wedge_run(
+            &wedge,
+            (self.segs, self.b2),
+            hint,
+            self.segments,
+            self.cot_twice,
+            work,
+        );
+        *r = conclude_wedge(self.pair, p1, iz, r1, &wedge, outcome);
+        a
+    }
 }
 
 /// The wedge path through a loose index (the general visit) or the
@@ -658,40 +785,59 @@ fn wedge_run(
     };
     let mut walk = WedgeWalk::NEW;
     let mut c = work.credit();
-    let mut j = a;
+    // The vertex that starts segment `j`, when it is `va`.
     let mut cached = usize::MAX;
-    let mut va = wedge.vertex([0.0; 2]);
+    let mut va = WVertex::NONE;
     let mut stop = None;
-    while let (Some(g), Some(v1)) = (segs.get(j), b2.get(j + 1)) {
-        if g.sm > kh {
+    for j in a..segs.len().min(b2.len().saturating_sub(1)) {
+        let (Some(g), Some(v1)) = (segs.get(j), b2.get(j + 1)) else {
             break;
+        };
+        // The interval's low end decides first: below `kl` the segment
+        // reaches past the low edge, above `kh` it misses (and past the
+        // suffix minimum, at most the low end, the run ends).
+        let cut_lo = g.lo < kl;
+        // (A NaN fails.)
+        let lo_meets = cut_lo || g.lo <= kh;
+        if !lo_meets {
+            if g.sm > kh {
+                break;
+            }
+            if c == 0 {
+                stop = Some(Status::OverBudget);
+                break;
+            }
+            c -= 1;
+            continue;
         }
         if c == 0 {
             stop = Some(Status::OverBudget);
             break;
         }
         c -= 1;
-        if g.lo <= kh && g.hi >= kl {
-            if c < CLIP_UNITS {
-                c = 0;
-                stop = Some(Status::OverBudget);
-                break;
-            }
-            c -= CLIP_UNITS;
-            if cached != j {
-                if let Some(v) = b2.get(j) {
-                    va = wedge.vertex(v.arr());
-                }
-            }
-            let vb = wedge.vertex(v1.arr());
-            if let Err(s) = walk.take(wedge, j, (&va, &vb), (g.lo, g.hi), segments, cot_twice) {
-                stop = Some(s);
-                break;
-            }
-            va = vb;
-            cached = j + 1;
+        let cut_hi = g.hi > kh;
+        let hi_meets = cut_hi || g.hi >= kl;
+        if !hi_meets {
+            continue;
         }
-        j += 1;
+        if c < CLIP_UNITS {
+            c = 0;
+            stop = Some(Status::OverBudget);
+            break;
+        }
+        c -= CLIP_UNITS;
+        if cached != j {
+            if let Some(v0) = b2.get(j) {
+                va = wedge.vertex(v0.arr());
+            }
+        }
+        let vb = wedge.vertex(v1.arr());
+        if let Err(s) = walk.take_met(wedge, j, (&va, &vb), (cut_lo, cut_hi), segments, cot_twice) {
+            stop = Some(s);
+            break;
+        }
+        va = vb;
+        cached = j + 1;
     }
     work.set_credit(c);
     let outcome = match stop {

@@ -218,7 +218,8 @@ pub(crate) struct Index<const N: usize> {
     hint: usize,
     /// Every vertex is keyed and its widened key lies wholly above the one
     /// before, or wholly below (no period): no vertex's key meets a
-    /// segment but its own two.
+    /// segment but its own two. (`false` too where the build did not test
+    /// the order: [`Builder::push_all`]'s lean loop.)
     strict: bool,
 }
 
@@ -272,17 +273,13 @@ impl<const N: usize> Index<N> {
             period,
             unkeyed,
             n: 0,
-            prev: NO_KEY,
-            prev_e: 0.0,
+            order: KeyOrder::NEW,
             keyed: NO_KEY,
             offset: 0.0,
             first: NO_KEY,
             last: NO_KEY,
             run: f32::NEG_INFINITY,
             sum: 0.0,
-            odd: false,
-            up: true,
-            down: true,
             index: self,
         }
     }
@@ -458,40 +455,50 @@ impl<const N: usize> Index<N> {
     }
 
     /// Whether vertex `i`, whose raw key is `key`, may lie on a ray that
-    /// meets a segment outside `i − w ..= i + w − 1`: `false` is certain
+    /// meets a segment outside `i − w ..= i + w − 1` other than those set
+    /// aside (the envelopes leave them out): `false` is certain
     /// (its widened key lies above every interval before that window and
     /// below every one after it, in the oriented order: the envelopes say
-    /// so in `O(1)`), `true` needs the query ([`Self::visit`]) to decide.
-    /// Non-periodic keys only (else always `true`).
+    /// so in `O(1)`, for each copy of a periodic key that can meet the
+    /// keys' range), `true` needs the query ([`Self::visit`]) to decide.
     #[inline(always)]
     pub(crate) fn may_fold(&self, i: usize, key: f32, w: usize) -> bool {
-        if self.period > 0.0 || !self.aside.is_empty() {
-            return true;
-        }
         let k = self.orient * key;
         let e = self.margin(i);
-        let before = i
-            .checked_sub(w + 1)
-            .and_then(|j| self.seg.get(j))
-            .is_some_and(|g| k - e <= g.pm);
-        let after = self
-            .seg
-            .get(i + w)
-            .filter(|_| i + w < self.segments)
-            .is_some_and(|g| k + e >= g.sm);
-        before || after
+        let test = |k: f32| {
+            let before = i
+                .checked_sub(w + 1)
+                .and_then(|j| self.seg.get(j))
+                .is_some_and(|g| k - e <= g.pm);
+            let after = self
+                .seg
+                .get(i + w)
+                .filter(|_| i + w < self.segments)
+                .is_some_and(|g| k + e >= g.sm);
+            before || after
+        };
+        if self.period <= 0.0 {
+            return test(k);
+        }
+        // Periodic keys: every copy of the key that can meet the keys'
+        // range (the envelopes hold the unwrapped keys).
+        let mut c = [(0.0f32, 0.0f32); MAX_COPIES];
+        match self.copies(k - e, k + e, &mut c) {
+            Some(n) => c.iter().take(n).any(|&(lo, _)| test(lo + e)),
+            None => true,
+        }
     }
 
     /// Whether no vertex's key meets a segment other than its own two (so
-    /// no vertex of this polyline folds).
+    /// no vertex of this polyline folds); `false` says nothing.
     pub(crate) fn strict(&self) -> bool {
         self.strict
     }
 
     /// The fold test of vertex `i` with raw key `key`: whether its key
     /// (widened by its margin) meets a segment outside `i − w ..= i + w −
-    /// 1` ([`Self::may_fold`], then the query; each segment looked at one
-    /// unit of `work`).
+    /// 1` (the aside list, [`Self::may_fold`] for the rest, then the query;
+    /// each segment looked at one unit of `work`).
     #[inline(always)]
     pub(crate) fn folds(
         &mut self,
@@ -500,11 +507,33 @@ impl<const N: usize> Index<N> {
         w: usize,
         work: &mut Work,
     ) -> Result<bool, OutOfWork> {
-        if self.strict || !self.may_fold(i, key, w) {
+        if self.strict {
             return Ok(false);
         }
         let e = self.margin(i);
         let skip = (i.saturating_sub(w), i.saturating_add(w).saturating_sub(1));
+        if !self.aside.is_empty() {
+            // The segments set aside first (the envelopes leave them out),
+            // all for one unit: a spurious detector point's two segments
+            // meet most keys and settle the test at once.
+            work.spend(1)?;
+            let k = self.orient * key;
+            let mut c = [(0.0f32, 0.0f32); MAX_COPIES];
+            let copies = match self.copies(k - e, k + e, &mut c) {
+                Some(n) => c.get(..n).unwrap_or(&[]),
+                None => return Ok(true),
+            };
+            let outside = |j: u16| usize::from(j) < skip.0 || usize::from(j) > skip.1;
+            let met = self.aside.iter().any(|&(j, lo, hi)| {
+                outside(j) && copies.iter().any(|&(ql, qh)| lo <= qh && hi >= ql)
+            });
+            if met {
+                return Ok(true);
+            }
+        }
+        if !self.may_fold(i, key, w) {
+            return Ok(false);
+        }
         let mut met = Met(false);
         self.visit(
             Query::Keys(key - e, key + e),
@@ -547,6 +576,12 @@ impl<const N: usize> Index<N> {
     /// times it).
     pub(crate) fn orient(&self) -> f32 {
         self.orient
+    }
+
+    /// The vertices' key margins, for a caller that writes them before
+    /// the build ([`Builder::push_all_stored`]).
+    pub(crate) fn margins_mut(&mut self) -> &mut [f32; N] {
+        &mut self.margin
     }
 
     /// The key margin of vertex `i` (0 when out of range).
@@ -972,6 +1007,64 @@ impl Visitor for Met {
     }
 }
 
+/// Whether the widened keys of a polyline's vertices, in order, each lie
+/// wholly above the one before (`up`) or wholly below (`down`), and
+/// whether one of them is unkeyed (`odd`): fed one vertex at a time.
+/// Strictly ordered keys ([`KeyOrder::strict`]) meet no segment but their
+/// own two, so nothing folds and the envelopes are the intervals
+/// themselves.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct KeyOrder {
+    /// The previous vertex's key and its widened ends.
+    prev: f32,
+    plo: f32,
+    phi: f32,
+    first: bool,
+    up: bool,
+    down: bool,
+    odd: bool,
+}
+
+impl KeyOrder {
+    pub(crate) const NEW: KeyOrder = KeyOrder {
+        prev: NO_KEY,
+        plo: 0.0,
+        phi: 0.0,
+        first: true,
+        up: true,
+        down: true,
+        odd: false,
+    };
+
+    /// The next vertex's key ([`NO_KEY`] where none) and margin; whether
+    /// it and the one before are both keyed, with their widened ends
+    /// `((previous lo, previous hi), (lo, hi))`.
+    #[inline(always)]
+    pub(crate) fn push(&mut self, k: f32, e: f32) -> Option<((f32, f32), (f32, f32))> {
+        let (vlo, vhi) = (k - e, k + e);
+        let (plo, phi) = (self.plo, self.phi);
+        let both = (k + self.prev).is_finite();
+        let first = self.first;
+        (self.prev, self.plo, self.phi, self.first) = (k, vlo, vhi, false);
+        if first {
+            return None;
+        }
+        if !both {
+            self.odd = true;
+            return None;
+        }
+        self.up &= vlo > phi;
+        self.down &= vhi < plo;
+        Some(((plo, phi), (vlo, vhi)))
+    }
+
+    /// Every vertex keyed and the widened keys strictly ordered one way,
+    /// for keys without a period (`period` 0).
+    pub(crate) fn strict(&self, period: f32) -> bool {
+        !self.odd && period <= 0.0 && (self.up || self.down)
+    }
+}
+
 /// Builds an [`Index`] one vertex at a time (pass 1 of the module docs:
 /// oriented, unwrapped keys, intervals, prefix maxima and the widths' sum,
 /// in locals while the vertices come).
@@ -981,27 +1074,118 @@ pub(crate) struct Builder<'a, const N: usize> {
     period: f32,
     unkeyed: Unkeyed,
     n: usize,
-    prev: f32,
-    prev_e: f32,
+    order: KeyOrder,
     keyed: f32,
     offset: f32,
     first: f32,
     last: f32,
     run: f32,
     sum: f32,
-    odd: bool,
-    /// Each vertex's widened key lies wholly above (`up`) or below
-    /// (`down`) the one before, so far.
-    up: bool,
-    down: bool,
 }
 
 impl<const N: usize> Builder<'_, N> {
-    /// The next vertex's raw key ([`NO_KEY`] where none) and margin; at
-    /// most `N` count.
+    /// Push every vertex `keys` gives, raw key ([`NO_KEY`] where none) and
+    /// margin, in order (through [`Self::push_run`]); at most `N` count.
     #[inline(always)]
-    pub(crate) fn push(&mut self, raw: f32, e: f32) {
+    pub(crate) fn push_all(&mut self, keys: impl Iterator<Item = (f32, f32)>) {
+        let mut keys = keys;
+        self.push_run(|m| {
+            let (raw, e) = keys.next()?;
+            *m = e;
+            Some(raw)
+        });
+    }
+
+    /// [`Self::push_stored`] for every raw key `keys` gives, in order
+    /// (through [`Self::push_run`]).
+    #[inline(always)]
+    pub(crate) fn push_all_stored(&mut self, keys: impl Iterator<Item = f32>) {
+        let mut keys = keys;
+        self.push_run(|_| keys.next());
+    }
+
+    /// Push vertices while `next` gives their raw keys, each with its
+    /// margin put in (or already in) the slot it is handed; at most `N`.
+    /// While the keys have no period and are finite (the usual polyline)
+    /// a lean loop writes the intervals and prefix maxima (the values
+    /// [`Self::push_stored`] gives) without the key-order test (the index
+    /// is then not [`Index::strict`], a shortcut of the fold test only);
+    /// from the first vertex it cannot take on, [`Self::push_stored`].
+    #[inline(always)]
+    fn push_run(&mut self, mut next: impl FnMut(&mut f32) -> Option<f32>) {
+        let mut pending = None;
+        if self.n == 0 && self.period <= 0.0 {
+            let Some(raw) = self.index.margin.first_mut().and_then(&mut next) else {
+                return;
+            };
+            self.push_stored(raw);
+            let k = self.o * raw;
+            let (Some(&e), true) = (self.index.margin.first(), k.is_finite()) else {
+                return self.push_rest(next);
+            };
+            let o = self.o;
+            let (mut prev, mut plo, mut phi) = (k, k - e, k + e);
+            let (mut run, mut sum) = (self.run, self.sum);
+            let mut n = 1usize;
+            let slots = self
+                .index
+                .margin
+                .iter_mut()
+                .skip(1)
+                .zip(self.index.seg.iter_mut());
+            for (m, g) in slots {
+                let Some(raw) = next(m) else {
+                    break;
+                };
+                let k = o * raw;
+                if !(k + prev).is_finite() {
+                    pending = Some(raw);
+                    break;
+                }
+                let e = *m;
+                let (vlo, vhi) = (k - e, k + e);
+                g.lo = fmin(plo, vlo);
+                g.hi = fmax(phi, vhi);
+                sum += g.hi - g.lo;
+                run = fmax(run, g.hi);
+                g.pm = run;
+                (prev, plo, phi) = (k, vlo, vhi);
+                n += 1;
+            }
+            if n > 1 {
+                self.order = KeyOrder {
+                    prev,
+                    plo,
+                    phi,
+                    first: false,
+                    up: false,
+                    down: false,
+                    odd: false,
+                };
+                (self.n, self.run, self.sum, self.last) = (n, run, sum, prev);
+            }
+        }
+        if let Some(raw) = pending {
+            self.push_stored(raw);
+        }
+        self.push_rest(next);
+    }
+
+    /// The rest of [`Self::push_run`], one [`Self::push_stored`] at a time.
+    fn push_rest(&mut self, mut next: impl FnMut(&mut f32) -> Option<f32>) {
+        while let Some(raw) = self.index.margin.get_mut(self.n).and_then(&mut next) {
+            self.push_stored(raw);
+        }
+    }
+
+    /// The next vertex's raw key ([`NO_KEY`] where none), its margin
+    /// already in place (in `margin[n]`); at most `N` count.
+    #[inline(always)]
+    fn push_stored(&mut self, raw: f32) {
         let i = self.n;
+        let Some(&e) = self.index.margin.get(i) else {
+            return;
+        };
         let mut k = self.o * raw;
         if self.period > 0.0 && k.is_finite() {
             // Consecutive keys are less than half a turn apart.
@@ -1016,24 +1200,14 @@ impl<const N: usize> Builder<'_, N> {
             }
             self.keyed = k;
         }
-        if let Some(m) = self.index.margin.get_mut(i) {
-            *m = e;
-        } else {
-            return;
-        }
+        let ends = self.order.push(k, e);
         if let Some(g) = i.checked_sub(1).and_then(|j| self.index.seg.get_mut(j)) {
-            // Both keys finite (their sum is, for keys this small).
-            if (k + self.prev).is_finite() {
-                let (plo, phi) = (self.prev - self.prev_e, self.prev + self.prev_e);
-                let (vlo, vhi) = (k - e, k + e);
-                self.up &= vlo > phi;
-                self.down &= vhi < plo;
+            if let Some(((plo, phi), (vlo, vhi))) = ends {
                 g.lo = fmin(plo, vlo);
                 g.hi = fmax(phi, vhi);
                 self.sum += g.hi - g.lo;
             } else {
                 // An unkeyed end: the rebuild sorts it out.
-                self.odd = true;
                 (g.lo, g.hi) = match self.unkeyed {
                     Unkeyed::MeetAll => (f32::NEG_INFINITY, f32::INFINITY),
                     Unkeyed::MeetNone => (f32::INFINITY, f32::NEG_INFINITY),
@@ -1048,8 +1222,6 @@ impl<const N: usize> Builder<'_, N> {
             }
             self.last = k;
         }
-        self.prev = k;
-        self.prev_e = e;
         self.n = i + 1;
     }
 
@@ -1064,15 +1236,14 @@ impl<const N: usize> Builder<'_, N> {
             first,
             last,
             sum,
-            odd,
-            up,
-            down,
+            order,
             period,
             ..
         } = self;
         let s = n.saturating_sub(1);
         index.segments = s;
-        index.strict = !odd && period <= 0.0 && (up || down);
+        index.strict = order.strict(period);
+        let odd = order.odd;
         // The keys (oriented by `o`) fall overall: orient them the other way.
         let flip = last < first;
         index.orient = o;
@@ -1125,4 +1296,227 @@ fn bisect(
         }
     }
     Ok(hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_rng::Rng;
+    extern crate std;
+    use std::vec::Vec;
+
+    const CAP: usize = 96;
+
+    /// A random key sequence of one of several shapes, with margins; some
+    /// keys missing ([`NO_KEY`]); periodic ones in `[0, 4)` when `period`.
+    fn keys(rng: &mut Rng, shape: u32, n: usize, period: bool) -> Vec<(f32, f32)> {
+        let mut k = rng.next() * 2.0 - 1.0;
+        let step = 0.002 + 0.05 * rng.next();
+        let mut out = Vec::new();
+        for i in 0..n {
+            let e = 1.0e-4 * rng.next();
+            k += match shape {
+                // Monotone.
+                0 => step,
+                // Monotone with jitter.
+                1 => step * (1.0 + 1.5 * (rng.next() - 0.5)),
+                // A fold halfway.
+                2 if i > n / 2 => -step,
+                2 => step,
+                // Nearly constant (radial).
+                3 => 1.0e-4 * (rng.next() - 0.5),
+                // Zig-zag.
+                _ => {
+                    if i % 2 == 0 {
+                        step
+                    } else {
+                        -0.8 * step
+                    }
+                }
+            };
+            let mut v = k;
+            // Spikes (spurious points).
+            if rng.next() < 0.04 {
+                v += (rng.next() - 0.5) * 3.0;
+            }
+            if period {
+                v = v.rem_euclid(4.0);
+            }
+            if rng.next() < 0.02 {
+                out.push((NO_KEY, 0.0));
+            } else {
+                out.push((v, e));
+            }
+        }
+        out
+    }
+
+    /// The segments' intervals as the builder forms them, in raw keys
+    /// unwrapped along the polyline for periodic keys (`None`: an end
+    /// without a key).
+    fn intervals(ks: &[(f32, f32)], period: bool) -> Vec<Option<(f32, f32)>> {
+        let mut unwrapped = Vec::new();
+        let (mut offset, mut last) = (0.0f32, NO_KEY);
+        for &(k, e) in ks {
+            if !k.is_finite() {
+                unwrapped.push((k, e));
+                continue;
+            }
+            let mut v = k + offset;
+            if period {
+                let d = v - last;
+                if d > 2.0 {
+                    offset -= 4.0;
+                    v -= 4.0;
+                } else if d < -2.0 {
+                    offset += 4.0;
+                    v += 4.0;
+                }
+                last = v;
+            }
+            unwrapped.push((v, e));
+        }
+        unwrapped
+            .windows(2)
+            .map(|w| {
+                let ((a, ea), (b, eb)) = (w[0], w[1]);
+                (a.is_finite() && b.is_finite())
+                    .then(|| (fmin(a - ea, b - eb), fmax(a + ea, b + eb)))
+            })
+            .collect()
+    }
+
+    /// Whether an interval meets `[lo, hi]` or one of its copies `+ 4m`.
+    fn meets(iv: (f32, f32), (lo, hi): (f32, f32), period: bool) -> bool {
+        if !period {
+            return iv.0 <= hi && iv.1 >= lo;
+        }
+        (-40..=40).any(|m| {
+            let s = 4.0 * m as f32;
+            iv.0 <= hi + s && iv.1 >= lo + s
+        })
+    }
+
+    /// The segments offered, and whether in increasing order.
+    #[derive(Clone, Copy)]
+    struct Record {
+        seen: [bool; CAP],
+        last: Option<usize>,
+        ordered: bool,
+    }
+    impl Visitor for Record {
+        fn segment(&mut self, j: usize, _: (f32, f32)) -> (Flow, u32) {
+            self.ordered &= self.last.is_none_or(|l| j > l);
+            self.last = Some(j);
+            if let Some(s) = self.seen.get_mut(j) {
+                *s = true;
+            }
+            (Flow::Continue, 0)
+        }
+    }
+
+    #[derive(Clone, Copy)]
+    struct Count(usize, usize);
+    impl Visitor for Count {
+        fn segment(&mut self, j: usize, _: (f32, f32)) -> (Flow, u32) {
+            // Increasing indices, counted.
+            assert!(self.1 == usize::MAX || j > self.1, "{j} after {}", self.1);
+            self.1 = j;
+            self.0 += 1;
+            (Flow::Continue, 0)
+        }
+    }
+
+    /// The index offers every segment whose interval meets the query (a
+    /// segment with an unkeyed end meets every query, in frame 2's index),
+    /// in increasing order, whatever the shape of the keys: monotone,
+    /// jittering, folding, radial, zig-zag, with spikes and missing keys,
+    /// periodic or not, either orientation guess.
+    #[test]
+    fn visit_offers_every_segment_that_meets_the_query() {
+        let mut rng = Rng(0x5ea7_c401);
+        let mut index = Index::<CAP>::new();
+        for case in 0..3000 {
+            let (shape, period) = (case % 5, case % 3 == 0);
+            let n = 2 + (rng.next() * (CAP - 2) as f32) as usize;
+            let ks = keys(&mut rng, shape, n, period);
+            let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+            let mut b = index.builder((if period { 4.0 } else { 0.0 }, orient), Unkeyed::MeetAll);
+            b.push_all(ks.iter().copied());
+            b.finish(None);
+            let ivs = intervals(&ks, period);
+            for _ in 0..8 {
+                let c = if period {
+                    4.0 * rng.next()
+                } else {
+                    rng.next() * 3.0 - 1.5
+                };
+                let w = 0.2 * rng.next() * rng.next();
+                let q = (c - w, c + w);
+                let mut rec = Record {
+                    seen: [false; CAP],
+                    last: None,
+                    ordered: true,
+                };
+                let mut work = Work::new();
+                work.grant(u32::MAX);
+                assert!(index
+                    .visit(Query::Keys(q.0, q.1), false, None, &mut work, &mut rec)
+                    .is_ok());
+                assert!(rec.ordered, "case {case}: out of order");
+                for (j, iv) in ivs.iter().enumerate() {
+                    let must = iv.is_none_or(|iv| meets(iv, q, period));
+                    assert!(
+                        !must || rec.seen[j],
+                        "case {case} (shape {shape}, period {period}): segment {j} {iv:?} meets {q:?} but was not offered"
+                    );
+                }
+                let mut count = Count(0, usize::MAX);
+                let mut work = Work::new();
+                work.grant(u32::MAX);
+                assert!(index
+                    .visit(Query::Everything, false, None, &mut work, &mut count)
+                    .is_ok());
+                assert_eq!(count.0, n - 1, "case {case}: every segment for Everything");
+            }
+        }
+    }
+
+    /// The fold test (the `strict` certificate, the envelopes' `O(1)`
+    /// answer and the query) equals the brute force: a vertex folds when its
+    /// widened key meets a segment outside its window (a segment with an
+    /// unkeyed end meets nothing here).
+    #[test]
+    fn folds_equals_brute_force() {
+        let mut rng = Rng(0xf01d_0002);
+        let mut index = Index::<CAP>::new();
+        let w = 4;
+        for case in 0..3000 {
+            let (shape, period) = (case % 5, case % 3 == 0);
+            let n = 2 + (rng.next() * (CAP - 2) as f32) as usize;
+            let ks = keys(&mut rng, shape, n, period);
+            let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+            let mut b = index.builder((if period { 4.0 } else { 0.0 }, orient), Unkeyed::MeetNone);
+            b.push_all(ks.iter().copied());
+            b.finish(None);
+            let ivs = intervals(&ks, period);
+            for (i, &(k, e)) in ks.iter().enumerate() {
+                if !k.is_finite() {
+                    continue;
+                }
+                let brute = ivs.iter().enumerate().any(|(j, iv)| {
+                    let outside = j + w < i || j > i + w - 1;
+                    outside && iv.is_some_and(|iv| meets(iv, (k - e, k + e), period))
+                });
+                let mut work = Work::new();
+                work.grant(u32::MAX);
+                let fast = index.folds(i, k, w, &mut work);
+                assert_eq!(
+                    fast,
+                    Ok(brute),
+                    "case {case} (shape {shape}, period {period}) vertex {i} key {k}"
+                );
+            }
+        }
+    }
 }

@@ -30,16 +30,20 @@
 //! side, as the wedge leaves the half-plane through the FOE's row). With
 //! every key widened by its rounding margin, a segment whose interval
 //! ([`crate::search`]) misses the wedge's is outside it; one whose interval
-//! lies inside the wedge's is inside it, end to end; only a segment whose
-//! interval straddles an edge's key is clipped by that edge's line, exactly
-//! (one division per edge it crosses). The segment's part in the wedge then
-//! has the range `[λ₀, λ₁]` of `λ = â·(q − p₁')` (`â = d/ρ₁`; `λ` is linear
-//! along the segment, so the ends of the part give it), cut at `λ ≥ −(r₁ +
-//! e₂)`.
+//! lies inside the wedge's is taken whole (it reaches at most its keys'
+//! margins past an edge, which only lengthens the piece: the stick stays a
+//! bound); only a segment whose interval straddles an edge's key is
+//! clipped by that edge's line, exactly (one division per edge it
+//! crosses). The segment's part in the wedge then has the range `[λ₀, λ₁]`
+//! of `λ = â·(q − p₁')` (`â = d/ρ₁`; `λ` is linear along the segment, so
+//! the ends of the part give it), cut at `λ ≥ −(r₁ + e₂)`.
 //!
 //! The walk over the segments (in order, with the rules of
 //! [`crate::matching`]: one piece, not grazing, no end vertex inside,
-//! the exact line's nearest crossing for the estimate) gives the piece's
+//! the exact line's nearest crossing for the estimate, where the segment's
+//! ends lie on the line's two sides: a segment whose keys miss the line's,
+//! widened by the margins, has both ends farther from the line than the
+//! sides' rounding, so no key test is needed there) gives the piece's
 //! range `[lo, hi]` and the crossing's `λ`, and with `|a| = W' ρ₁`
 //! the depth and stick of [`crate::depth`] become
 //!
@@ -86,8 +90,6 @@ pub(crate) struct Wedge {
     /// Inward normals of the edges whose keys are `kl` and `kh`.
     nl: [f32; 2],
     nh: [f32; 2],
-    /// The exact line's key interval (oriented, widened by its margin).
-    own: (f32, f32),
     /// `−(r₁ + e₂)`.
     pub(crate) lam_lo: f32,
 }
@@ -118,43 +120,33 @@ impl Wedge {
         }
         let inv = 1.0 / rho;
         let t = re / (rho - re) * (1.0 + 1.53e-5);
-        let perp = [-d[1], d[0]];
-        let em = [d[0] - t * perp[0], d[1] - t * perp[1]];
-        let ep = [d[0] + t * perp[0], d[1] + t * perp[1]];
-        // Keys of the edge directions; an edge outside the half-plane
-        // stands for the key limit where the wedge crosses the FOE's row,
-        // on the side of d (the wedge is narrower than 53°).
-        let limit = orient * if d[0] >= 0.0 { 1.0 } else { -1.0 };
-        let key = |e: [f32; 2]| {
-            let te = side * e[1];
-            if te > 0.0 {
-                let i = 1.0 / (e[0].abs() + te);
-                (orient * (e[0] * i), key_scale * i + ULP20, true)
+        // The edge directions d ∓ s T d⊥ (d⊥ = (−d_v, d_u)), named so that
+        // the first has the lower key: turning d by +90° moves its key by
+        // −side, then the orientation (s = ±1, so the products are those
+        // of d ± T d⊥ exactly).
+        let s = if side * orient > 0.0 { -1.0 } else { 1.0 };
+        let st = s * t;
+        let el = [d[0] + st * d[1], d[1] - st * d[0]];
+        let eh = [d[0] - st * d[1], d[1] + st * d[0]];
+        let (tl, th) = (side * el[1], side * eh[1]);
+        let (kl, kh, nl, nh) = if tl > 0.0 && th > 0.0 {
+            // Both edges in the half-plane (the usual wedge).
+            let (il, ih) = (1.0 / (el[0].abs() + tl), 1.0 / (eh[0].abs() + th));
+            let (k0, k1) = (orient * (el[0] * il), orient * (eh[0] * ih));
+            if k0 < k1 {
+                // Inward normals: s perp(e_l) and −s perp(e_h) point
+                // towards d.
+                (
+                    k0 - (key_scale * il + ULP20),
+                    k1 + (key_scale * ih + ULP20),
+                    [-s * el[1], s * el[0]],
+                    [s * eh[1], -s * eh[0]],
+                )
             } else {
-                (limit, 0.0, false)
+                edge_keys(d, (el, eh, s), side, key_scale, orient)
             }
-        };
-        let ((km, mm, im), (kp, mp, ip)) = (key(em), key(ep));
-        // Inward normals: perp(e₋) and −perp(e₊) point towards d.
-        let (nm, np) = ([-em[1], em[0]], [ep[1], -ep[0]]);
-        let (mut kl, nl, mut kh, nh) = if km <= kp {
-            (km - mm, nm, kp + mp, np)
         } else {
-            (kp - mp, np, km + mm, nm)
-        };
-        let td = side * d[1];
-        if !(td > 0.0 || im || ip) {
-            // The whole wedge lies beyond the FOE's row: no keyed point.
-            (kl, kh) = (f32::INFINITY, f32::NEG_INFINITY);
-        }
-        // The exact line's own key (none beyond the row: it never enters
-        // the half-plane past p₁').
-        let own = if td > 0.0 {
-            let i = 1.0 / (d[0].abs() + td);
-            let (k, m) = (orient * (d[0] * i), key_scale * i + ULP20);
-            (k - m, k + m)
-        } else {
-            (f32::INFINITY, f32::NEG_INFINITY)
+            edge_keys(d, (el, eh, s), side, key_scale, orient)
         };
         Ok(Self {
             foe,
@@ -167,19 +159,96 @@ impl Wedge {
             kh,
             nl,
             nh,
-            own,
             lam_lo: -re,
         })
     }
 
-    /// A vertex in the wedge's frame: `v − F` and its `λ`.
+    /// A vertex in the wedge's frame: `w = v − F`, its `λ` and its side of
+    /// the exact line.
     #[inline(always)]
     pub(crate) fn vertex(&self, v: [f32; 2]) -> WVertex {
         let w = sub(v, self.foe);
         WVertex {
             w,
             lam: dot(self.u, w) - self.rho,
+            side: self.d[0] * w[1] - self.d[1] * w[0],
         }
+    }
+
+    /// The part of segment `a → b` in the wedge, as [`WedgeWalk::take`]
+    /// takes a segment whose key interval meets the wedge's (`cut`: it
+    /// reaches past the low edge's key, the high edge's): clipped by those
+    /// edges, its `λ` range cut at `λ ≥ −(r₁ + e₂)`; `None` when nothing is
+    /// left.
+    #[inline(always)]
+    pub(crate) fn part(&self, a: &WVertex, b: &WVertex, cut: (bool, bool)) -> Option<Part> {
+        let dl = b.lam - a.lam;
+        // The part's ends, and whether each is the segment's own end.
+        let (mut l0, mut l1, mut whole) = (a.lam, b.lam, (true, true));
+        if cut.0 || cut.1 {
+            let (t0, t1) = self.clip(a, b, cut)?;
+            if t0 != 0.0 {
+                (l0, whole.0) = (a.lam + t0 * dl, false);
+            }
+            if t1 != 1.0 {
+                (l1, whole.1) = (a.lam + t1 * dl, false);
+            }
+        }
+        let (lo, hi) = if l0 <= l1 { (l0, l1) } else { (l1, l0) };
+        // At λ ≥ −(r₁ + e₂) only. (A NaN fails.)
+        let lo = if lo > self.lam_lo {
+            lo
+        } else if hi >= self.lam_lo {
+            self.lam_lo
+        } else {
+            return None;
+        };
+        Some(Part { lo, hi, whole })
+    }
+
+    /// Whether a piece with the `λ` range `[lo, hi]` is grazing (module
+    /// docs); it stays so as the piece grows.
+    #[inline(always)]
+    pub(crate) fn grazing(&self, lo: f32, hi: f32, cot_twice: f32) -> bool {
+        hi - lo > self.t * (self.rho + lo) * cot_twice
+    }
+
+    /// `best` lowered to the exact line's crossing of segment `a → b`, if
+    /// it has one (its ends on the line's two sides) nearer than `best`
+    /// and beyond `λ = −(r₁ + e₂)`.
+    #[inline(always)]
+    pub(crate) fn crossing(&self, a: &WVertex, b: &WVertex, best: f32) -> f32 {
+        let (sa, sb) = (a.side, b.side);
+        if crate::depth::side_bit(sa) != crate::depth::side_bit(sb) {
+            let lam = a.lam + sa / (sa - sb) * (b.lam - a.lam);
+            if lam < best && lam > self.lam_lo {
+                return lam;
+            }
+        }
+        best
+    }
+
+    /// The part of the segment `a → b` inside the edges' lines where `cut`
+    /// says (low edge, high edge; the side towards `d` is inside), as its
+    /// range `(t0, t1)` along the segment; `None` when it has none.
+    #[inline(always)]
+    fn clip(&self, a: &WVertex, b: &WVertex, cut: (bool, bool)) -> Option<(f32, f32)> {
+        let (mut t0, mut t1) = (0.0f32, 1.0f32);
+        for (cut, n) in [(cut.0, self.nl), (cut.1, self.nh)] {
+            if cut {
+                let (ca, cb) = (dot(n, a.w), dot(n, b.w));
+                if ca < 0.0 {
+                    if cb < 0.0 {
+                        return None;
+                    }
+                    t0 = fmax(t0, ca / (ca - cb));
+                } else if cb < 0.0 {
+                    t1 = fmin(t1, ca / (ca - cb));
+                }
+            }
+        }
+        // (A NaN fails.)
+        (t0 <= t1).then_some((t0, t1))
     }
 
     /// The point of the exact line at `λ` (for a crossing: the frame-2
@@ -211,11 +280,73 @@ impl Wedge {
     }
 }
 
-/// A frame-2 vertex relative to the FOE, with its `λ` along a wedge's line.
+/// The wedge's key interval and the inward normals of the edges whose
+/// keys bound it, in general: the keys of the edge directions `el`, `eh`
+/// (named as in [`Wedge::new`]), each widened by its margin; an edge
+/// outside the half-plane stands for the key limit where the wedge crosses
+/// the FOE's row, on the side of `d` (the wedge is narrower than 53°); the
+/// lower key is the low end (the first edge's on a tie), and the interval
+/// is empty when the whole wedge lies beyond the row.
+#[cold]
+#[inline(never)]
+fn edge_keys(
+    d: [f32; 2],
+    (el, eh, s): ([f32; 2], [f32; 2], f32),
+    side: f32,
+    key_scale: f32,
+    orient: f32,
+) -> (f32, f32, [f32; 2], [f32; 2]) {
+    let limit = orient * if d[0] >= 0.0 { 1.0 } else { -1.0 };
+    let key = |e: [f32; 2]| {
+        let te = side * e[1];
+        if te > 0.0 {
+            let i = 1.0 / (e[0].abs() + te);
+            (orient * (e[0] * i), key_scale * i + ULP20, true)
+        } else {
+            (limit, 0.0, false)
+        }
+    };
+    let ((k0, m0, in0), (k1, m1, in1)) = (key(el), key(eh));
+    // Inward normals: s perp(e_l) and −s perp(e_h) point towards d.
+    let (n0, n1) = ([-s * el[1], s * el[0]], [s * eh[1], -s * eh[0]]);
+    // The first edge's is the lower key on a tie when it is d − T d⊥'s.
+    let first_low = if s > 0.0 { k0 <= k1 } else { k0 < k1 };
+    let (kl, nl, kh, nh) = if first_low {
+        (k0 - m0, n0, k1 + m1, n1)
+    } else {
+        (k1 - m1, n1, k0 + m0, n0)
+    };
+    if !(side * d[1] > 0.0 || in0 || in1) {
+        // The whole wedge lies beyond the FOE's row: no keyed point.
+        return (f32::INFINITY, f32::NEG_INFINITY, nl, nh);
+    }
+    (kl, kh, nl, nh)
+}
+
+/// A frame-2 vertex in a wedge's frame ([`Wedge::vertex`]).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct WVertex {
     w: [f32; 2],
     lam: f32,
+    side: f32,
+}
+
+impl WVertex {
+    /// A placeholder, never read before it is overwritten.
+    pub(crate) const NONE: WVertex = WVertex {
+        w: [0.0; 2],
+        lam: 0.0,
+        side: 0.0,
+    };
+}
+
+/// A segment's part in a wedge ([`Wedge::part`]): its `λ` range, and
+/// whether each end is the segment's own (no edge cut it off).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Part {
+    pub(crate) lo: f32,
+    pub(crate) hi: f32,
+    whole: (bool, bool),
 }
 
 /// The walk over a polyline's segments through one wedge (the rules of
@@ -258,37 +389,27 @@ impl WedgeWalk {
         if klo > wedge.kh || khi < wedge.kl {
             return Ok(());
         }
-        let (mut t0, mut t1) = (0.0f32, 1.0f32);
-        if klo < wedge.kl || khi > wedge.kh {
-            // The segment's rays reach past an edge: clip it by that edge's
-            // line (the side towards d is inside).
-            for (cut, n) in [(klo < wedge.kl, wedge.nl), (khi > wedge.kh, wedge.nh)] {
-                if cut {
-                    let (ca, cb) = (dot(n, a.w), dot(n, b.w));
-                    if ca < 0.0 {
-                        if cb < 0.0 {
-                            return Ok(());
-                        }
-                        t0 = fmax(t0, ca / (ca - cb));
-                    } else if cb < 0.0 {
-                        t1 = fmin(t1, ca / (ca - cb));
-                    }
-                }
-            }
-            // (A NaN fails.)
-            if !(t0 <= t1) {
-                return Ok(());
-            }
-        }
-        let dl = b.lam - a.lam;
-        let l0 = if t0 == 0.0 { a.lam } else { a.lam + t0 * dl };
-        let l1 = if t1 == 1.0 { b.lam } else { a.lam + t1 * dl };
-        let (lo, hi) = if l0 <= l1 { (l0, l1) } else { (l1, l0) };
-        // (A NaN fails.)
-        if !(hi >= wedge.lam_lo) {
+        let cut = (klo < wedge.kl, khi > wedge.kh);
+        self.take_met(wedge, j, (a, b), cut, segments, cot_twice)
+    }
+
+    /// [`Self::take`] for a segment whose interval meets the wedge's;
+    /// `cut`: whether it reaches past the low edge's key, and past the
+    /// high edge's.
+    #[inline(always)]
+    pub(crate) fn take_met(
+        &mut self,
+        wedge: &Wedge,
+        j: usize,
+        (a, b): (&WVertex, &WVertex),
+        cut: (bool, bool),
+        segments: usize,
+        cot_twice: f32,
+    ) -> Result<(), Status> {
+        let Some(part) = wedge.part(a, b, cut) else {
             return Ok(());
-        }
-        let lo = fmax(lo, wedge.lam_lo);
+        };
+        let (lo, hi) = (part.lo, part.hi);
         if self.next == j {
             self.lo = fmin(self.lo, lo);
             self.hi = fmax(self.hi, hi);
@@ -298,25 +419,19 @@ impl WedgeWalk {
             }
             self.lo = lo;
             self.hi = hi;
-            // The first vertex is in the wedge when no edge cut it off.
-            self.open |= j == 0 && t0 == 0.0 && a.lam >= wedge.lam_lo;
-        }
-        self.open |= j + 1 == segments && t1 == 1.0 && b.lam >= wedge.lam_lo;
-        self.next = j + 1;
-        if self.hi - self.lo > wedge.t * (wedge.rho + self.lo) * cot_twice {
-            return Err(Status::Grazing);
-        }
-        if klo <= wedge.own.1 && khi >= wedge.own.0 {
-            // The exact line may cross here: the sides of the ends.
-            let d = wedge.d;
-            let (sa, sb) = (d[0] * a.w[1] - d[1] * a.w[0], d[0] * b.w[1] - d[1] * b.w[0]);
-            if crate::depth::side_bit(sa) != crate::depth::side_bit(sb) {
-                let lam = a.lam + sa / (sa - sb) * dl;
-                if lam < self.best && lam > wedge.lam_lo {
-                    self.best = lam;
-                }
+            if j == 0 {
+                // The first vertex is in the wedge when no edge cut it off.
+                self.open |= end_inside(part.whole.0, a.lam, wedge.lam_lo);
             }
         }
+        if j + 1 == segments {
+            self.open |= end_inside(part.whole.1, b.lam, wedge.lam_lo);
+        }
+        self.next = j + 1;
+        if wedge.grazing(self.lo, self.hi, cot_twice) {
+            return Err(Status::Grazing);
+        }
+        self.best = wedge.crossing(a, b, self.best);
         Ok(())
     }
 
@@ -335,6 +450,15 @@ impl WedgeWalk {
             hi: self.hi,
         }
     }
+}
+
+/// Whether an end vertex of the polyline lies in the wedge: no edge cut
+/// it off (`whole`) and its `λ` is at least `lam_lo`. (Out of line: the
+/// walk's usual segment is no end.)
+#[cold]
+#[inline(never)]
+fn end_inside(whole: bool, lam: f32, lam_lo: f32) -> bool {
+    whole && lam >= lam_lo
 }
 
 /// A wedge walk as an index [`Visitor`] (the loose index, and the
@@ -358,10 +482,7 @@ impl<'a> WedgeWalker<'a> {
             boundary,
             cot_twice,
             cache_i: usize::MAX,
-            cache: WVertex {
-                w: [0.0; 2],
-                lam: 0.0,
-            },
+            cache: WVertex::NONE,
             walk: WedgeWalk::NEW,
             decided: None,
         }
@@ -405,5 +526,97 @@ impl Visitor for WedgeWalker<'_> {
                 (Flow::Stop, CLIP_UNITS)
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::depth::{Band, PointErrors};
+    use crate::test_rng::Rng;
+
+    /// Every point the band holds (a true frame-1 point within `r₁`, any
+    /// depth, a polyline point within `e₂` of its correspondent, computed in
+    /// `f64`) lies in the wedge: its key interval meets the wedge's, and
+    /// the wedge walk takes it as a piece (`W' > 0`, no translation error;
+    /// keys on either side of the FOE's row).
+    #[test]
+    fn wedge_holds_every_band_point() {
+        let mut rng = Rng(0x3ed9_e001);
+        let mut inside = 0;
+        let key_scale = 9.536_743e-7 * 1024.0;
+        for case in 0..40_000 {
+            let w = 0.05 + rng.next();
+            let g = [(rng.next() - 0.5) * 300.0, (rng.next() - 0.5) * 300.0];
+            let c2 = [255.5f32, 239.5];
+            let foe = [c2[0] + g[0] / w, c2[1] + g[1] / w];
+            let p = [512.0 * rng.next(), 480.0 * rng.next()];
+            let (r1, e2) = (0.05 + rng.next(), 0.05 + rng.next());
+            let ang = rng.next() * core::f32::consts::TAU;
+            let rad = f64::from(r1) * f64::from(rng.next());
+            let pt = [
+                f64::from(p[0]) + rad * f64::from(libm::cosf(ang)),
+                f64::from(p[1]) + rad * f64::from(libm::sinf(ang)),
+            ];
+            let wf = f64::from(w);
+            let at = [
+                wf * (pt[0] - f64::from(c2[0])) - f64::from(g[0]),
+                wf * (pt[1] - f64::from(c2[1])) - f64::from(g[1]),
+            ];
+            let s = wf + 0.01 + 60.0 * f64::from(rng.next()) * f64::from(rng.next());
+            let tau = 1.0 / (s - wf);
+            let p2 = [pt[0] + tau * at[0], pt[1] + tau * at[1]];
+            let ang2 = rng.next() * core::f32::consts::TAU;
+            let rad2 = f64::from(e2) * f64::from(rng.next());
+            let q = [
+                (p2[0] + rad2 * f64::from(libm::cosf(ang2))) as f32,
+                (p2[1] + rad2 * f64::from(libm::sinf(ang2))) as f32,
+            ];
+            // The boundary's side of the FOE's row: q's, and q keyed.
+            let dq = [q[0] - foe[0], q[1] - foe[1]];
+            let side = if dq[1] >= 0.0 { 1.0 } else { -1.0 };
+            let t = side * dq[1];
+            if !(t >= 4.0 && q[0].abs() < 3000.0 && q[1].abs() < 3000.0) {
+                continue;
+            }
+            let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+            let Ok(wedge) = Wedge::new(p, (foe, side), (r1, e2), key_scale, orient) else {
+                continue;
+            };
+            let i = 1.0 / (dq[0].abs() + t);
+            let (k, m) = (orient * (dq[0] * i), key_scale * i + ULP20);
+            assert!(
+                k + m >= wedge.kl && k - m <= wedge.kh,
+                "case {case}: key {k} ± {m} outside [{}, {}]",
+                wedge.kl,
+                wedge.kh
+            );
+            let v = wedge.vertex(q);
+            let mut walk = WedgeWalk::NEW;
+            let r = walk.take(&wedge, 5, (&v, &v), (k - m, k + m), 10, 11.34);
+            assert!(
+                walk.next == 6 || r == Err(Status::Grazing),
+                "case {case}: q {q:?} not in the wedge of {p:?} (foe {foe:?})"
+            );
+            // And the band itself holds it (the wedge is the larger).
+            let band = Band::new(
+                p,
+                [w * (p[0] - c2[0]) - g[0], w * (p[1] - c2[1]) - g[1]],
+                w,
+                &PointErrors {
+                    r1,
+                    e2,
+                    spread_a: 0.0,
+                    spread_w: 0.0,
+                },
+                0.0,
+            );
+            if let Ok(b) = band {
+                let c = b.vertex(q);
+                assert!(Band::contains(&c), "case {case}: q outside the band");
+            }
+            inside += 1;
+        }
+        assert!(inside > 5_000, "{inside}");
     }
 }

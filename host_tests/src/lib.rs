@@ -7,6 +7,7 @@ pub mod certify;
 pub mod drive;
 pub mod drives;
 pub mod jsonl;
+pub mod link;
 pub mod scenarios;
 pub mod synth;
 

@@ -18,7 +18,32 @@ use roadstereo::calibration::{
 };
 use roadstereo::fusion::{ChainedMotion, Fusion, FusionConfig};
 use roadstereo::geometry::Sample;
+use roadstereo::link::{write_packet, UartLink};
+use roadstereo::wire::{encode, result, DataIds, Event, Receiver, ResultView};
 use roadstereo::{Camera, Config, Frame, Motion, Pixel, Processor, Step};
+
+/// A UART whose bytes the optimiser cannot see.
+struct Opaque;
+impl embedded_io::ErrorType for Opaque {
+    type Error = core::convert::Infallible;
+}
+impl embedded_io::Read for Opaque {
+    fn read(&mut self, buf: &mut [u8]) -> Result<usize, Self::Error> {
+        for b in buf.iter_mut() {
+            *b = black_box(0x5A);
+        }
+        Ok(black_box(buf.len()))
+    }
+}
+impl embedded_io::Write for Opaque {
+    fn write(&mut self, buf: &[u8]) -> Result<usize, Self::Error> {
+        black_box(buf);
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> Result<(), Self::Error> {
+        Ok(())
+    }
+}
 
 const N: usize = 256;
 
@@ -131,6 +156,47 @@ fn main() -> ! {
         black_box((fusion.digest(), fusion.structure().digest()));
         if black_box(false) {
             fusion.reset();
+        }
+        // The link: bytes from outside through the receiver (decoder,
+        // pairing, per-pair config), the per-frame call, the result and
+        // report packets, the UART driver, and the vehicle-side parsers.
+        let mut rx = Receiver::<N, 2>::new(DataIds::DEFAULT, Config::DEFAULT);
+        let mut link = UartLink::new(Opaque);
+        let mut raw = [0u8; roadstereo::wire::result_packet_max(N, 2)];
+        let mut framed =
+            [0u8; roadstereo::wire::cobs_max(roadstereo::wire::result_packet_max(N, 2))];
+        let mut out = Opaque;
+        for _ in 0..black_box(3) {
+            let _ = link.poll(&mut rx, |ev| match ev {
+                Event::Frame(job) => {
+                    if let Ok(step) = job.run(&mut processor) {
+                        let head = job.result_head(black_box(7));
+                        if let Ok(n) =
+                            encode::result(&mut raw, 1, 2, &head, &step, &job.kept_quality)
+                        {
+                            let _ =
+                                write_packet(&mut out, raw.get(..n).unwrap_or(&[]), &mut framed);
+                        }
+                    }
+                }
+                Event::Error(e) => {
+                    if let Ok(n) = encode::report(&mut raw, 1, 2, &e) {
+                        let _ = write_packet(&mut out, raw.get(..n).unwrap_or(&[]), &mut framed);
+                    }
+                }
+                _ => {}
+            });
+        }
+        let bytes = black_box(&raw[..]);
+        if let Ok(c) = result::check(bytes) {
+            if let Ok(v) = ResultView::parse(c.payload) {
+                for b in v.boundaries() {
+                    for p in b.points() {
+                        black_box(p);
+                    }
+                }
+            }
+            black_box(result::report(c.payload));
         }
         // The calibration entry points too.
         let flows = black_box(

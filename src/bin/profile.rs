@@ -46,6 +46,7 @@ fn main() -> ! {
     for (k, (name, data)) in WINDOWS.iter().enumerate() {
         ok &= window(k, name, data);
     }
+    ok &= wire_window(WINDOWS.len());
     fw::exit(ok)
 }
 
@@ -74,6 +75,39 @@ fn window(k: usize, name: &str, data: &'static [u8]) -> bool {
         name,
         points,
         processor.structure().digest(),
+        ok
+    );
+    ok
+}
+
+/// The link's decoder on the representative pair's first frame (a
+/// 2 × 256 frame packet): COBS, CRC, parsing, the points validated and
+/// written into the decoder's frame (`roadstereo::wire`).
+fn wire_window(k: usize) -> bool {
+    use roadstereo::wire::{cobs_max, frame_packet_max, DataIds, Decoder, Packet};
+    const RAW: usize = frame_packet_max(256, 2);
+    let mut raw = [0u8; RAW];
+    let mut cam = [0u8; 64];
+    let mut link = [0u8; cobs_max(RAW)];
+    let Some((cam_n, link_n, points)) =
+        fw::wire_sample::<256, 2>(WINDOWS[0].1, &mut raw, &mut cam, &mut link)
+    else {
+        return false;
+    };
+    let mut d = Decoder::<256, 2>::new(DataIds::DEFAULT);
+    let _ = d.feed(cam.get(..cam_n).unwrap_or(&[]));
+    let bytes = link.get(..link_n).unwrap_or(&[]);
+    let tag = 2 * k as u32 + 1;
+    marker(tag);
+    let (used, out) = d.feed(black_box(bytes));
+    let ok = used == bytes.len() && matches!(out.map(|o| o.packet), Some(Ok(Packet::Frame(..))));
+    marker(tag + 1);
+    defmt::info!(
+        "profile window={=usize} name={=str} points={=usize} digest={=u32:08x} ok={=bool}",
+        k,
+        "wire decode",
+        points,
+        0u32,
         ok
     );
     ok

@@ -5,6 +5,7 @@ use crate::bench::{bench, bench_args};
 use crate::demo::demo;
 use crate::profile::{profile, CYCLES_PER_POINT};
 use crate::setup::setup_toolchain;
+use crate::stream::stream;
 use crate::util::{root, run, THUMB};
 
 /// The README's test command: the library's unit and doc tests on the host,
@@ -62,6 +63,21 @@ pub fn ci() -> Result<(), String> {
     // The firmware on the emulated controller: the demo, compared frame by
     // frame with the host build, then the benchmark, budgets and proofs.
     demo(true)?;
+    // The link: the README's example drive streamed over UART0, then the
+    // demo drive with faults injected; any divergence fails.
+    stream(&["docs/example.jsonl".into()])?;
+    stream(&[
+        "--drive".into(),
+        "src/bin/data/drive.bin".into(),
+        "--corrupt".into(),
+        "0.1".into(),
+        "--drop".into(),
+        "0.05".into(),
+        "--duplicate".into(),
+        "0.05".into(),
+        "--seed".into(),
+        "1".into(),
+    ])?;
     let bench = bench(&bench_args(&[])?);
     // The profiler too, so it cannot rot (about ten seconds), with its
     // cycles budget; it runs even when a bench budget is missed, so both

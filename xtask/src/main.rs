@@ -7,6 +7,10 @@
 //!   `qemu-system-arm`, `defmt-print`), builds the firmware in release mode,
 //!   runs it and prints a summary table. `--check` also compares every
 //!   frame's results with the host build of the same code.
+//! * `stream`  — a recorded drive (replay JSON Lines) streamed into the
+//!   link firmware over UART0 on the emulated controller, with optional
+//!   fault injection (`--corrupt/--drop/--duplicate/--seed`), every result
+//!   compared bit for bit with the host build (see `stream --help`).
 //! * `bench`   — instruction counts (the representative pair and the
 //!   adversarial family of issue 11), stage costs, stack, memory figures and
 //!   the link-time proofs (panic-never, no `f64`, no allocator), with the
@@ -31,6 +35,7 @@ mod disasm;
 mod firmware;
 mod profile;
 mod setup;
+mod stream;
 mod util;
 
 use std::process::ExitCode;
@@ -56,10 +61,11 @@ fn main() -> ExitCode {
             Ok(())
         }
         "profile" => profile::profile_args(rest).and_then(profile::profile),
+        "stream" => stream::stream(rest),
         "setup" => setup::setup_emulator(),
         _ => {
             eprintln!(
-                "usage: cargo xtask <test|demo [--check]|bench [options]|profile [options]|figures|ci|setup>"
+                "usage: cargo xtask <test|demo [--check]|stream FILE [options]|bench [options]|profile [options]|figures|ci|setup>"
             );
             return ExitCode::from(2);
         }

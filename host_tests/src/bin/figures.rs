@@ -23,6 +23,70 @@ fn world(pose: &synth::Pose, p: [f32; 3]) -> V3 {
     [0, 1, 2].map(|i| c[i] + r[i][0] * p[0] + r[i][1] * p[1] + r[i][2] * p[2])
 }
 
+/// The parts of a polyline inside the rectangle `x × y`, each a run of
+/// points, the ends where it leaves or enters cut exactly at the edge
+/// (Liang–Barsky on each segment), so no line is drawn along an edge.
+fn clipped_runs(
+    pts: impl IntoIterator<Item = (f64, f64)>,
+    x: (f64, f64),
+    y: (f64, f64),
+) -> Vec<Vec<(f64, f64)>> {
+    let clip = |a: (f64, f64), b: (f64, f64)| -> Option<((f64, f64), (f64, f64))> {
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+        let d = (b.0 - a.0, b.1 - a.1);
+        for (p, q) in [
+            (-d.0, a.0 - x.0),
+            (d.0, x.1 - a.0),
+            (-d.1, a.1 - y.0),
+            (d.1, y.1 - a.1),
+        ] {
+            if p == 0.0 {
+                if q < 0.0 {
+                    return None;
+                }
+            } else {
+                let t = q / p;
+                if p < 0.0 {
+                    t0 = t0.max(t);
+                } else {
+                    t1 = t1.min(t);
+                }
+            }
+        }
+        (t0 <= t1).then_some((
+            (a.0 + t0 * d.0, a.1 + t0 * d.1),
+            (a.0 + t1 * d.0, a.1 + t1 * d.1),
+        ))
+    };
+    let pts: Vec<(f64, f64)> = pts.into_iter().collect();
+    let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut cur: Vec<(f64, f64)> = Vec::new();
+    for w in pts.windows(2) {
+        match clip(w[0], w[1]) {
+            Some((a, b)) => {
+                if cur.last() != Some(&a) {
+                    if cur.len() > 1 {
+                        runs.push(std::mem::take(&mut cur));
+                    }
+                    cur.clear();
+                    cur.push(a);
+                }
+                cur.push(b);
+            }
+            None => {
+                if cur.len() > 1 {
+                    runs.push(std::mem::take(&mut cur));
+                }
+                cur.clear();
+            }
+        }
+    }
+    if cur.len() > 1 {
+        runs.push(cur);
+    }
+    runs
+}
+
 fn fig7(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
     let s = scenarios::named().remove(0); // fig6
     let k = s.intrinsics;
@@ -55,12 +119,7 @@ fn fig7(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
     let truth: Vec<Vec<V3>> = r
         .world
         .iter()
-        .map(|c| {
-            c.iter()
-                .copied()
-                .filter(|p| p[2] > 0.0 && p[2] < zmax)
-                .collect()
-        })
+        .map(|c| c.iter().copied().filter(|p| p[2] > 0.0).collect())
         .collect();
     // Top view.
     let mut top = ChartBuilder::on(&left)
@@ -73,23 +132,39 @@ fn fig7(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
         .x_desc("x (right), camera heights")
         .y_desc("forward, camera heights")
         .draw()?;
+    let mut labelled = false;
     for c in &truth {
-        top.draw_series(LineSeries::new(
-            c.iter().map(|p| (p[0], p[2])),
-            &BLUE.mix(0.5),
-        ))?;
+        for run in clipped_runs(c.iter().map(|p| (p[0], p[2])), (-3.0, 3.0), (0.0, zmax)) {
+            let s = top.draw_series(LineSeries::new(run, BLUE.mix(0.5)))?;
+            if !labelled {
+                s.label("true boundaries")
+                    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLUE.mix(0.5)));
+                labelled = true;
+            }
+        }
     }
     top.draw_series(
         sticks
             .iter()
             .map(|(n, f)| PathElement::new(vec![(n[0], n[2]), (f[0], f[2])], RED)),
-    )?;
+    )?
+    .label("sticks (e = 1 px)")
+    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], RED));
     top.draw_series(
         points
             .iter()
             .map(|p| Circle::new((p[0], p[2]), 1, BLACK.filled())),
-    )?;
-    top.draw_series(std::iter::once(Circle::new((0.0, 0.0), 6, BLACK)))?;
+    )?
+    .label("reconstructed points")
+    .legend(|(x, y)| Circle::new((x + 9, y), 2, BLACK.filled()));
+    top.draw_series(std::iter::once(Circle::new((0.0, 0.0), 6, BLACK)))?
+        .label("camera")
+        .legend(|(x, y)| Circle::new((x + 9, y), 5, BLACK));
+    top.configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()?;
     // Side view.
     let mut side = ChartBuilder::on(&right)
         .caption(
@@ -104,27 +179,43 @@ fn fig7(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
         .x_desc("forward, camera heights")
         .y_desc("height")
         .draw()?;
+    let mut labelled = false;
     for c in &truth {
-        side.draw_series(LineSeries::new(
-            c.iter().map(|p| (p[2], -p[1])),
-            &BLUE.mix(0.5),
-        ))?;
+        for run in clipped_runs(c.iter().map(|p| (p[2], -p[1])), (0.0, zmax), (-0.6, 1.4)) {
+            let s = side.draw_series(LineSeries::new(run, BLUE.mix(0.5)))?;
+            if !labelled {
+                s.label("true boundaries")
+                    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLUE.mix(0.5)));
+                labelled = true;
+            }
+        }
     }
     side.draw_series(
         sticks
             .iter()
             .map(|(n, f)| PathElement::new(vec![(n[2], -n[1]), (f[2], -f[1])], RED)),
-    )?;
+    )?
+    .label("sticks (e = 1 px)")
+    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], RED));
     side.draw_series(
         points
             .iter()
             .map(|p| Circle::new((p[2], -p[1]), 1, BLACK.filled())),
-    )?;
+    )?
+    .label("reconstructed points")
+    .legend(|(x, y)| Circle::new((x + 9, y), 2, BLACK.filled()));
     side.draw_series(std::iter::once(Circle::new(
         (r.pose1.centre[2], -r.pose1.centre[1]),
         6,
         BLACK,
-    )))?;
+    )))?
+    .label("camera")
+    .legend(|(x, y)| Circle::new((x + 9, y), 5, BLACK));
+    side.configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()?;
     root.present()?;
     let ok = stats.iter().filter(|p| p.status == Status::Ok).count();
     let inside = stats
@@ -392,7 +483,7 @@ fn fig10(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
     for (area, (comp, name)) in panels.iter().zip([(0usize, "ΔU"), (1, "ΔV"), (2, "ΔW")]) {
         let mut chart = ChartBuilder::on(area)
             .caption(
-                format!("Effect of {name} = ±5 % (o: over, u: under)"),
+                format!("Effect of {name} = ±5 % of the travel"),
                 ("sans-serif", 16),
             )
             .margin(10)
@@ -404,7 +495,7 @@ fn fig10(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
             .x_desc("x (right)")
             .y_desc("forward")
             .draw()?;
-        for (sign, col) in [(1.0f32, RED), (-1.0, GREEN)] {
+        for (sign, col, what) in [(1.0f32, RED, "+5 %"), (-1.0, GREEN, "−5 %")] {
             let mut tr = robot;
             tr[comp] += sign * 0.05 * travel;
             if comp < 2 {
@@ -412,22 +503,35 @@ fn fig10(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
                 tr = tr.map(|x| x * travel / len);
             }
             let mm = Motion::new(vehicle_to_camera(tr, tilt)?, m.angles())?;
-            chart.draw_series(top(&mm).into_iter().map(|p| Circle::new(p, 2, col)))?;
+            chart
+                .draw_series(top(&mm).into_iter().map(|p| Circle::new(p, 2, col)))?
+                .label(format!("{name} {what}"))
+                .legend(move |(x, y)| Circle::new((x + 9, y), 3, col));
         }
-        chart.draw_series(base.iter().map(|&p| Circle::new(p, 1, BLACK.filled())))?;
+        chart
+            .draw_series(base.iter().map(|&p| Circle::new(p, 1, BLACK.filled())))?
+            .label("true motion")
+            .legend(|(x, y)| Circle::new((x + 9, y), 2, BLACK.filled()));
         let c0 = r.pose1.centre;
+        let mut labelled = false;
         for curve in &r.world {
-            chart.draw_series(LineSeries::new(
-                curve
-                    .iter()
-                    .map(|p| {
-                        let rel = [p[0] - c0[0], p[1] - c0[1], p[2] - c0[2]];
-                        (rel[0], rel[2])
-                    })
-                    .filter(|p| p.1 > 0.0 && p.1 < 12.0),
-                BLUE.mix(0.5),
-            ))?;
+            let pts = curve.iter().map(|p| (p[0] - c0[0], p[2] - c0[2]));
+            for run in clipped_runs(pts, (-2.0, 3.0), (0.0, 12.0)) {
+                let s = chart.draw_series(LineSeries::new(run, BLUE.mix(0.5)))?;
+                if !labelled {
+                    s.label("true boundaries").legend(|(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 18, y)], BLUE.mix(0.5))
+                    });
+                    labelled = true;
+                }
+            }
         }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()?;
     }
     root.present()?;
     println!("wrote {}", path.display());

@@ -158,6 +158,45 @@ impl Drive {
     }
 }
 
+/// The first frame of `data` (an RSD1 drive) as the link sends it: the
+/// camera packet into `cam`, the frame packet (radius 0.5 px, quality 255)
+/// into `frame`, both COBS-framed. Returns the two lengths and the frame's
+/// point count.
+pub fn wire_sample<const N: usize, const B: usize>(
+    data: &'static [u8],
+    raw: &mut [u8],
+    cam: &mut [u8],
+    frame: &mut [u8],
+) -> Option<(usize, usize, usize)> {
+    use roadstereo::wire::encode::{self, BoundaryHead, FrameHead, FramePacket};
+    use roadstereo::wire::DataIds;
+    let mut drive = Drive::new(data).ok()?;
+    let camera = drive.camera;
+    let mut f = Frame::<N, B>::new(camera);
+    drive.next_frame(&mut f).ok()?;
+    let ids = DataIds::DEFAULT;
+    let n = encode::camera(raw, ids.camera, 0, &camera).ok()?;
+    let cam_n = encode::cobs_frame(raw.get(..n)?, cam).ok()?;
+    let head = FrameHead {
+        timestamp_us: 0,
+        frame_id: 1,
+        width: camera.width(),
+        height: camera.height(),
+    };
+    let mut p = FramePacket::begin(raw, ids.frame, 0, &head).ok()?;
+    let bh = BoundaryHead {
+        quality: 255,
+        radius_px: 0.5,
+    };
+    for b in f.boundaries() {
+        p.boundary(&bh, b.points()).ok()?;
+    }
+    let n = p.finish().ok()?;
+    let frame_n = encode::cobs_frame(raw.get(..n)?, frame).ok()?;
+    let points = f.boundaries().iter().map(|b| b.points().len()).sum();
+    Some((cam_n, frame_n, points))
+}
+
 /// A HardFault ends the run with failure (QEMU's exit code says so).
 #[exception]
 unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {

@@ -1,0 +1,406 @@
+//! Stream a recorded drive into the link firmware on QEMU over UART0 and
+//! compare every output packet with the host build, bit for bit.
+//!
+//! `stream --elf ELF [--drive] FILE [--corrupt P] [--drop P] [--duplicate P]
+//! [--seed S] [--radius PX] [--frames K]`
+//!
+//! FILE is replay JSON Lines, or with `--drive` the firmware drive format
+//! (`src/bin/data/drive.bin`). `cargo xtask stream` builds the firmware and
+//! calls this. Exit code 1 on any divergence.
+
+use std::collections::BTreeMap;
+use std::io::{Read, Write};
+use std::os::unix::net::UnixStream;
+use std::process::{Command, ExitCode, Stdio};
+use std::time::{Duration, Instant};
+
+use host_tests::link::{self, Faults, Kind};
+use roadstereo::wire::result::{check, report};
+use roadstereo::wire::{ErrorKind, PacketType, ResultView};
+
+const BUDGET_INSTRUCTIONS: u64 = 33 * 168_000 / 20;
+
+struct Args {
+    elf: String,
+    file: String,
+    drive: bool,
+    faults: Faults,
+    radius: f32,
+    frames: Option<usize>,
+}
+
+fn args() -> Result<Args, String> {
+    let mut a = Args {
+        elf: String::new(),
+        file: String::new(),
+        drive: false,
+        faults: Faults::default(),
+        radius: 0.5,
+        frames: None,
+    };
+    let mut it = std::env::args().skip(1);
+    while let Some(x) = it.next() {
+        let mut val = |name: &str| it.next().ok_or(format!("{name} needs a value"));
+        match x.as_str() {
+            "--elf" => a.elf = val("--elf")?,
+            "--drive" => a.drive = true,
+            "--corrupt" => {
+                a.faults.corrupt = val("--corrupt")?
+                    .parse()
+                    .map_err(|e| format!("--corrupt: {e}"))?
+            }
+            "--drop" => {
+                a.faults.drop = val("--drop")?.parse().map_err(|e| format!("--drop: {e}"))?
+            }
+            "--duplicate" => {
+                a.faults.duplicate = val("--duplicate")?
+                    .parse()
+                    .map_err(|e| format!("--duplicate: {e}"))?
+            }
+            "--seed" => {
+                a.faults.seed = val("--seed")?.parse().map_err(|e| format!("--seed: {e}"))?
+            }
+            "--radius" => {
+                a.radius = val("--radius")?
+                    .parse()
+                    .map_err(|e| format!("--radius: {e}"))?
+            }
+            "--frames" => {
+                a.frames = Some(
+                    val("--frames")?
+                        .parse()
+                        .map_err(|e| format!("--frames: {e}"))?,
+                )
+            }
+            f if !f.starts_with("--") && a.file.is_empty() => a.file = f.to_string(),
+            other => return Err(format!("unknown argument {other}")),
+        }
+    }
+    for p in [a.faults.corrupt, a.faults.drop, a.faults.duplicate] {
+        if !(0.0..=1.0).contains(&p) {
+            return Err("fault probabilities must be in [0, 1]".into());
+        }
+    }
+    if a.elf.is_empty() || a.file.is_empty() {
+        return Err("usage: stream --elf ELF [--drive] FILE [--corrupt P] [--drop P] [--duplicate P] [--seed S] [--radius PX] [--frames K]".into());
+    }
+    Ok(a)
+}
+
+/// Run the firmware with UART0 on a Unix socket; write `input`, read the
+/// output link bytes until the summary packet (or the firmware exits).
+fn run_qemu(elf: &str, input: &[u8]) -> Result<(Vec<u8>, String, f64), String> {
+    let elf = std::fs::canonicalize(elf).map_err(|e| format!("{elf}: {e}"))?;
+    let dir = std::env::temp_dir().join(format!("roadstereo-stream-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let sock = dir.join("uart0.sock");
+    let _ = std::fs::remove_file(&sock);
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let chardev = format!("socket,id=link,path={},server=on,wait=on", sock.display());
+    let mut child = Command::new("bash")
+        .arg(root.join(".cargo/qemu-run.sh"))
+        .arg(&elf)
+        .args(["-chardev", &chardev, "-serial", "chardev:link"])
+        .current_dir(&root)
+        .stdout(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("cannot start QEMU: {e}"))?;
+    let start = Instant::now();
+    let mut conn = loop {
+        match UnixStream::connect(&sock) {
+            Ok(c) => break c,
+            Err(_) if start.elapsed() < Duration::from_secs(30) => {
+                std::thread::sleep(Duration::from_millis(50))
+            }
+            Err(e) => {
+                let _ = child.kill();
+                return Err(format!("cannot connect to QEMU's UART0 socket: {e}"));
+            }
+        }
+    };
+    let t0 = Instant::now();
+    let mut writer = conn.try_clone().map_err(|e| e.to_string())?;
+    let data = input.to_vec();
+    let w = std::thread::spawn(move || {
+        for c in data.chunks(256) {
+            if writer.write_all(c).is_err() {
+                return;
+            }
+        }
+        let _ = writer.flush();
+    });
+    conn.set_read_timeout(Some(Duration::from_secs(300)))
+        .map_err(|e| e.to_string())?;
+    let mut out = Vec::new();
+    let mut buf = [0u8; 4096];
+    loop {
+        match conn.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => {
+                out.extend_from_slice(&buf[..n]);
+                // The summary packet is the last thing the firmware sends.
+                if n > 0 && buf[n - 1] == 0 {
+                    let frames = link::split_link(&out);
+                    if let Some(Ok(last)) = frames.last() {
+                        if link::type_of(last) == Some(PacketType::Summary) {
+                            break;
+                        }
+                    }
+                }
+            }
+            Err(e) => {
+                let _ = child.kill();
+                return Err(format!("reading UART0: {e}"));
+            }
+        }
+    }
+    let secs = t0.elapsed().as_secs_f64();
+    let _ = w.join();
+    drop(conn);
+    let mut log = String::new();
+    if let Some(mut s) = child.stdout.take() {
+        let _ = s.read_to_string(&mut log);
+    }
+    let status = child.wait().map_err(|e| e.to_string())?;
+    let _ = std::fs::remove_dir_all(&dir);
+    if !status.success() {
+        return Err(format!("firmware failed ({status})\n{log}"));
+    }
+    Ok((out, log, secs))
+}
+
+fn main() -> ExitCode {
+    let a = match args() {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("stream: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let frames = match std::fs::read(&a.file)
+        .map_err(|e| e.to_string())
+        .and_then(|b| {
+            if a.drive {
+                link::from_drive(&b)
+            } else {
+                link::from_jsonl(&String::from_utf8_lossy(&b))
+            }
+        }) {
+        Ok(mut f) => {
+            if let Some(k) = a.frames {
+                f.truncate(k);
+            }
+            f
+        }
+        Err(e) => {
+            eprintln!("stream: {}: {e}", a.file);
+            return ExitCode::from(2);
+        }
+    };
+    let packets = match link::packets(&frames, a.radius) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("stream: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let (stream, injected) = link::inject(&packets, &a.faults);
+    let frame_packets = packets.iter().filter(|p| p.kind == Kind::Frame).count();
+    println!(
+        "stream: {} frames, {} packets, {} bytes in; faults injected: {} corrupted, {} dropped, {} duplicated (seed {})",
+        frames.len(),
+        packets.len(),
+        stream.len(),
+        injected.corrupted,
+        injected.dropped,
+        injected.duplicated,
+        a.faults.seed
+    );
+    // The host reference on the same bytes, and the clean run (no faults)
+    // for the pairs the faulty run shares with it.
+    let host = link::host_outputs(&stream, 61);
+    let (clean_stream, _) = link::inject(&packets, &Faults::default());
+    let clean = link::host_outputs(&clean_stream, 61);
+    let (fw_bytes, _log, secs) = match run_qemu(&a.elf, &stream) {
+        Ok(x) => x,
+        Err(e) => {
+            eprintln!("stream: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    println!(
+        "stream: {} bytes in, {} bytes out in {secs:.1} s",
+        stream.len(),
+        fw_bytes.len()
+    );
+    let fw: Vec<Vec<u8>> = link::split_link(&fw_bytes)
+        .into_iter()
+        .map(|r| r.unwrap_or_default())
+        .collect();
+
+    let mut divergences = Vec::new();
+    if fw.len() != host.len() {
+        divergences.push(format!(
+            "firmware sent {} packets, host {}",
+            fw.len(),
+            host.len()
+        ));
+    }
+    // Every packet, bit for bit (a result's instruction count is the
+    // firmware's own and is set to 0 for the comparison).
+    let mut compared = 0usize;
+    let mut fw_errors: BTreeMap<ErrorKind, u32> = BTreeMap::new();
+    let mut host_errors: BTreeMap<ErrorKind, u32> = BTreeMap::new();
+    let mut rows = Vec::new();
+    for (i, (f, h)) in fw.iter().zip(&host).enumerate() {
+        let mut f0 = f.clone();
+        if link::type_of(f) == Some(PacketType::Result) {
+            ResultView::zero_instructions(&mut f0);
+        }
+        if &f0 != h {
+            divergences.push(format!("output packet {i} differs"));
+        }
+        if let Ok(c) = check(f) {
+            match c.ptype {
+                PacketType::Result => {
+                    if let Ok(v) = ResultView::parse(c.payload) {
+                        if v.structure {
+                            compared += 1;
+                        }
+                        rows.push(v.clone_owned());
+                    }
+                }
+                PacketType::Report => {
+                    if let Some(r) = report(c.payload) {
+                        *fw_errors.entry(r.kind).or_default() += 1;
+                    }
+                }
+                _ => {}
+            }
+        } else {
+            divergences.push(format!("output packet {i} does not check"));
+        }
+    }
+    for h in &host {
+        if let Ok(c) = check(h) {
+            if c.ptype == PacketType::Report {
+                if let Some(r) = report(c.payload) {
+                    *host_errors.entry(r.kind).or_default() += 1;
+                }
+            }
+        }
+    }
+    // The pairs both runs have: the same results (payloads without the
+    // counter, so a fault before them changed nothing).
+    let key = |raw: &Vec<u8>| -> Option<((u32, u32), Vec<u8>)> {
+        let c = check(raw).ok()?;
+        (c.ptype == PacketType::Result).then_some(())?;
+        let v = ResultView::parse(c.payload).ok()?;
+        v.structure
+            .then(|| ((v.kept_id, v.frame_id), c.payload.to_vec()))
+    };
+    let clean_pairs: BTreeMap<(u32, u32), Vec<u8>> = clean.iter().filter_map(key).collect();
+    let (mut shared, mut shared_same) = (0usize, 0usize);
+    for (k, payload) in host.iter().filter_map(key) {
+        if let Some(c) = clean_pairs.get(&k) {
+            shared += 1;
+            if *c == payload {
+                shared_same += 1;
+            } else {
+                divergences.push(format!("pair {k:?} differs from the fault-free run"));
+            }
+        }
+    }
+
+    println!();
+    println!(
+        "| frame | kept | points | ok | flagged | instructions | instr/point | frame budget used |"
+    );
+    println!("|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for r in rows.iter().filter(|r| r.structure) {
+        let points: u64 = r.counts.iter().map(|&c| u64::from(c)).sum();
+        let ok = u64::from(r.counts[0]);
+        println!(
+            "| {} | {} | {} | {} | {} | {} | {} | {:.1} % |",
+            r.frame_id,
+            r.kept_id,
+            points,
+            ok,
+            points - ok,
+            r.instructions,
+            u64::from(r.instructions) / points.max(1),
+            f64::from(r.instructions) * 100.0 / BUDGET_INSTRUCTIONS as f64
+        );
+    }
+    println!();
+    println!("| error reported | firmware | host |");
+    println!("|---|---:|---:|");
+    let kinds: std::collections::BTreeSet<_> = fw_errors
+        .keys()
+        .chain(host_errors.keys())
+        .copied()
+        .collect();
+    for k in &kinds {
+        println!(
+            "| {} | {} | {} |",
+            k.name(),
+            fw_errors.get(k).copied().unwrap_or(0),
+            host_errors.get(k).copied().unwrap_or(0)
+        );
+    }
+    if kinds.is_empty() {
+        println!("| (none) | 0 | 0 |");
+    }
+    println!();
+    println!("| faults injected (corrupted / dropped / duplicated) | errors reported | frame packets sent | frames compared bit for bit | pairs also in the fault-free run, identical | divergences |");
+    println!("|---|---:|---:|---:|---:|---:|");
+    println!(
+        "| {} / {} / {} | {} | {} | {} | {} / {} | {} |",
+        injected.corrupted,
+        injected.dropped,
+        injected.duplicated,
+        fw_errors.values().sum::<u32>(),
+        frame_packets,
+        compared,
+        shared_same,
+        shared,
+        divergences.len()
+    );
+    if divergences.is_empty() {
+        println!(
+            "stream: firmware and host agree bit for bit on all {} output packets ({} frames with a structure)",
+            fw.len(),
+            compared
+        );
+        ExitCode::SUCCESS
+    } else {
+        for d in divergences.iter().take(20) {
+            eprintln!("stream: divergence: {d}");
+        }
+        ExitCode::FAILURE
+    }
+}
+
+/// A result's fields for the table (the view borrows the packet).
+struct Row {
+    frame_id: u32,
+    kept_id: u32,
+    structure: bool,
+    instructions: u32,
+    counts: [u16; 13],
+}
+
+trait Owned {
+    fn clone_owned(&self) -> Row;
+}
+impl Owned for ResultView<'_> {
+    fn clone_owned(&self) -> Row {
+        Row {
+            frame_id: self.frame_id,
+            kept_id: self.kept_id,
+            structure: self.structure,
+            instructions: self.instructions,
+            counts: self.counts,
+        }
+    }
+}

@@ -1,0 +1,196 @@
+//! The camera front-end link on the emulated vehicle controller: packets
+//! come in on UART0 (camera, motion and frame packets, `roadstereo::wire`),
+//! each frame goes through the per-frame processor with its pair's
+//! configuration, and a result packet (or a report packet for each typed
+//! error) goes back out on UART0. An end packet makes it answer with a
+//! summary packet (its counters) and exit with success.
+//!
+//! The per-frame call is timed alone (the UART polling's instruction count
+//! varies from run to run); the instructions go into the result packet and
+//! the defmt log. `cargo xtask stream FILE.jsonl` drives it.
+
+#![no_std]
+#![no_main]
+
+mod fw;
+
+use cortex_m_rt::entry;
+use defmt_semihosting as _;
+use roadstereo::link::{write_packet, UartLink};
+use roadstereo::wire::{self, encode, DataIds, Event, Receiver};
+use roadstereo::{Config, Processor, Status, Step};
+
+/// Capacity: two boundaries of up to 256 points.
+const N: usize = 256;
+const B: usize = 2;
+
+/// Default frame budget: 5 % of a 33 ms frame at 168 MHz, one instruction
+/// counted as one cycle (as the demo).
+const BUDGET_INSTRUCTIONS: u32 = 33 * 168_000 / 20;
+
+/// UART0 of the mps2-an386 (CMSDK APB UART), register level. The library
+/// stays free of `unsafe`: the volatile register accesses live here.
+mod uart0 {
+    use core::convert::Infallible;
+    use core::ptr::{read_volatile, write_volatile};
+
+    const BASE: usize = 0x4000_4000;
+    const DATA: *mut u32 = BASE as *mut u32;
+    const STATE: *mut u32 = (BASE + 0x04) as *mut u32;
+    const CTRL: *mut u32 = (BASE + 0x08) as *mut u32;
+    const BAUDDIV: *mut u32 = (BASE + 0x10) as *mut u32;
+    const TX_FULL: u32 = 1 << 0;
+    const RX_FULL: u32 = 1 << 1;
+
+    /// A handle on UART0 (all handles drive the same registers).
+    pub struct Uart0;
+
+    impl Uart0 {
+        /// Enable transmit and receive.
+        pub fn init() -> Self {
+            // SAFETY: the UART0 registers of this machine; nothing else in
+            // the firmware touches them.
+            unsafe {
+                write_volatile(BAUDDIV, 16);
+                write_volatile(CTRL, 0b11);
+            }
+            Uart0
+        }
+        fn state() -> u32 {
+            // SAFETY: see `init`.
+            unsafe { read_volatile(STATE) }
+        }
+    }
+
+    impl embedded_io::ErrorType for Uart0 {
+        type Error = Infallible;
+    }
+
+    impl embedded_io::Read for Uart0 {
+        /// Blocks until a byte came, then takes what is there.
+        fn read(&mut self, buf: &mut [u8]) -> Result<usize, Infallible> {
+            let mut n = 0;
+            if buf.is_empty() {
+                return Ok(0);
+            }
+            while Self::state() & RX_FULL == 0 {}
+            for b in buf.iter_mut() {
+                if Self::state() & RX_FULL == 0 {
+                    break;
+                }
+                // SAFETY: see `init`.
+                *b = unsafe { read_volatile(DATA) } as u8;
+                n += 1;
+            }
+            Ok(n)
+        }
+    }
+
+    impl embedded_io::Write for Uart0 {
+        fn write(&mut self, buf: &[u8]) -> Result<usize, Infallible> {
+            for &b in buf {
+                while Self::state() & TX_FULL != 0 {}
+                // SAFETY: see `init`.
+                unsafe { write_volatile(DATA, u32::from(b)) };
+            }
+            Ok(buf.len())
+        }
+        fn flush(&mut self) -> Result<(), Infallible> {
+            Ok(())
+        }
+    }
+}
+
+use uart0::Uart0;
+
+const RAW: usize = wire::result_packet_max(N, B);
+
+#[entry]
+fn main() -> ! {
+    let Some(mut core) = cortex_m::Peripherals::take() else {
+        fw::exit(false)
+    };
+    fw::start_counter(&mut core.SYST);
+    let mut link = UartLink::new(Uart0::init());
+    let mut tx = Uart0;
+    let ids = DataIds::DEFAULT;
+    let mut rx = Receiver::<N, B>::new(ids, Config::DEFAULT);
+    let mut processor = Processor::<N, B>::new(Config::DEFAULT);
+    let mut raw = [0u8; RAW];
+    let mut framed = [0u8; wire::cobs_max(RAW)];
+    let (mut results, mut reports) = (0u16, 0u16);
+    defmt::info!(
+        "roadstereo link: UART0, capacity {=usize} x {=usize}, budget {=u32} instructions/frame",
+        B,
+        N,
+        BUDGET_INSTRUCTIONS
+    );
+    defmt::info!(
+        "sizes receiver={=usize} uart_link={=usize} result_buffers={=usize}",
+        core::mem::size_of::<Receiver<N, B>>(),
+        core::mem::size_of::<UartLink<Uart0>>(),
+        RAW + wire::cobs_max(RAW)
+    );
+    loop {
+        let mut end = false;
+        let polled = link.poll(&mut rx, |ev| match ev {
+            Event::Frame(job) => {
+                let (step, instr) = fw::measure(|| job.run(&mut processor));
+                let Ok(step) = step else {
+                    defmt::error!("frame {=u32}: processor refused", job.info.frame_id);
+                    return;
+                };
+                if let Step::Structure(s) = &step {
+                    let c = s.status_counts();
+                    defmt::info!(
+                        "frame={=u32} kept={=u32} points={=u32} ok={=u32} instr={=u32} budget_permille={=u32} digest={=u32:08x}",
+                        job.info.frame_id,
+                        job.kept_id,
+                        c.iter().sum::<usize>() as u32,
+                        c.get(Status::Ok as usize).copied().unwrap_or(0) as u32,
+                        instr,
+                        (u64::from(instr) * 1000 / u64::from(BUDGET_INSTRUCTIONS)) as u32,
+                        s.digest()
+                    );
+                }
+                let head = job.result_head(instr);
+                match encode::result(&mut raw, ids.result, results, &head, &step, &job.kept_quality) {
+                    Ok(n) => {
+                        results = results.wrapping_add(1);
+                        if write_packet(&mut tx, raw.get(..n).unwrap_or(&[]), &mut framed).is_err() {
+                            defmt::error!("result packet too large");
+                        }
+                    }
+                    Err(e) => defmt::error!("result packet: {}", e),
+                }
+            }
+            Event::Error(e) => {
+                defmt::warn!("link error: {}", e);
+                if let Ok(n) = encode::report(&mut raw, ids.report, reports, &e) {
+                    reports = reports.wrapping_add(1);
+                    let _ = write_packet(&mut tx, raw.get(..n).unwrap_or(&[]), &mut framed);
+                }
+            }
+            Event::End => end = true,
+            Event::Motion(_) | Event::Camera => {}
+        });
+        if polled.is_err() {
+            defmt::error!("UART read error");
+        }
+        if end {
+            let c = *rx.counters();
+            if let Ok(n) = encode::summary(&mut raw, ids.summary, 0, &c.values()) {
+                let _ = write_packet(&mut tx, raw.get(..n).unwrap_or(&[]), &mut framed);
+            }
+            defmt::info!(
+                "done bytes={=u32} frames={=u32} motions={=u32} cameras={=u32} errors={=u32}",
+                c.bytes,
+                c.frames,
+                c.motions,
+                c.cameras,
+                c.total_errors()
+            );
+            fw::exit(true)
+        }
+    }
+}

@@ -1,0 +1,72 @@
+//! Thin drivers that move the [`crate::wire`] bytes: an SPI front end with
+//! a data-ready pin ([`SpiLink`], embedded-hal 1.0) and a UART
+//! ([`UartLink`], embedded-io). Both feed a [`Receiver`] and hand its
+//! events to the caller; neither buffers more than one fixed-size chunk.
+//!
+//! Errors wrap the HAL's own error type ([`Error::Bus`]).
+
+mod spi;
+mod uart;
+
+pub use spi::{SpiLink, SPI_CHUNK, SPI_HEADER_LEN};
+pub use uart::{write_packet, UartLink, UART_CHUNK};
+
+use core::fmt;
+
+/// A driver's error: the bus's or pin's own error, or what the link's
+/// framing found before any byte reached the decoder.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Error<E, P = core::convert::Infallible> {
+    /// The bus (SPI or UART) failed; the packet in progress is ended (the
+    /// receiver reports it truncated) and the next one decodes as usual.
+    Bus(E),
+    /// The data-ready pin could not be read.
+    Pin(P),
+    /// The SPI length header is not valid (its check bytes disagree, or
+    /// the length is 0): nothing was read after it.
+    BadHeader {
+        /// The header's four bytes.
+        raw: [u8; SPI_HEADER_LEN],
+    },
+    /// The SPI length header announces more bytes than the largest packet
+    /// of this capacity: the bytes were read and dropped.
+    TooLarge {
+        /// Announced length.
+        len: u16,
+        /// The largest accepted.
+        max: u16,
+    },
+    /// The output buffer is too small for the packet.
+    Encode(crate::wire::encode::EncodeError),
+}
+
+impl<E: fmt::Debug, P: fmt::Debug> fmt::Display for Error<E, P> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Bus(e) => write!(f, "bus error: {e:?}"),
+            Self::Pin(e) => write!(f, "data-ready pin error: {e:?}"),
+            Self::BadHeader { raw } => write!(f, "bad SPI length header {raw:02x?}"),
+            Self::TooLarge { len, max } => {
+                write!(f, "packet of {len} bytes announced, at most {max}")
+            }
+            Self::Encode(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl<E: fmt::Debug, P: fmt::Debug> core::error::Error for Error<E, P> {}
+
+use crate::wire::Receiver;
+
+/// End the packet in progress (after a bus error): the receiver sees a
+/// delimiter, reports the cut packet and starts afresh.
+fn cut<const N: usize, const B: usize>(
+    rx: &mut Receiver<N, B>,
+    on: &mut impl FnMut(crate::wire::Event<'_, N, B>),
+) {
+    rx.feed(&[0], on);
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,383 @@
+//! Writing packets into caller-provided buffers: the raw packet (header,
+//! payload, CRC) first, then [`cobs_frame`] for the link.
+
+use core::fmt;
+
+use super::{
+    px_to_raw, radius_to_raw, PacketType, BOUNDARY_HEAD_LEN, CRC, CRC_LEN, FRAME_HEAD_LEN,
+    HEADER_LEN, MAGIC, VERSION,
+};
+use crate::{Camera, Motion, Pixel, Status, Step, Structure};
+
+use super::WireError;
+
+/// Why a packet could not be written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum EncodeError {
+    /// The output buffer is too small.
+    BufferTooSmall,
+    /// A point is outside what the format holds (`[−1, 4094.9375]` px) or
+    /// not finite.
+    PointRange,
+    /// A radius is negative, NaN or above [`super::MAX_RADIUS_PX`].
+    Radius,
+    /// More than 255 boundaries, or more than 65 535 points or bytes.
+    TooLarge,
+}
+
+impl core::error::Error for EncodeError {}
+
+impl fmt::Display for EncodeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::BufferTooSmall => "output buffer too small",
+            Self::PointRange => "point outside [-1, 4094.9375] px or not finite",
+            Self::Radius => "error radius outside [0, 100] px",
+            Self::TooLarge => "too many boundaries, points or bytes for the format",
+        })
+    }
+}
+
+/// A bounds-checked little-endian writer.
+struct Writer<'a> {
+    buf: &'a mut [u8],
+    at: usize,
+}
+
+impl Writer<'_> {
+    fn bytes(&mut self, b: &[u8]) -> Result<(), EncodeError> {
+        let end = self.at.checked_add(b.len()).ok_or(EncodeError::TooLarge)?;
+        let dst = self
+            .buf
+            .get_mut(self.at..end)
+            .ok_or(EncodeError::BufferTooSmall)?;
+        for (d, s) in dst.iter_mut().zip(b) {
+            *d = *s;
+        }
+        self.at = end;
+        Ok(())
+    }
+    fn u8(&mut self, x: u8) -> Result<(), EncodeError> {
+        self.bytes(&[x])
+    }
+    fn u16(&mut self, x: u16) -> Result<(), EncodeError> {
+        self.bytes(&x.to_le_bytes())
+    }
+    fn u32(&mut self, x: u32) -> Result<(), EncodeError> {
+        self.bytes(&x.to_le_bytes())
+    }
+    fn f32(&mut self, x: f32) -> Result<(), EncodeError> {
+        self.u32(x.to_bits())
+    }
+    fn patch(&mut self, at: usize, b: &[u8]) {
+        if let Some(dst) = self.buf.get_mut(at..at.saturating_add(b.len())) {
+            for (d, s) in dst.iter_mut().zip(b) {
+                *d = *s;
+            }
+        }
+    }
+    /// Write the header with a zero length (patched by [`Writer::finish`]).
+    fn header(&mut self, t: PacketType, data_id: u16, counter: u16) -> Result<(), EncodeError> {
+        self.bytes(&MAGIC)?;
+        self.u8(VERSION)?;
+        self.u8(t as u8)?;
+        self.u16(data_id)?;
+        self.u16(counter)?;
+        self.u16(0)
+    }
+    /// Patch the payload length, append the CRC; the packet's length.
+    fn finish(mut self) -> Result<usize, EncodeError> {
+        let payload = self
+            .at
+            .checked_sub(HEADER_LEN)
+            .ok_or(EncodeError::TooLarge)?;
+        let len = u16::try_from(payload).map_err(|_| EncodeError::TooLarge)?;
+        self.patch(8, &len.to_le_bytes());
+        let crc = CRC.checksum(self.buf.get(..self.at).unwrap_or(&[]));
+        self.u32(crc)?;
+        Ok(self.at)
+    }
+}
+
+/// The fixed part of a frame packet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FrameHead {
+    /// Exposure timestamp, microseconds (the front end's clock).
+    pub timestamp_us: u64,
+    /// Frame id (the motion packets name frames by it).
+    pub frame_id: u32,
+    /// Image width, pixels.
+    pub width: u16,
+    /// Image height, pixels.
+    pub height: u16,
+}
+
+/// A boundary's fixed part in a frame packet.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct BoundaryHead {
+    /// Quality from the detector (0–255, carried to the result).
+    pub quality: u8,
+    /// Localisation-error radius of every point, pixels (`[0, 100]`;
+    /// rounded up to 1/256 px).
+    pub radius_px: f32,
+}
+
+/// A frame packet being written: [`FramePacket::boundary`] per boundary,
+/// then [`FramePacket::finish`].
+pub struct FramePacket<'a> {
+    w: Writer<'a>,
+    count: u8,
+}
+
+impl<'a> FramePacket<'a> {
+    /// Start a frame packet in `out`.
+    pub fn begin(
+        out: &'a mut [u8],
+        data_id: u16,
+        counter: u16,
+        head: &FrameHead,
+    ) -> Result<Self, EncodeError> {
+        let mut w = Writer { buf: out, at: 0 };
+        w.header(PacketType::Frame, data_id, counter)?;
+        w.bytes(&head.timestamp_us.to_le_bytes())?;
+        w.u32(head.frame_id)?;
+        w.u16(head.width)?;
+        w.u16(head.height)?;
+        w.u8(0)?;
+        w.u8(0)?;
+        Ok(Self { w, count: 0 })
+    }
+
+    /// Append the next boundary (points rounded to 1/16 px).
+    pub fn boundary(&mut self, head: &BoundaryHead, points: &[Pixel]) -> Result<(), EncodeError> {
+        let n = u16::try_from(points.len()).map_err(|_| EncodeError::TooLarge)?;
+        let r = radius_to_raw(head.radius_px).ok_or(EncodeError::Radius)?;
+        self.w.u8(self.count)?;
+        self.w.u8(head.quality)?;
+        self.w.u16(r)?;
+        self.w.u16(n)?;
+        for p in points {
+            let u = px_to_raw(p.u).ok_or(EncodeError::PointRange)?;
+            let v = px_to_raw(p.v).ok_or(EncodeError::PointRange)?;
+            self.w.u16(u)?;
+            self.w.u16(v)?;
+        }
+        self.count = self.count.checked_add(1).ok_or(EncodeError::TooLarge)?;
+        Ok(())
+    }
+
+    /// Patch the boundary count and length, append the CRC: the packet's
+    /// length in `out`.
+    pub fn finish(mut self) -> Result<usize, EncodeError> {
+        self.w.patch(HEADER_LEN + FRAME_HEAD_LEN - 2, &[self.count]);
+        self.w.finish()
+    }
+}
+
+/// Write a whole frame packet for `boundaries` (points and head each).
+pub fn frame(
+    out: &mut [u8],
+    data_id: u16,
+    counter: u16,
+    head: &FrameHead,
+    boundaries: &[(BoundaryHead, &[Pixel])],
+) -> Result<usize, EncodeError> {
+    let mut p = FramePacket::begin(out, data_id, counter, head)?;
+    for (h, pts) in boundaries {
+        p.boundary(h, pts)?;
+    }
+    p.finish()
+}
+
+/// The content of a motion packet.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct MotionFields {
+    /// Frame id of the first frame.
+    pub from: u32,
+    /// Frame id of the second frame.
+    pub to: u32,
+    /// Translation `(U, V, W)` (README's conventions).
+    pub translation: [f32; 3],
+    /// Rotation `(α, β, γ)`, radians.
+    pub rotation: [f32; 3],
+    /// Bound on each translation component's error, if known.
+    pub translation_error: Option<f32>,
+    /// Bound on each rotation angle's error, radians, if known.
+    pub rotation_error: Option<[f32; 3]>,
+}
+
+impl MotionFields {
+    /// The fields of a validated motion, without error bounds.
+    pub fn of(from: u32, to: u32, m: &Motion) -> Self {
+        Self {
+            from,
+            to,
+            translation: m.translation(),
+            rotation: m.angles(),
+            translation_error: None,
+            rotation_error: None,
+        }
+    }
+}
+
+/// Write a motion packet.
+pub fn motion(
+    out: &mut [u8],
+    data_id: u16,
+    counter: u16,
+    m: &MotionFields,
+) -> Result<usize, EncodeError> {
+    let mut w = Writer { buf: out, at: 0 };
+    w.header(PacketType::Motion, data_id, counter)?;
+    w.u32(m.from)?;
+    w.u32(m.to)?;
+    for x in m.translation.iter().chain(m.rotation.iter()) {
+        w.f32(*x)?;
+    }
+    let flags =
+        u8::from(m.translation_error.is_some()) | (u8::from(m.rotation_error.is_some()) << 1);
+    w.bytes(&[flags, 0, 0, 0])?;
+    w.f32(m.translation_error.unwrap_or(0.0))?;
+    for x in m.rotation_error.unwrap_or([0.0; 3]) {
+        w.f32(x)?;
+    }
+    w.finish()
+}
+
+/// Write a camera packet.
+pub fn camera(
+    out: &mut [u8],
+    data_id: u16,
+    counter: u16,
+    c: &Camera,
+) -> Result<usize, EncodeError> {
+    let mut w = Writer { buf: out, at: 0 };
+    w.header(PacketType::Camera, data_id, counter)?;
+    for x in [c.fx(), c.fy(), c.cx(), c.cy()] {
+        w.f32(x)?;
+    }
+    w.u16(c.width())?;
+    w.u16(c.height())?;
+    w.finish()
+}
+
+/// Write an end packet (no payload).
+pub fn end(out: &mut [u8], data_id: u16, counter: u16) -> Result<usize, EncodeError> {
+    let mut w = Writer { buf: out, at: 0 };
+    w.header(PacketType::End, data_id, counter)?;
+    w.finish()
+}
+
+/// Write a report packet for `e`.
+pub fn report(
+    out: &mut [u8],
+    data_id: u16,
+    counter: u16,
+    e: &WireError,
+) -> Result<usize, EncodeError> {
+    let mut w = Writer { buf: out, at: 0 };
+    w.header(PacketType::Report, data_id, counter)?;
+    let (sub, a, rest) = e.details();
+    w.u8(e.kind() as u8)?;
+    w.u8(sub)?;
+    w.u16(a)?;
+    for x in rest {
+        w.u32(x)?;
+    }
+    w.finish()
+}
+
+/// Write a summary packet: the receiver's counters, `u32` each.
+pub fn summary(
+    out: &mut [u8],
+    data_id: u16,
+    counter: u16,
+    values: &[u32],
+) -> Result<usize, EncodeError> {
+    let mut w = Writer { buf: out, at: 0 };
+    w.header(PacketType::Summary, data_id, counter)?;
+    for x in values {
+        w.u32(*x)?;
+    }
+    w.finish()
+}
+
+/// What a result packet says about its frame besides the structure.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ResultHead {
+    /// The frame (frame 2 of the pair).
+    pub frame_id: u32,
+    /// The kept frame it was paired with (itself for a first frame).
+    pub kept_id: u32,
+    /// The frame's exposure timestamp, microseconds.
+    pub timestamp_us: u64,
+    /// Instructions of the per-frame call, where the firmware counts them
+    /// (0 otherwise).
+    pub instructions: u32,
+}
+
+/// Write a result packet: `step` of the frame, `quality` per boundary
+/// (from the frame-1 packet; 0 where unknown).
+pub fn result<const N: usize, const B: usize>(
+    out: &mut [u8],
+    data_id: u16,
+    counter: u16,
+    head: &ResultHead,
+    step: &Step<'_, N, B>,
+    quality: &[u8],
+) -> Result<usize, EncodeError> {
+    let mut w = Writer { buf: out, at: 0 };
+    w.header(PacketType::Result, data_id, counter)?;
+    w.u32(head.frame_id)?;
+    w.u32(head.kept_id)?;
+    w.bytes(&head.timestamp_us.to_le_bytes())?;
+    let s: Option<&Structure<N, B>> = match step {
+        Step::First => None,
+        Step::Structure(s) => Some(s),
+    };
+    w.u8(u8::from(s.is_some()))?;
+    let nb = s.map_or(0, |s| s.boundaries().len());
+    w.u8(u8::try_from(nb).map_err(|_| EncodeError::TooLarge)?)?;
+    w.u16(0)?;
+    w.u32(head.instructions)?;
+    w.u32(s.map_or(0, |s| s.digest()))?;
+    let counts = s.map_or([0; Status::ALL.len()], |s| s.status_counts());
+    for c in counts {
+        w.u16(u16::try_from(c).unwrap_or(u16::MAX))?;
+    }
+    w.u16(0)?;
+    if let Some(s) = s {
+        for (k, b) in s.boundaries().iter().enumerate() {
+            let pts = b.points();
+            w.u16(u16::try_from(pts.len()).map_err(|_| EncodeError::TooLarge)?)?;
+            w.u8(quality.get(k).copied().unwrap_or(0))?;
+            w.u8(0)?;
+            for r in pts {
+                w.u8(r.status() as u8)?;
+                if let (Some([x, y, z]), Some(i)) = (s.point(r), r.interval()) {
+                    for v in [x, y, z, i.z_near, i.z_far] {
+                        w.f32(v)?;
+                    }
+                }
+            }
+        }
+    }
+    w.finish()
+}
+
+/// COBS-encode the packet `raw` into `out` (with the `cobs` crate) and
+/// append the frame delimiter: the bytes to send.
+pub fn cobs_frame(raw: &[u8], out: &mut [u8]) -> Result<usize, EncodeError> {
+    let n = cobs::try_encode(raw, out).map_err(|_| EncodeError::BufferTooSmall)?;
+    let d = out.get_mut(n).ok_or(EncodeError::BufferTooSmall)?;
+    *d = 0;
+    Ok(n + 1)
+}
+
+// Used by the decoder's length checks.
+const _: () = assert!(BOUNDARY_HEAD_LEN == 6 && CRC_LEN == 4);

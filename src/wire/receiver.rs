@@ -1,0 +1,295 @@
+//! The receiver: the decoder plus the pairing of frames with motions and
+//! the per-pair configuration.
+//!
+//! # Pairing
+//! A frame is paired with the kept frame (the last frame handed out) when
+//! the last motion packet since then goes from the kept frame's id to this
+//! frame's id. Otherwise (the motion was lost, or a frame was) the error
+//! is reported ([`WireError::MotionMismatch`], [`WireError::MissingMotion`])
+//! and the frame starts the pairing anew: its job resets the processor
+//! and keeps the frame ([`crate::Step::First`]). A motion packet is used
+//! once.
+//!
+//! # Per-pair configuration
+//! The job's [`Config`] is the receiver's base configuration with
+//! * `e₁` = the largest localisation-error radius of the kept frame's
+//!   boundaries and `e₂` = the largest of this frame's
+//!   ([`Config::with_localisation_error`]). The processor's error model is
+//!   frame-wide, so a boundary with a smaller radius than another gets the
+//!   larger one: its sticks are longer than they need be, never too short.
+//! * the motion packet's error bounds, when it has them
+//!   ([`Config::with_translation_error`], [`Config::with_rotation_error`]);
+//!   the base configuration's otherwise.
+
+use super::decode::{FrameInfo, MotionPacket, Packet};
+use super::encode::ResultHead;
+use super::{DataIds, Decoder, ErrorKind, WireError};
+use crate::{Config, Frame, Motion, ProcessError, Processor, Step};
+
+/// What the receiver counted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Counters {
+    /// Bytes fed.
+    pub bytes: u32,
+    /// Frame jobs handed out.
+    pub frames: u32,
+    /// Motion packets taken.
+    pub motions: u32,
+    /// Camera packets taken.
+    pub cameras: u32,
+    /// Errors reported, indexed like [`ErrorKind::ALL`].
+    pub errors: [u32; ErrorKind::ALL.len()],
+}
+
+impl Counters {
+    /// Errors of `kind`.
+    pub fn errors_of(&self, kind: ErrorKind) -> u32 {
+        self.errors
+            .get(usize::from(kind as u8).saturating_sub(1))
+            .copied()
+            .unwrap_or(0)
+    }
+    /// All errors.
+    pub fn total_errors(&self) -> u32 {
+        self.errors.iter().fold(0u32, |a, &e| a.saturating_add(e))
+    }
+    /// The counters as a summary packet carries them: bytes, frames,
+    /// motions, cameras, then the errors by kind.
+    pub fn values(&self) -> [u32; 4 + ErrorKind::ALL.len()] {
+        let mut v = [0u32; 4 + ErrorKind::ALL.len()];
+        let head = [self.bytes, self.frames, self.motions, self.cameras];
+        for (d, s) in v.iter_mut().zip(head.iter().chain(self.errors.iter())) {
+            *d = *s;
+        }
+        v
+    }
+}
+
+/// A frame ready for the processor: [`FrameJob::run`] it.
+#[derive(Debug)]
+pub struct FrameJob<'a, const N: usize, const B: usize> {
+    /// The validated frame (in the decoder).
+    pub frame: &'a Frame<N, B>,
+    /// Its packet's other fields.
+    pub info: &'a FrameInfo<B>,
+    /// The motion from the kept frame, or `None` when this frame starts the
+    /// pairing (the processor is reset).
+    pub motion: Option<Motion>,
+    /// The configuration for this pair.
+    pub config: Config,
+    /// The kept frame's id (this frame's own when it starts the pairing).
+    pub kept_id: u32,
+    /// The kept frame's boundary qualities (what the result reports).
+    pub kept_quality: [u8; B],
+}
+
+impl<const N: usize, const B: usize> FrameJob<'_, N, B> {
+    /// Run the per-frame call on `processor`: set the pair's configuration,
+    /// reset first when the pairing starts anew, then
+    /// [`Processor::process`].
+    pub fn run<'p>(
+        &self,
+        processor: &'p mut Processor<N, B>,
+    ) -> Result<Step<'p, N, B>, ProcessError> {
+        processor.set_config(self.config);
+        if self.motion.is_none() {
+            processor.reset();
+        }
+        processor.process(self.frame, self.motion.as_ref())
+    }
+
+    /// The result packet's head for this job.
+    pub fn result_head(&self, instructions: u32) -> ResultHead {
+        ResultHead {
+            frame_id: self.info.frame_id,
+            kept_id: self.kept_id,
+            timestamp_us: self.info.timestamp_us,
+            instructions,
+        }
+    }
+}
+
+/// What the receiver hands out, in order.
+#[derive(Debug)]
+pub enum Event<'a, const N: usize, const B: usize> {
+    /// A frame to process.
+    Frame(FrameJob<'a, N, B>),
+    /// A motion packet was taken.
+    Motion(MotionPacket),
+    /// A camera packet was taken.
+    Camera,
+    /// A typed error (see [`WireError`]).
+    Error(WireError),
+    /// The end of the stream.
+    End,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Kept<const B: usize> {
+    id: u32,
+    radius: f32,
+    quality: [u8; B],
+}
+
+/// The link's receiving end for frames of up to `B` boundaries of `N`
+/// points.
+pub struct Receiver<const N: usize, const B: usize> {
+    decoder: Decoder<N, B>,
+    base: Config,
+    motion: Option<MotionPacket>,
+    kept: Option<Kept<B>>,
+    counters: Counters,
+}
+
+impl<const N: usize, const B: usize> Receiver<N, B> {
+    /// A receiver for packets with the data ids `ids`, building each
+    /// pair's configuration from `base`.
+    pub const fn new(ids: DataIds, base: Config) -> Self {
+        Self {
+            decoder: Decoder::new(ids),
+            base,
+            motion: None,
+            kept: None,
+            counters: Counters {
+                bytes: 0,
+                frames: 0,
+                motions: 0,
+                cameras: 0,
+                errors: [0; ErrorKind::ALL.len()],
+            },
+        }
+    }
+
+    /// What has been counted so far.
+    pub fn counters(&self) -> &Counters {
+        &self.counters
+    }
+
+    /// Feed the next bytes from the link; `on` is called for every event,
+    /// in order (a frame job's borrow ends with the call). At most
+    /// `input.len()` decoder steps.
+    pub fn feed(&mut self, input: &[u8], mut on: impl FnMut(Event<'_, N, B>)) {
+        let Self {
+            decoder,
+            base,
+            motion,
+            kept,
+            counters,
+        } = self;
+        counters.bytes = counters
+            .bytes
+            .saturating_add(u32::try_from(input.len()).unwrap_or(u32::MAX));
+        let mut rest = input;
+        for _ in 0..input.len() {
+            if rest.is_empty() {
+                break;
+            }
+            let (used, out) = decoder.feed(rest);
+            rest = rest.get(used..).unwrap_or(&[]);
+            let Some(d) = out else { continue };
+            if d.missed > 0 {
+                report(
+                    counters,
+                    WireError::CounterJump { missed: d.missed },
+                    &mut on,
+                );
+            }
+            match d.packet {
+                Err(e) => report(counters, e, &mut on),
+                Ok(Packet::Camera(_)) => {
+                    counters.cameras = counters.cameras.saturating_add(1);
+                    on(Event::Camera);
+                }
+                Ok(Packet::Motion(m)) => {
+                    counters.motions = counters.motions.saturating_add(1);
+                    *motion = Some(m);
+                    on(Event::Motion(m));
+                }
+                Ok(Packet::End) => on(Event::End),
+                Ok(Packet::Frame(frame, info)) => {
+                    let count = frame.boundaries().len();
+                    let radius = info.max_radius(count);
+                    let mut job = FrameJob {
+                        frame,
+                        info,
+                        motion: None,
+                        config: *base,
+                        kept_id: info.frame_id,
+                        kept_quality: info.quality,
+                    };
+                    if let Some(k) = *kept {
+                        match motion.take() {
+                            Some(m) if m.from == k.id && m.to == info.frame_id => {
+                                match pair_config(base, k.radius, radius, &m) {
+                                    Ok(c) => {
+                                        job.motion = Some(m.motion);
+                                        job.config = c;
+                                        job.kept_id = k.id;
+                                        job.kept_quality = k.quality;
+                                    }
+                                    Err(e) => report(counters, e, &mut on),
+                                }
+                            }
+                            Some(m) => report(
+                                counters,
+                                WireError::MotionMismatch {
+                                    kept: k.id,
+                                    frame: info.frame_id,
+                                    from: m.from,
+                                    to: m.to,
+                                },
+                                &mut on,
+                            ),
+                            None => report(
+                                counters,
+                                WireError::MissingMotion {
+                                    kept: k.id,
+                                    frame: info.frame_id,
+                                },
+                                &mut on,
+                            ),
+                        }
+                    }
+                    *kept = Some(Kept {
+                        id: info.frame_id,
+                        radius,
+                        quality: info.quality,
+                    });
+                    counters.frames = counters.frames.saturating_add(1);
+                    on(Event::Frame(job));
+                }
+            }
+        }
+    }
+}
+
+/// Count `e` and hand it out.
+fn report<const N: usize, const B: usize>(
+    counters: &mut Counters,
+    e: WireError,
+    on: &mut impl FnMut(Event<'_, N, B>),
+) {
+    let i = usize::from(e.kind() as u8).saturating_sub(1);
+    if let Some(c) = counters.errors.get_mut(i) {
+        *c = c.saturating_add(1);
+    }
+    on(Event::Error(e));
+}
+
+/// The configuration for a pair: `base` with the two frames' radii and the
+/// motion's error bounds.
+fn pair_config(base: &Config, e1: f32, e2: f32, m: &MotionPacket) -> Result<Config, WireError> {
+    let mut c = base
+        .with_localisation_error(e1, e2)
+        .map_err(|_| WireError::Radius { boundary: 0 })?;
+    if let Some(t) = m.translation_error {
+        c = c
+            .with_translation_error(t)
+            .map_err(WireError::MotionBounds)?;
+    }
+    if let Some(r) = m.rotation_error {
+        c = c.with_rotation_error(r).map_err(WireError::MotionBounds)?;
+    }
+    Ok(c)
+}

@@ -1,0 +1,346 @@
+//! Unit tests of the wire format: round trips at every chunking, each
+//! typed error, resynchronisation, and the decoder against `cobs`.
+
+#![allow(clippy::panic, clippy::large_enum_variant)]
+
+extern crate std;
+use std::vec;
+use std::vec::Vec;
+
+use super::encode::{self, BoundaryHead, FrameHead, MotionFields};
+use super::*;
+use crate::test_rng::Rng;
+use crate::{BoundaryError, Camera, Frame, Pixel};
+
+const IDS: DataIds = DataIds::DEFAULT;
+
+fn cam() -> Camera {
+    Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).unwrap()
+}
+
+fn link(raw: &[u8]) -> Vec<u8> {
+    let mut out = vec![0u8; cobs_max(raw.len())];
+    let n = encode::cobs_frame(raw, &mut out).unwrap();
+    out.truncate(n);
+    out
+}
+
+fn camera_packet(counter: u16) -> Vec<u8> {
+    let mut raw = [0u8; 64];
+    let n = encode::camera(&mut raw, IDS.camera, counter, &cam()).unwrap();
+    link(&raw[..n])
+}
+
+fn line(n: usize, u0: f32) -> Vec<Pixel> {
+    (0..n)
+        .map(|i| Pixel::new(u0 + 0.0625 * i as f32, 470.0 - i as f32))
+        .collect()
+}
+
+fn frame_raw(counter: u16, id: u32, bs: &[(f32, Vec<Pixel>)]) -> Vec<u8> {
+    let mut raw = vec![0u8; frame_packet_max(64, 4)];
+    let head = FrameHead {
+        timestamp_us: 1_000_000 + u64::from(id),
+        frame_id: id,
+        width: 512,
+        height: 480,
+    };
+    let list: Vec<(BoundaryHead, &[Pixel])> = bs
+        .iter()
+        .enumerate()
+        .map(|(k, (r, p))| {
+            (
+                BoundaryHead {
+                    quality: k as u8 + 7,
+                    radius_px: *r,
+                },
+                p.as_slice(),
+            )
+        })
+        .collect();
+    let n = encode::frame(&mut raw, IDS.frame, counter, &head, &list).unwrap();
+    raw.truncate(n);
+    raw
+}
+
+fn frame_packet(counter: u16, id: u32, bs: &[(f32, Vec<Pixel>)]) -> Vec<u8> {
+    link(&frame_raw(counter, id, bs))
+}
+
+fn motion_packet(counter: u16, from: u32, to: u32) -> Vec<u8> {
+    let mut raw = [0u8; 80];
+    let m = MotionFields {
+        from,
+        to,
+        translation: [0.0, 0.0, 0.4],
+        rotation: [0.0, 0.01, 0.0],
+        translation_error: Some(0.01),
+        rotation_error: None,
+    };
+    let n = encode::motion(&mut raw, IDS.motion, counter, &m).unwrap();
+    link(&raw[..n])
+}
+
+/// What a decoder made of a stream: per packet, `Ok(kind)` or the error.
+#[derive(Debug, PartialEq)]
+enum Out {
+    Frame(Frame<64, 2>, FrameInfo<2>, u16),
+    Motion(MotionPacket, u16),
+    Camera(u16),
+    End,
+    Err(WireError),
+}
+
+fn run(d: &mut Decoder<64, 2>, stream: &[u8], chunk: usize) -> Vec<Out> {
+    let mut out = Vec::new();
+    for piece in stream.chunks(chunk.max(1)) {
+        let mut rest = piece;
+        while !rest.is_empty() {
+            let (used, got) = d.feed(rest);
+            assert!(used > 0 && used <= rest.len());
+            rest = &rest[used..];
+            if let Some(g) = got {
+                out.push(match g.packet {
+                    Ok(Packet::Frame(f, i)) => Out::Frame(f.clone(), *i, g.missed),
+                    Ok(Packet::Motion(m)) => Out::Motion(m, g.missed),
+                    Ok(Packet::Camera(_)) => Out::Camera(g.missed),
+                    Ok(Packet::End) => Out::End,
+                    Err(e) => Out::Err(e),
+                });
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn residue_checks_any_intact_packet() {
+    let mut rng = Rng(7);
+    for len in 0..200 {
+        let mut m: Vec<u8> = (0..len).map(|_| (rng.next() * 256.0) as u8).collect();
+        let c = CRC.checksum(&m);
+        m.extend_from_slice(&c.to_le_bytes());
+        let mut d = CRC.digest();
+        d.update(&m);
+        assert_eq!(d.finalize(), RESIDUE, "len {len}");
+    }
+}
+
+#[test]
+fn fixed_point_conversions_are_exact() {
+    for raw in [257u16, 258, 272, 273, 8000, 65535] {
+        assert_eq!(px_to_raw(raw_to_px(raw)), Some(raw));
+    }
+    assert_eq!(raw_to_px(RAW_MINUS_ONE_PX), -1.0);
+    assert_eq!(raw_to_px(65535), 4078.875);
+    assert_eq!(px_to_raw(-1.04), None);
+    assert_eq!(px_to_raw(f32::NAN), None);
+    assert_eq!(px_to_raw(4079.0), None);
+    // Integer and half-pixel coordinates have no zero byte.
+    for k in 0..8000 {
+        let raw = px_to_raw(-1.0 + 0.5 * k as f32).unwrap();
+        assert!(raw.to_le_bytes().iter().all(|&b| b != 0), "{k}");
+    }
+    assert_eq!(radius_to_raw(0.5), Some(128));
+    assert!(raw_to_radius(radius_to_raw(0.3).unwrap()) >= 0.3);
+    assert_eq!(radius_to_raw(100.5), None);
+}
+
+#[test]
+fn round_trip_at_every_chunking() {
+    let b0 = line(40, 100.0);
+    let b1 = line(64, 400.0);
+    let mut stream = vec![0u8];
+    stream.extend(camera_packet(0));
+    stream.extend(motion_packet(0, 4, 5));
+    stream.extend(frame_packet(0, 5, &[(0.5, b0.clone()), (1.25, b1.clone())]));
+    let mut raw = [0u8; 20];
+    let n = encode::end(&mut raw, IDS.end, 0).unwrap();
+    stream.extend(link(&raw[..n]));
+    let mut expect = Frame::<64, 2>::new(cam());
+    expect.push_boundary(&b0).unwrap();
+    expect.push_boundary(&b1).unwrap();
+    for chunk in [1, 2, 3, 4, 5, 7, 13, 64, 255, 256, 10_000] {
+        let mut d = Decoder::<64, 2>::new(IDS);
+        let out = run(&mut d, &stream, chunk);
+        assert_eq!(out.len(), 4, "chunk {chunk}: {out:?}");
+        assert_eq!(out[0], Out::Camera(0));
+        let Out::Motion(m, 0) = &out[1] else {
+            panic!("{:?}", out[1])
+        };
+        assert_eq!(
+            (m.from, m.to, m.translation_error, m.rotation_error),
+            (4, 5, Some(0.01), None)
+        );
+        let Out::Frame(f, info, 0) = &out[2] else {
+            panic!("{:?}", out[2])
+        };
+        assert_eq!(f, &expect, "chunk {chunk}");
+        assert_eq!(info.frame_id, 5);
+        assert_eq!(info.timestamp_us, 1_000_005);
+        assert_eq!(info.quality, [7, 8]);
+        assert_eq!(info.radius_px, [0.5, 1.25]);
+        assert_eq!(out[3], Out::End);
+    }
+}
+
+#[test]
+fn typed_errors_and_resync() {
+    let good = frame_packet(1, 1, &[(0.5, line(10, 50.0))]);
+    let mut d = Decoder::<64, 2>::new(IDS);
+    // A frame before any camera.
+    let out = run(&mut d, &frame_packet(0, 0, &[(0.5, line(10, 50.0))]), 9);
+    assert_eq!(out, [Out::Err(WireError::NoCamera)]);
+    run(&mut d, &camera_packet(0), 9);
+
+    // Garbage without a delimiter, then a packet: one error, then the packet.
+    let mut s: Vec<u8> = (1..=40u8).collect();
+    s.push(0);
+    s.extend(&good);
+    let out = run(&mut d, &s, 5);
+    assert_eq!(out.len(), 2, "{out:?}");
+    assert!(matches!(out[0], Out::Err(_)));
+    // (The NoCamera packet was intact: its counter 0 counted.)
+    assert!(matches!(out[1], Out::Frame(_, _, 0)), "{:?}", out[1]);
+
+    // Repeated counter: dropped.
+    assert_eq!(
+        run(&mut d, &good, 3),
+        [Out::Err(WireError::Repeated { counter: 1 })]
+    );
+
+    // A flipped bit: bad CRC (or a cut when it makes a zero), and the
+    // counter is not advanced by it.
+    let mut bad = frame_packet(2, 2, &[(0.5, line(10, 50.0))]);
+    bad[30] ^= 0x10;
+    let out = run(&mut d, &bad, 4);
+    assert!(
+        matches!(out.as_slice(), [Out::Err(WireError::BadCrc)]),
+        "{out:?}"
+    );
+    let out = run(&mut d, &frame_packet(2, 2, &[(0.5, line(10, 50.0))]), 4);
+    assert!(matches!(out.as_slice(), [Out::Frame(_, _, 0)]), "{out:?}");
+
+    // A packet cut short: the next packet's delimiter ends it early.
+    let p = frame_packet(3, 3, &[(0.5, line(10, 50.0))]);
+    let mut s = p[..p.len() / 2].to_vec();
+    s.push(0);
+    let out = run(&mut d, &s, 4);
+    assert!(
+        matches!(out.as_slice(), [Out::Err(WireError::Truncated { .. })]),
+        "{out:?}"
+    );
+
+    // Counter jump: taken, with the count.
+    let out = run(&mut d, &frame_packet(6, 6, &[(0.5, line(10, 50.0))]), 4);
+    assert!(matches!(out.as_slice(), [Out::Frame(_, _, 3)]), "{out:?}");
+
+    // Invalid content, intact packets.
+    let unordered = vec![
+        Pixel::new(1.0, 1.0),
+        Pixel::new(2.0, 5.0),
+        Pixel::new(3.0, 2.0),
+    ];
+    let out = run(&mut d, &frame_packet(7, 7, &[(0.5, unordered)]), 4);
+    assert_eq!(
+        out,
+        [Out::Err(WireError::Boundary {
+            boundary: 0,
+            error: BoundaryError::Unordered { index: 2 }
+        })]
+    );
+    let outside = vec![Pixel::new(1.0, 1.0), Pixel::new(600.0, 5.0)];
+    let out = run(&mut d, &frame_packet(8, 8, &[(0.5, outside)]), 4);
+    assert_eq!(
+        out,
+        [Out::Err(WireError::Boundary {
+            boundary: 0,
+            error: BoundaryError::OutsideImage { index: 1 }
+        })]
+    );
+    let three = [
+        (0.5, line(3, 9.0)),
+        (0.5, line(3, 19.0)),
+        (0.5, line(3, 29.0)),
+    ];
+    let out = run(&mut d, &frame_packet(9, 9, &three), 4);
+    assert_eq!(
+        out,
+        [Out::Err(WireError::TooManyBoundaries {
+            count: 3,
+            capacity: 2
+        })]
+    );
+    let out = run(&mut d, &frame_packet(10, 10, &[(0.5, line(65, 9.0))]), 4);
+    assert_eq!(
+        out,
+        [Out::Err(WireError::TooManyPoints {
+            boundary: 0,
+            len: 65,
+            capacity: 64
+        })]
+    );
+
+    // Version, magic, type and data id.
+    let mut raw = frame_raw(11, 11, &[(0.5, line(4, 9.0))]);
+    raw[2] = 9;
+    let n = raw.len() - 4;
+    let c = CRC.checksum(&raw[..n]);
+    raw[n..].copy_from_slice(&c.to_le_bytes());
+    assert_eq!(
+        run(&mut d, &link(&raw), 4),
+        [Out::Err(WireError::UnknownVersion { version: 9 })]
+    );
+    raw[2] = VERSION;
+    raw[4] = 0x55;
+    let c = CRC.checksum(&raw[..n]);
+    raw[n..].copy_from_slice(&c.to_le_bytes());
+    assert_eq!(
+        run(&mut d, &link(&raw), 4),
+        [Out::Err(WireError::WrongDataId {
+            expected: IDS.frame,
+            got: 0x0F55
+        })]
+    );
+    // And still in step.
+    let out = run(&mut d, &frame_packet(11, 11, &[(0.5, line(10, 50.0))]), 4);
+    assert!(matches!(out.as_slice(), [Out::Frame(_, _, 0)]), "{out:?}");
+}
+
+/// The run-at-a-time COBS path agrees with the `cobs` crate's decoder on
+/// random streams (with zeros and long runs).
+#[test]
+fn cobs_paths_agree_with_the_crate() {
+    let mut rng = Rng(99);
+    for case in 0..300 {
+        let len = (rng.next() * 1200.0) as usize;
+        let zero_rate = rng.next() * 0.3;
+        let body: Vec<u8> = (0..len)
+            .map(|_| {
+                if rng.next() < zero_rate {
+                    0
+                } else {
+                    1 + (rng.next() * 255.0) as u8
+                }
+            })
+            .collect();
+        let enc = link(&body);
+        let mut reference = vec![0u8; len + 8];
+        let n = cobs::decode(&enc[..enc.len() - 1], &mut reference)
+            .unwrap()
+            .frame_size();
+        assert_eq!(&reference[..n], &body[..], "case {case}");
+        // The decoder sees the same bytes: its CRC says so (the body is no
+        // packet, so the verdict must be a length or CRC error, never a
+        // COBS cut).
+        let mut d = Decoder::<64, 2>::new(IDS);
+        let out = run(&mut d, &enc, 1 + case % 17);
+        if len >= 14 {
+            assert_eq!(out.len(), 1, "case {case}");
+            assert!(
+                !matches!(out[0], Out::Err(WireError::Truncated { .. })),
+                "case {case}: {out:?}"
+            );
+        }
+    }
+}

@@ -632,7 +632,11 @@ fn verdict(misses: &[String], b: &Budget) -> Result<(), String> {
     }
     let hard: Vec<&String> = misses.iter().filter(|m| !m.starts_with(OPEN)).collect();
     if !hard.is_empty() {
-        return Err(hard.iter().map(|m| m.as_str()).collect::<Vec<_>>().join("; "));
+        return Err(hard
+            .iter()
+            .map(|m| m.as_str())
+            .collect::<Vec<_>>()
+            .join("; "));
     }
     if !misses.is_empty() {
         println!(

@@ -16,7 +16,9 @@
 //! [`calibration`] (intrinsics from foci of expansion, Appendix II B), and
 //! [`analysis`] (the disparity analysis of Sec. 3, the tilt transform of
 //! Appendix I), [`motion_error`] (Sec. 4.2 and 5) and [`geometry`] (camera
-//! height, tilt and road width from the reconstruction, Sec. 4.2.1).
+//! height, tilt and road width from the reconstruction, Sec. 4.2.1), and
+//! [`fusion`] (the error ranges of many frames fused on a key frame's rays,
+//! Sec. 5) with its [`map`] (the fused road in the current vehicle frame).
 //!
 //! [`wire`] is the camera front-end link's format and streaming decoder,
 //! [`link`] its embedded-hal / embedded-io drivers.
@@ -47,8 +49,10 @@ pub mod camera;
 mod config;
 pub mod depth;
 pub mod epipolar;
+pub mod fusion;
 pub mod geometry;
 pub mod link;
+pub mod map;
 mod matching;
 mod math;
 pub mod motion;

@@ -24,7 +24,7 @@
 
 use core::fmt;
 
-use crate::math::{mat3_mul, sin_cos, MAX_TRANSLATION};
+use crate::math::{asin, atan2, mat3_mul, mat3_vec, sin_cos, MAX_TRANSLATION};
 
 /// Largest accepted rotation about any one axis between two frames, radians (60°).
 pub const MAX_ROTATION_RAD: f32 = core::f32::consts::FRAC_PI_3;
@@ -112,6 +112,77 @@ impl Motion {
         })
     }
 
+    /// The motion from frame 1 to frame 3 when `self` goes from frame 1 to
+    /// frame 2 and `next` from frame 2 to frame 3: the translation
+    /// `T = T₁ + R₁ T₂` (frame-1 coordinates) and the rotation `R = R₁ R₂`,
+    /// composed as matrices (no round trip through the angles, which
+    /// [`Motion::angles`] gives recovered from `R`). The same checks as
+    /// [`Motion::new`]: a composition that comes back to its start is
+    /// [`MotionError::ZeroTranslation`], one that turns more than
+    /// [`MAX_ROTATION_RAD`] about an axis [`MotionError::RotationTooLarge`].
+    ///
+    /// Each composition rounds like one matrix product in `f32`, about
+    /// `1e-7` of the rotation's entries: composing `n` motions moves the
+    /// rotation-compensated points by about `n · 1e-7 · f` pixels (`8e-4`
+    /// px for 10 motions at `f = 800`), well inside the localisation error.
+    ///
+    /// ```
+    /// use roadstereo::Motion;
+    /// let step = Motion::new([0.0, 0.0, 0.4], [0.0, 0.05, 0.0])?;
+    /// let two = step.then(&step)?;
+    /// // Two turns of 0.05 rad are one of 0.1 rad.
+    /// assert!((two.angles()[1] - 0.1).abs() < 1e-6);
+    /// // The second step goes forward along the turned axis.
+    /// let [u, _, w] = two.translation();
+    /// assert!((u - 0.4 * 0.05f32.sin()).abs() < 1e-6 && (w - 0.4 - 0.4 * 0.05f32.cos()).abs() < 1e-6);
+    /// # Ok::<(), roadstereo::MotionError>(())
+    /// ```
+    pub fn then(&self, next: &Motion) -> Result<Motion, MotionError> {
+        let r = self.rotation;
+        let t = mat3_vec(&r, next.translation);
+        let translation = [
+            self.translation[0] + t[0],
+            self.translation[1] + t[1],
+            self.translation[2] + t[2],
+        ];
+        Self::from_matrix(translation, mat3_mul(&r, &next.rotation))
+    }
+
+    /// A motion from its translation and rotation matrix, checked as
+    /// [`Motion::new`] checks its arguments; the angles are recovered from
+    /// the matrix (`R = R_y(β) R_x(α) R_z(γ)`: `α = asin(−R₁₂)`,
+    /// `β = atan2(R₀₂, R₂₂)`, `γ = atan2(R₁₀, R₁₁)`). The caller makes
+    /// `rotation` a rotation (a product of rotations).
+    pub(crate) fn from_matrix(
+        translation: [f32; 3],
+        rotation: [[f32; 3]; 3],
+    ) -> Result<Self, MotionError> {
+        if translation
+            .iter()
+            .chain(rotation.iter().flatten())
+            .any(|x| !x.is_finite())
+        {
+            return Err(MotionError::NotFinite);
+        }
+        if translation.iter().any(|x| x.abs() > MAX_TRANSLATION) {
+            return Err(MotionError::TranslationTooLarge);
+        }
+        let [u, v, w] = translation;
+        if u * u + v * v + w * w < MIN_TRANSLATION * MIN_TRANSLATION {
+            return Err(MotionError::ZeroTranslation);
+        }
+        let [[_, _, r02], [r10, r11, r12], [_, _, r22]] = rotation;
+        let angles = [asin(-r12), atan2(r02, r22), atan2(r10, r11)];
+        if angles.iter().any(|x| x.abs() > MAX_ROTATION_RAD) {
+            return Err(MotionError::RotationTooLarge);
+        }
+        Ok(Self {
+            translation,
+            angles,
+            rotation,
+        })
+    }
+
     /// Translation `(U, V, W)` in frame-1 camera coordinates.
     pub fn translation(&self) -> [f32; 3] {
         self.translation
@@ -144,6 +215,40 @@ mod tests {
     fn pitch_up_turns_forward_axis_towards_minus_y() {
         let m = Motion::new([0.0, 0.0, 1.0], [0.1, 0.0, 0.0]).unwrap();
         assert!(m.rotation_matrix()[1][2] < -0.09);
+    }
+
+    #[test]
+    fn composition_matches_the_product_of_the_motions() {
+        // A point's frame-3 coordinates through two motions, step by step
+        // and through the composition: P₂ = R₁ᵀ (P₁ − T₁), P₃ = R₂ᵀ (P₂ − T₂).
+        let a = Motion::new([0.1, -0.05, 0.4], [0.02, 0.08, -0.01]).unwrap();
+        let b = Motion::new([-0.03, 0.02, 0.35], [-0.01, -0.04, 0.03]).unwrap();
+        let ab = a.then(&b).unwrap();
+        let to_next = |m: &Motion, p: [f32; 3]| {
+            let t = m.translation();
+            let d = [p[0] - t[0], p[1] - t[1], p[2] - t[2]];
+            mat3_vec(&crate::math::mat3_transpose(&m.rotation_matrix()), d)
+        };
+        for p in [[1.0, 2.0, 5.0], [-3.0, 0.5, 12.0], [0.0, 0.0, 1.0]] {
+            let step = to_next(&b, to_next(&a, p));
+            let once = to_next(&ab, p);
+            for (x, y) in step.iter().zip(once) {
+                assert!((x - y).abs() < 2e-6, "{step:?} {once:?}");
+            }
+        }
+        // The recovered angles give back the matrix.
+        let again = Motion::new(ab.translation(), ab.angles()).unwrap();
+        for (r, q) in again.rotation_matrix().iter().zip(ab.rotation_matrix()) {
+            for (x, y) in r.iter().zip(q) {
+                assert!((x - y).abs() < 2e-6);
+            }
+        }
+        // Out and back is no baseline; too many turns are too large.
+        let back = Motion::new([0.0, 0.0, -0.4], [0.0; 3]).unwrap();
+        let fwd = Motion::new([0.0, 0.0, 0.4], [0.0; 3]).unwrap();
+        assert_eq!(fwd.then(&back), Err(MotionError::ZeroTranslation));
+        let turn = Motion::new([0.0, 0.0, 0.4], [0.0, 0.6, 0.0]).unwrap();
+        assert_eq!(turn.then(&turn), Err(MotionError::RotationTooLarge));
     }
 
     #[test]

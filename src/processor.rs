@@ -103,7 +103,8 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     }
 
     /// Use `config` from the next call on (e.g. the error bounds that came
-    /// with a frame pair over the link, [`crate::wire`]). The kept frame
+    /// with a frame pair over the link, [`crate::wire`], or those of the
+    /// motion [`crate::fusion`] composes from its key frame). The kept frame
     /// and the last output are untouched; a [`Config`] is valid by
     /// construction.
     ///

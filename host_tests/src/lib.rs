@@ -5,6 +5,7 @@
 pub mod calib;
 pub mod certify;
 pub mod drive;
+pub mod drives;
 pub mod fuzz;
 pub mod jsonl;
 pub mod link;

@@ -15,3 +15,24 @@ fn processor_for_two_boundaries_of_256_points_fits_24_kib() {
     // Everything the processor keeps (state + output + scratch) is inside it.
     assert!(processor <= 28 * 1024, "{processor} B");
 }
+
+/// The key-frame fusion's state and the road map beside the processor fit
+/// 24 KiB (issue 13): 2 × 256 key-frame points (16 B each) and a map of
+/// 2 × 512 points (12 B each) with its batches. (The library asserts it at
+/// compile time for 32-bit targets, and the bench prints the Cortex-M4F
+/// figures.)
+#[test]
+fn fusion_state_and_map_fit_24_kib() {
+    use roadstereo::fusion::{Fusion, KeyFrame};
+    use roadstereo::map::RoadMap;
+    let fusion = core::mem::size_of::<Fusion<256, 2, 512>>();
+    let processor = core::mem::size_of::<Processor<256, 2>>();
+    let key = core::mem::size_of::<KeyFrame<256, 2>>();
+    let map = core::mem::size_of::<RoadMap<2, 512>>();
+    println!(
+        "Fusion<256, 2, 512>: {fusion} B = processor {processor} B + {} B (key frame {key} B, map {map} B) on this 64-bit host",
+        fusion - processor
+    );
+    assert!(fusion - processor <= 24 * 1024, "{} B", fusion - processor);
+    assert!(key <= 16 * 2 * 256 + 64 && map <= 12 * 2 * 512 + 1024);
+}

@@ -9,6 +9,11 @@
 //! (issue 11: `host_tests/src/drive/adversarial.rs`, the table
 //! `data/adversarial.rs` it generates) at every N, measured like the
 //! representative rows, with the count of every status by name.
+//! Then the key-frame fusion over the demo drive (24 frames, two boundaries
+//! of up to 256 points): per frame the instructions of the whole fusion
+//! step and of the processor call inside it (the same call replayed on a
+//! copy of the processor), whose difference is the fusion and the road
+//! map's own cost.
 //! `cargo xtask bench` runs it, prints the tables and checks the budgets.
 
 #![no_std]
@@ -20,7 +25,8 @@ use core::hint::black_box;
 
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
-use roadstereo::{Config, Frame, Processor, Status, Structure};
+use roadstereo::fusion::{ChainedMotion, Fusion, FusionConfig};
+use roadstereo::{Config, Frame, Motion, Processor, Status, Structure};
 
 static BENCH: [(u32, &[u8]); 5] = [
     (32, include_bytes!("data/bench_32.bin")),
@@ -42,6 +48,93 @@ static STRESS: [(u32, &[u8]); 2] = [
 include!("data/adversarial.rs");
 
 const CAP: usize = 512;
+
+/// The demo drive (`cargo xtask demo`), for the fusion's cost.
+static DRIVE: &[u8] = include_bytes!("data/drive.bin");
+
+/// The fusion over the demo drive: per frame the whole step, the processor
+/// call inside it (replayed on a copy of the processor, with the motion
+/// composed the same way, and checked to give the same structure), and
+/// the difference: the fusion's and the map's own instructions.
+fn fusion_bench() -> bool {
+    let Ok(mut drive) = fw::Drive::new(DRIVE) else {
+        return false;
+    };
+    let Ok(policy) = FusionConfig::DEFAULT.with_tilt(23f32.to_radians()) else {
+        return false;
+    };
+    let mut fusion = Fusion::<256, 2, 512>::new(Config::default(), policy);
+    let mut frame = Frame::<256, 2>::new(drive.camera);
+    // The motion from the key frame to the previous frame.
+    let mut key_motion: Option<Motion> = None;
+    for i in 0..drive.frames {
+        let Ok(motion) = drive.next_frame(&mut frame) else {
+            return false;
+        };
+        let chained = motion.map(|m| ChainedMotion {
+            from: i.wrapping_sub(1),
+            motion: m,
+        });
+        let mut copy = fusion.processor().clone();
+        // The stack of one step, on a copy (a retiring frame and the next).
+        if i == 8 || i == 9 {
+            let mut twin = fusion.clone();
+            let bytes = stack::high_water(|| {
+                let _ = black_box(twin.step(black_box(i), &frame, chained.as_ref()));
+            });
+            defmt::info!("fusion_stack frame={=u32} bytes={=u32}", i, bytes);
+        }
+        let (result, step_instr) =
+            fw::measure(|| fusion.step(black_box(i), &frame, chained.as_ref()));
+        let Ok(step) = result else {
+            return false;
+        };
+        let composed = match (key_motion, motion) {
+            (Some(k), Some(m)) => k.then(&m).ok(),
+            (None, m) => m,
+            _ => None,
+        };
+        let matching = match (step.new_key.is_some(), step.paired.is_some(), composed) {
+            (true, false, _) => {
+                copy.reset();
+                fw::measure(|| copy.process(&frame, None).is_ok()).1
+            }
+            (true, true, Some(m)) => fw::measure(|| copy.process(&frame, Some(&m)).is_ok()).1,
+            (false, true, Some(m)) => {
+                fw::measure(|| copy.process_against_kept(&frame, &m).is_ok()).1
+            }
+            _ => 0,
+        };
+        key_motion = if step.new_key.is_some() {
+            None
+        } else {
+            composed
+        };
+        let points: usize = fusion
+            .structure()
+            .boundaries()
+            .iter()
+            .map(|b| b.points().len())
+            .sum();
+        let same =
+            step.paired.is_none() || copy.structure().digest() == fusion.structure().digest();
+        let own = step_instr.saturating_sub(matching);
+        defmt::info!(
+            "fusion frame={=u32} points={=u32} step_instr={=u32} matching_instr={=u32} fusion_instr={=u32} per_point={=u32} paired={=bool} retired={=bool} same_structure={=bool} map={=u32}",
+            i,
+            points as u32,
+            step_instr,
+            matching,
+            own,
+            own / (points as u32).max(1),
+            step.paired.is_some(),
+            step.retired.is_some(),
+            same,
+            (fusion.map().len(0) + fusion.map().len(1)) as u32
+        );
+    }
+    true
+}
 
 /// The count of every status present (and of `ok` always) as
 /// `status.<name>=<count>` fields, by [`Status::name`] over [`Status::ALL`],
@@ -242,6 +335,17 @@ fn main() -> ! {
         );
     }
     wire_cost();
+    if !fusion_bench() {
+        defmt::error!("fusion bench failed");
+        fw::exit(false)
+    }
+    defmt::info!(
+        "fusion_memory fusion_256_2_512={=u32} processor_256_2={=u32} key_frame_256_2={=u32} map_2_512={=u32}",
+        core::mem::size_of::<Fusion<256, 2, 512>>() as u32,
+        core::mem::size_of::<Processor<256, 2>>() as u32,
+        core::mem::size_of::<roadstereo::fusion::KeyFrame<256, 2>>() as u32,
+        core::mem::size_of::<roadstereo::map::RoadMap<2, 512>>() as u32
+    );
     let (p, f, s) = (
         core::mem::size_of::<Processor<256, 2>>() as u32,
         core::mem::size_of::<Frame<256, 2>>() as u32,

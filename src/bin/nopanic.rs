@@ -1,4 +1,5 @@
-//! Link-time proof that the per-frame code (and the calibration) has no
+//! Link-time proof that the per-frame code (the processor and the fusion
+//! with its road map, and the calibration) has no
 //! panic path: this binary calls every public per-frame entry point and the
 //! calibration functions with inputs the optimiser
 //! cannot see (`black_box`), and uses `panic-never`, whose panic handler
@@ -15,6 +16,8 @@ use panic_never as _;
 use roadstereo::calibration::{
     calibrate_jointly, calibrate_stepwise, focus_of_expansion, Flow, MotionFlows,
 };
+use roadstereo::fusion::{ChainedMotion, Fusion, FusionConfig};
+use roadstereo::geometry::Sample;
 use roadstereo::link::{write_packet, UartLink};
 use roadstereo::wire::{encode, result, DataIds, Event, Receiver, ResultView};
 use roadstereo::{Camera, Config, Frame, Motion, Pixel, Processor, Step};
@@ -55,6 +58,14 @@ fn main() -> ! {
         )
         .unwrap_or_default(),
     );
+    let mut fusion = Fusion::<N, 2, 512>::new(
+        *processor.config(),
+        FusionConfig::new(black_box(8), black_box(500))
+            .and_then(|c| c.with_tilt(black_box(0.4)))
+            .and_then(|c| c.with_map_min_pairs(black_box(2)))
+            .unwrap_or_default(),
+    );
+    let mut id = 0u32;
     let mut points = [Pixel::default(); N];
     loop {
         let Ok(camera) = Camera::new(
@@ -103,6 +114,48 @@ fn main() -> ! {
         }
         if black_box(false) {
             processor.reset();
+        }
+        // The fusion and its road map: every public entry point.
+        let chained = motion.map(|m| ChainedMotion {
+            from: black_box(id),
+            motion: m,
+        });
+        id = id.wrapping_add(black_box(1));
+        match fusion.step(black_box(id), black_box(&frame), chained.as_ref()) {
+            Ok(s) => {
+                black_box(s);
+            }
+            Err(e) => {
+                black_box(e);
+            }
+        }
+        black_box(
+            fusion
+                .constrain(black_box(0), black_box(3), black_box(1.0), black_box(2.0))
+                .ok(),
+        );
+        if let Some(k) = fusion.key() {
+            black_box((k.counts(), k.point(black_box(0), black_box(1)), k.len(0)));
+            for p in k.points(black_box(1)) {
+                black_box(p);
+            }
+        }
+        let map = fusion.map();
+        for p in map.points(black_box(0)) {
+            black_box(p);
+        }
+        let mut samples = heapless::Vec::<Sample, N>::new();
+        map.samples(black_box(0), black_box(1), &mut samples);
+        black_box((
+            samples.len(),
+            map.len(1),
+            map.drops(),
+            map.batch_key(0),
+            map.batches(),
+        ));
+        black_box((fusion.digest(), fusion.structure().digest()));
+        if black_box(false) {
+            fusion.reset();
         }
         // The link: bytes from outside through the receiver (decoder,
         // pairing, per-pair config), the per-frame call, the result and

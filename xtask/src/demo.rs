@@ -32,24 +32,37 @@ pub fn demo(check: bool) -> Result<(), String> {
 }
 
 /// One row per frame: points, matched, flagged, instructions, share of the
-/// frame budget.
+/// frame budget; and the fusion: key frame and partner, fused points, their
+/// median relative width, inconsistent points, the road map.
 fn frame_table(frames: &[Record]) {
     println!();
-    println!("| frame | points | ok | flagged | instructions | instr/point | frame budget used |");
-    println!("|---:|---:|---:|---:|---:|---:|---:|");
+    println!("| frame | points | ok | flagged | instructions | instr/point | frame budget used | key frame (partner) | fused | median fused width | inconsistent | map points ahead (dropped behind) |");
+    println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for f in frames {
         let points = num(f, "points");
         let ok = num(f, "ok");
         let instr = num(f, "instr");
         println!(
-            "| {} | {} | {} | {} | {} | {} | {:.1} % |",
+            "| {} | {} | {} | {} | {} | {} | {:.1} % | {} ({}){} | {} | {:.1} % | {} | {} ({}) |",
             num(f, "frame"),
             points,
             ok,
             points - ok,
             instr,
             instr / points.max(1),
-            num(f, "budget_permille") as f64 / 10.0
+            num(f, "budget_permille") as f64 / 10.0,
+            num(f, "key"),
+            num(f, "partner"),
+            if field(f, "retired") == Some("true") {
+                ", retires"
+            } else {
+                ""
+            },
+            num(f, "fused"),
+            num(f, "width_permille") as f64 / 10.0,
+            num(f, "inconsistent"),
+            num(f, "map"),
+            num(f, "map_behind")
         );
     }
 }

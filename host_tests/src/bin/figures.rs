@@ -3,6 +3,11 @@
 //! * `fig7_sticks.svg`: the paper's Fig. 7 from our code — top and side view
 //!   of the reconstructed boundary points of the Fig. 6 set-up (quantised
 //!   boundaries), each with its stick, and the true boundary;
+//! * `fig_fusion.svg`: the key-frame fusion over a drive of the Fig. 6
+//!   set-up — top and side view of the fused intervals every key frame
+//!   retired with, the first key frame's single-pair sticks, the road map
+//!   at the end and the true boundaries; and the median relative width
+//!   against the number of partner frames;
 //! * `example.jsonl` / `example_out.jsonl`: a two-frame replay example.
 
 use host_tests::{jsonl, point_stats, reconstruct, scenarios, synth};
@@ -533,10 +538,269 @@ fn fig10(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
+/// A vehicle-frame point of frame `pose` (camera tilted by `tilt`) in
+/// world coordinates.
+fn vehicle_to_world(pose: &synth::Pose, tilt: f64, v: [f32; 3]) -> V3 {
+    let v = v.map(f64::from);
+    let (s, c) = tilt.sin_cos();
+    let cam = [v[0], c * v[1] - s * v[2], s * v[1] + c * v[2]];
+    let r = pose.rot;
+    [0, 1, 2].map(|i| pose.centre[i] + r[i][0] * cam[0] + r[i][1] * cam[1] + r[i][2] * cam[2])
+}
+
+fn fig_fusion(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
+    use host_tests::drives::{self, fig6_drive, DriveFamily, Noise};
+    use roadstereo::fusion::{FusedStatus, FusionConfig};
+    let path = dir.join("fig_fusion.svg");
+    let d = fig6_drive(20);
+    let input = d.input(Noise::Rounded, None, 1);
+    let tilt = d.spec.tilt;
+    let cam = d.spec.intrinsics.camera();
+    let policy = FusionConfig::DEFAULT.with_tilt(tilt as f32)?;
+    // Stick (or fused interval) of key-frame point i as world segment.
+    let seg = |key: usize, b: usize, i: usize, near: f32, far: f32| -> (V3, V3) {
+        let (x, y) = cam.normalise(input.frames[key][b][i]);
+        let pose = &d.frames[key].pose;
+        (
+            world(pose, [x * near, y * near, near]),
+            world(pose, [x * far, y * far, far]),
+        )
+    };
+    let (mut single, mut fused, mut map) = (Vec::new(), Vec::new(), Vec::new());
+    let last = d.frames.len() - 1;
+    let run = drives::run(&d, &input, policy, |j, step, f| {
+        let Some(key) = f.key() else { return };
+        let kid = key.id() as usize;
+        // A key frame that just retired (or the last one at the end): its
+        // fused intervals.
+        {
+            if step.retired.is_some() || j == last {
+                for b in 0..2 {
+                    for (i, p) in key.points(b).enumerate() {
+                        if let (FusedStatus::Consistent, Some(iv)) = (p.status, p.interval) {
+                            fused.push(seg(kid, b, i, iv.z_near, iv.z_far));
+                        }
+                    }
+                }
+            }
+        }
+        if j == last {
+            for b in 0..2 {
+                for p in f.map().points(b) {
+                    map.push((
+                        vehicle_to_world(&d.frames[j].pose, tilt, p.near),
+                        vehicle_to_world(&d.frames[j].pose, tilt, p.far),
+                    ));
+                }
+            }
+        }
+    });
+    // The first key frame's first pair: the single-pair sticks.
+    if let Some(rec) = run.keys.first() {
+        for (b, pts) in rec.pairs[0].iter().enumerate() {
+            for (i, q) in pts.iter().enumerate() {
+                if q.status == Status::Ok {
+                    single.push(seg(rec.key, b, i, q.z_near as f32, q.z_far as f32));
+                }
+            }
+        }
+    }
+    // The median width against the partners: the first key frame of each
+    // family's drives, the points with an interval after the first partner.
+    let mut curves: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    let strict = FusionConfig::new(8, 0)?;
+    let mut families: Vec<(String, Vec<drives::Drive>)> =
+        vec![("Fig. 6 set-up".into(), vec![fig6_drive(14)])];
+    for f in DriveFamily::ALL {
+        let ds: Vec<drives::Drive> = (0..40)
+            .filter_map(|seed| drives::DriveSpec::new(f, seed, 14).render())
+            .take(10)
+            .collect();
+        families.push((f.name().into(), ds));
+    }
+    for (name, ds) in &families {
+        let mut widths: Vec<Vec<f64>> = vec![Vec::new(); 8];
+        for (seed, dd) in ds.iter().enumerate() {
+            let input = dd.input(Noise::Rounded, None, seed as u64);
+            let r = drives::run(dd, &input, strict, |_, _, _| {});
+            let Some(rec) = r.keys.first() else { continue };
+            for (b, pts) in rec.fused[0].iter().enumerate() {
+                for (i, p0) in pts.iter().enumerate() {
+                    if p0.interval.is_none() || p0.status.is_flagged() {
+                        continue;
+                    }
+                    let z = dd.z_true(rec.key, b, i);
+                    for (n, snap) in rec.fused.iter().enumerate().take(8) {
+                        if let Some(iv) = snap[b][i]
+                            .interval
+                            .filter(|_| !snap[b][i].status.is_flagged())
+                        {
+                            widths[n].push(f64::from(iv.z_far - iv.z_near) / z);
+                        }
+                    }
+                }
+            }
+        }
+        let pts = widths
+            .iter_mut()
+            .enumerate()
+            .filter(|(_, w)| !w.is_empty())
+            .map(|(n, w)| {
+                w.sort_by(f64::total_cmp);
+                ((n + 1) as f64, w[w.len() / 2])
+            })
+            .collect();
+        curves.push((name.clone(), pts));
+    }
+    let root = SVGBackend::new(&path, (1500, 560)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (left, rest) = root.split_horizontally(470);
+    let (middle, right) = rest.split_horizontally(560);
+    // Only what is inside both views (plotters draws a segment that
+    // leaves the chart along its edge).
+    let inside = |p: &V3| p[0] > -1.9 && p[0] < 5.9 && p[2] > -0.9 && p[2] < 13.9;
+    let truth: Vec<Vec<V3>> = d
+        .world
+        .iter()
+        .map(|c| {
+            c.iter()
+                .copied()
+                .skip_while(|p| !inside(p))
+                .take_while(inside)
+                .collect()
+        })
+        .collect();
+    let keep = |v: &[(V3, V3)]| -> Vec<(V3, V3)> {
+        v.iter()
+            .copied()
+            .filter(|(n, f)| inside(n) && inside(f))
+            .collect()
+    };
+    let (single, fused, map) = (keep(&single), keep(&fused), keep(&map));
+    let poses: Vec<V3> = d.frames.iter().map(|f| f.pose.centre).collect();
+    let pale = RGBColor(240, 150, 150);
+    let green = RGBColor(0, 150, 60);
+    let layers = [
+        (
+            &single,
+            pale.stroke_width(1),
+            "single pair (first key frame, 1st partner)",
+        ),
+        (
+            &fused,
+            BLACK.stroke_width(2),
+            "fused, as each key frame retired",
+        ),
+        (&map, green.stroke_width(2), "road map after the last frame"),
+    ];
+    let mut top = ChartBuilder::on(&left)
+        .caption(
+            "Top view: fused intervals over 20 frames",
+            ("sans-serif", 18),
+        )
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(45)
+        .build_cartesian_2d(-2.0f64..6.0, -1.0f64..14.0)?;
+    top.configure_mesh()
+        .x_desc("x (right), camera heights")
+        .y_desc("forward, camera heights")
+        .draw()?;
+    for (k, c) in truth.iter().enumerate() {
+        let s = top.draw_series(LineSeries::new(
+            c.iter().map(|p| (p[0], p[2])),
+            BLUE.mix(0.5),
+        ))?;
+        if k == 0 {
+            s.label("true boundaries")
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLUE.mix(0.5)));
+        }
+    }
+    for (segs, style, name) in layers {
+        top.draw_series(
+            segs.iter()
+                .map(move |(n, f)| PathElement::new(vec![(n[0], n[2]), (f[0], f[2])], style)),
+        )?
+        .label(name)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+    }
+    top.draw_series(poses.iter().map(|p| Circle::new((p[0], p[2]), 3, BLACK)))?;
+    top.configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()?;
+    let mut side = ChartBuilder::on(&middle)
+        .caption("Side view: height vs forward distance", ("sans-serif", 18))
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(45)
+        .build_cartesian_2d(-1.0f64..14.0, -0.6f64..1.4)?;
+    side.configure_mesh()
+        .x_desc("forward, camera heights")
+        .y_desc("height above the start ground")
+        .draw()?;
+    for c in &truth {
+        side.draw_series(LineSeries::new(
+            c.iter().map(|p| (p[2], -p[1])),
+            BLUE.mix(0.5),
+        ))?;
+    }
+    for (segs, style, _) in layers {
+        side.draw_series(
+            segs.iter()
+                .map(move |(n, f)| PathElement::new(vec![(n[2], -n[1]), (f[2], -f[1])], style)),
+        )?;
+    }
+    side.draw_series(poses.iter().map(|p| Circle::new((p[2], -p[1]), 3, BLACK)))?;
+    let mut widths = ChartBuilder::on(&right)
+        .caption(
+            "Median relative width vs partner frames",
+            ("sans-serif", 18),
+        )
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(55)
+        .build_cartesian_2d(0.5f64..8.5, (0.02f64..0.8).log_scale())?;
+    widths
+        .configure_mesh()
+        .y_label_formatter(&|v| format!("{v:.2}"))
+        .x_desc("partner frames fused")
+        .y_desc("median (z_far − z_near) / z")
+        .draw()?;
+    for (k, (name, pts)) in curves.iter().enumerate() {
+        let color = Palette99::pick(k).to_rgba();
+        let style = if k == 0 {
+            BLACK.stroke_width(3)
+        } else {
+            color.stroke_width(1)
+        };
+        widths
+            .draw_series(LineSeries::new(pts.iter().copied(), style))?
+            .label(name.as_str())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+    }
+    widths
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
+    println!(
+        "wrote {} ({} single-pair sticks, {} fused intervals of retiring key frames, {} map points at the end)",
+        path.display(),
+        single.len(),
+        fused.len(),
+        map.len()
+    );
+    Ok(())
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dir = std::path::PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| "../docs".into()));
     std::fs::create_dir_all(&dir)?;
     fig7(&dir)?;
+    fig_fusion(&dir)?;
     fig3(&dir)?;
     fig4(&dir)?;
     fig_a2(&dir)?;

@@ -1,0 +1,323 @@
+//! The motion from the key frame to the current frame, composed from the
+//! per-frame motions, with a bound of its error when the configuration
+//! bounds the error of each per-frame motion.
+//!
+//! # The error model
+//! As in [`crate::Config::with_translation_error`] and
+//! [`crate::Config::with_rotation_error`]: the true motion of a frame is
+//! `T + d`, `R Ω` with `|d_k| ≤ δ` on each component (the previous frame's
+//! axes) and `Ω` a rotation whose rotation vector `ω` has `|ω_k| ≤ ε_k`
+//! about the axes of the frame it arrives at; its angle is `|ω| ≤ |ε|`.
+//!
+//! # Composing the bound
+//! With the key frame's motion to frame `j − 1` (`T₁`, `R₁`, bounds `δ₁`,
+//! `ε₁`, angle `ω₁`) and the motion to frame `j` (`T₂`, `R₂`, `δ`, `ε`,
+//! angle `ω₂ = |ε|`):
+//!
+//! * `T = T₁ + R₁ T₂`. The truth is `T₁ + d₁ + R₁ Ω₁ (T₂ + d₂)`, off by
+//!   `d₁ + R₁ u` with `u = (Ω₁ − I)(T₂ + d₂) + d₂`. A rotation by at most
+//!   `ω₁` moves a vector `v` by at most `ω₁ |v|`, so every component of `u`
+//!   is at most `a = ω₁ (|T₂| + √3 δ) + δ`, and component `k` of `R₁ u` at
+//!   most `a Σ_l |R₁[k][l]|`: `δ_j = δ₁ + a · max_k Σ_l |R₁[k][l]|`.
+//! * `R = R₁ R₂`. The truth `R₁ Ω₁ R₂ Ω₂ = R (R₂ᵀ Ω₁ R₂) Ω₂` is off by the
+//!   product of the rotations with vectors `R₂ᵀ ω₁` and `ω₂`, both about
+//!   frame `j`'s axes. Their sum bounds the product's vector to first
+//!   order, component by component (`Σ_l |R₂[l][k]| ε₁_l + ε_k`); the
+//!   second order (the commutator, `½ |ω₁| |ω₂|` and smaller terms) is
+//!   covered by adding `ω₁ ω₂`. The angle of the product is at most
+//!   `ω₁ + ω₂` (the triangle inequality on rotations).
+//!
+//! Each bound is rounded up by `2⁻¹⁶` of itself against the `f32` rounding
+//! of its own arithmetic. The translation bound grows with the travel, the
+//! rotation bound with the number of frames: a key frame's last partner is
+//! the last one whose bounds [`crate::Config`] still accepts (rotation
+//! errors summing to at most 0.1 rad), see [`crate::fusion`].
+//!
+//! Without configured error bounds every bound stays exactly 0 and the
+//! composed motion is what the per-frame motions compose to in `f32` (see
+//! [`Motion::then`] for its rounding).
+
+use crate::config::{Config, ConfigError};
+use crate::math::{mat3_mul, mat3_transpose, mat3_vec, sqrt, Mat3};
+use crate::motion::{Motion, MotionError};
+
+/// `√3`, rounded up: the length of a vector whose components are at most 1.
+const SQRT3: f32 = 1.732_051;
+/// Rounding allowance of a bound's arithmetic.
+const ROUND_UP: f32 = 1.0 + 1.0 / 65_536.0;
+
+/// The per-frame error bounds of the configuration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct StepBounds {
+    /// Translation error per component, length units.
+    pub(crate) delta: f32,
+    /// Rotation error per axis, radians.
+    pub(crate) eps: [f32; 3],
+    /// The angle of the rotation error, `|ε|` rounded up.
+    pub(crate) omega: f32,
+}
+
+impl StepBounds {
+    pub(crate) fn of(config: &Config) -> Self {
+        let eps = config.rotation_error();
+        let [a, b, c] = eps;
+        Self {
+            delta: config.translation_error(),
+            eps,
+            omega: sqrt(a * a + b * b + c * c) * ROUND_UP,
+        }
+    }
+
+    /// Whether any bound is configured.
+    pub(crate) fn any(&self) -> bool {
+        self.delta > 0.0 || self.omega > 0.0
+    }
+}
+
+/// The key frame's motion to the current frame and its error bounds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct Chain {
+    /// Translation, key-frame camera coordinates.
+    pub(crate) t: [f32; 3],
+    /// Orientation of the current camera in key-frame coordinates.
+    pub(crate) r: Mat3,
+    /// Translation error bound per component (key-frame axes).
+    pub(crate) delta: f32,
+    /// Rotation error bound per axis (current frame's axes).
+    pub(crate) eps: [f32; 3],
+    /// Rotation error angle bound.
+    pub(crate) omega: f32,
+}
+
+fn norm(v: [f32; 3]) -> f32 {
+    sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * ROUND_UP
+}
+
+impl Chain {
+    /// The key frame itself: no motion, no error.
+    pub(crate) const IDENTITY: Chain = Chain {
+        t: [0.0; 3],
+        r: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        delta: 0.0,
+        eps: [0.0; 3],
+        omega: 0.0,
+    };
+
+    /// The chain continued by one frame's motion `m` with error bounds `b`
+    /// (module docs).
+    pub(crate) fn then(&self, m: &Motion, b: &StepBounds) -> Chain {
+        let t2 = m.translation();
+        let r2 = m.rotation_matrix();
+        let rt2 = mat3_vec(&self.r, t2);
+        let t = [self.t[0] + rt2[0], self.t[1] + rt2[1], self.t[2] + rt2[2]];
+        let r = mat3_mul(&self.r, &r2);
+        if !(b.any() || self.delta > 0.0 || self.omega > 0.0) {
+            return Chain { t, r, ..*self };
+        }
+        let a = self.omega * (norm(t2) + SQRT3 * b.delta) + b.delta;
+        let row = self
+            .r
+            .iter()
+            .map(|[x, y, z]| x.abs() + y.abs() + z.abs())
+            .fold(0.0f32, |m, s| if s > m { s } else { m });
+        let delta = (self.delta + a * row) * ROUND_UP;
+        let mut eps = [0.0f32; 3];
+        for (k, e) in eps.iter_mut().enumerate() {
+            let mut s = b.eps.get(k).copied().unwrap_or(0.0) + self.omega * b.omega;
+            for (l, row) in r2.iter().enumerate() {
+                let rlk = row.get(k).copied().unwrap_or(0.0);
+                s += rlk.abs() * self.eps.get(l).copied().unwrap_or(0.0);
+            }
+            *e = s * ROUND_UP;
+        }
+        Chain {
+            t,
+            r,
+            delta,
+            eps,
+            omega: (self.omega + b.omega) * ROUND_UP,
+        }
+    }
+
+    /// The composed motion, for the processor.
+    pub(crate) fn motion(&self) -> Result<Motion, MotionError> {
+        Motion::from_matrix(self.t, self.r)
+    }
+
+    /// `base` with the composed error bounds in place of the per-frame
+    /// ones (`base` itself when there are none).
+    pub(crate) fn config(&self, base: &Config) -> Result<Config, ConfigError> {
+        if !(self.delta > 0.0 || self.omega > 0.0) {
+            return Ok(*base);
+        }
+        base.with_translation_error(self.delta)?
+            .with_rotation_error(self.eps)
+    }
+
+    /// The current frame's pose of key-frame points, `P = A P_K + b`
+    /// (`A = Rᵀ`, `b = −Rᵀ T`), and the error bound of a carried point,
+    /// `ρ + φ |P_K|`: `ρ = √3 δ + ω |T|`, `φ = ω` (the true point is
+    /// `Ωᵀ Rᵀ (P_K − T − d)`, off by at most `ω |P_K − T| + |d|`).
+    pub(crate) fn pose(&self) -> (Mat3, [f32; 3], f32, f32) {
+        let a = mat3_transpose(&self.r);
+        let at = mat3_vec(&a, self.t);
+        let rho = if self.delta > 0.0 || self.omega > 0.0 {
+            (SQRT3 * self.delta + self.omega * norm(self.t)) * ROUND_UP
+        } else {
+            0.0
+        };
+        (a, [-at[0], -at[1], -at[2]], rho, self.omega)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_rng::Rng;
+
+    fn rot(axis: usize, a: f32) -> Mat3 {
+        let (s, c) = (libm::sinf(a), libm::cosf(a));
+        match axis {
+            0 => [[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]],
+            1 => [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]],
+            _ => [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]],
+        }
+    }
+
+    /// The rotation with vector `w` (Rodrigues), in `f32`.
+    #[allow(clippy::needless_range_loop)]
+    fn exp(w: [f32; 3]) -> Mat3 {
+        let th = libm::sqrtf(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+        if th == 0.0 {
+            return Chain::IDENTITY.r;
+        }
+        let k = [w[0] / th, w[1] / th, w[2] / th];
+        let (s, c) = (libm::sinf(th), libm::cosf(th));
+        let kx = [[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]];
+        let mut m = Chain::IDENTITY.r;
+        let kk = mat3_mul(&kx, &kx);
+        for i in 0..3 {
+            for j in 0..3 {
+                m[i][j] += s * kx[i][j] + (1.0 - c) * kk[i][j];
+            }
+        }
+        m
+    }
+
+    /// The rotation vector of a rotation matrix (log map, small angles).
+    fn log(m: &Mat3) -> [f32; 3] {
+        let tr = m[0][0] + m[1][1] + m[2][2];
+        let th = libm::acosf(((tr - 1.0) / 2.0).clamp(-1.0, 1.0));
+        let f = if th < 1e-6 {
+            0.5
+        } else {
+            th / (2.0 * libm::sinf(th))
+        };
+        [
+            f * (m[2][1] - m[1][2]),
+            f * (m[0][2] - m[2][0]),
+            f * (m[1][0] - m[0][1]),
+        ]
+    }
+
+    /// Random motions, each perturbed inside its error box: the composed
+    /// truth stays inside the composed bounds.
+    #[test]
+    #[allow(clippy::needless_range_loop)]
+    fn composed_bounds_hold_for_perturbed_chains() {
+        let mut g = Rng(0xC0FF_EE11);
+        let base = Config::DEFAULT
+            .with_translation_error(0.02)
+            .unwrap()
+            .with_rotation_error([0.002, 0.003, 0.001])
+            .unwrap();
+        let b = StepBounds::of(&base);
+        let mut worst = [0.0f32; 2];
+        for _ in 0..300 {
+            let mut chain = Chain::IDENTITY;
+            let (mut tt, mut rt) = ([0.0f32; 3], Chain::IDENTITY.r);
+            for _ in 0..8 {
+                let mut u = || 2.0 * g.next() - 1.0;
+                let m = Motion::new(
+                    [0.1 * u(), 0.1 * u(), 0.4 + 0.1 * u()],
+                    [0.02 * u(), 0.08 * u(), 0.02 * u()],
+                )
+                .unwrap();
+                chain = chain.then(&m, &b);
+                // The truth: the translation off by up to δ per component,
+                // the rotation by a vector inside the ε box (about the new axes).
+                let d = [b.delta * u(), b.delta * u(), b.delta * u()];
+                let w = [b.eps[0] * u(), b.eps[1] * u(), b.eps[2] * u()];
+                let t2 = m.translation();
+                let t2 = [t2[0] + d[0], t2[1] + d[1], t2[2] + d[2]];
+                let r2 = mat3_mul(&m.rotation_matrix(), &exp(w));
+                let add = mat3_vec(&rt, t2);
+                tt = [tt[0] + add[0], tt[1] + add[1], tt[2] + add[2]];
+                rt = mat3_mul(&rt, &r2);
+                for (x, y) in tt.iter().zip(chain.t) {
+                    let off = (x - y).abs();
+                    worst[0] = worst[0].max(off / chain.delta);
+                    assert!(off <= chain.delta, "translation {off} > {}", chain.delta);
+                }
+                let err = log(&mat3_mul(&mat3_transpose(&chain.r), &rt));
+                for k in 0..3 {
+                    // (f32 rounding of the test's own products: 2e-6.)
+                    worst[1] = worst[1].max(err[k].abs() / chain.eps[k]);
+                    assert!(
+                        err[k].abs() <= chain.eps[k] + 2e-6,
+                        "{err:?} {:?}",
+                        chain.eps
+                    );
+                }
+            }
+        }
+        // Not vacuous: the truth comes within a factor of the bounds.
+        assert!(worst[0] > 0.3 && worst[1] > 0.3, "{worst:?}");
+        let _ = rot(0, 0.0);
+    }
+
+    #[test]
+    fn no_bounds_stay_zero_and_the_config_is_the_base() {
+        let b = StepBounds::of(&Config::DEFAULT);
+        assert!(!b.any());
+        let m = Motion::new([0.0, 0.0, 0.4], [0.0, 0.05, 0.0]).unwrap();
+        let c = Chain::IDENTITY.then(&m, &b).then(&m, &b);
+        assert_eq!((c.delta, c.eps, c.omega), (0.0, [0.0; 3], 0.0));
+        assert_eq!(c.config(&Config::DEFAULT), Ok(Config::DEFAULT));
+        assert_eq!(c.pose().2, 0.0);
+        // The composed motion is the motions' composition.
+        let two = m.then(&m).unwrap();
+        assert_eq!(c.motion().unwrap().translation(), two.translation());
+        assert_eq!(c.motion().unwrap().rotation_matrix(), two.rotation_matrix());
+        let r = rot(1, 0.1);
+        for (x, y) in r.iter().flatten().zip(c.r.iter().flatten()) {
+            assert!((x - y).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn first_partner_has_the_per_frame_bounds_and_they_grow() {
+        let base = Config::DEFAULT
+            .with_translation_error(0.02)
+            .unwrap()
+            .with_rotation_error([0.004, 0.004, 0.004])
+            .unwrap();
+        let b = StepBounds::of(&base);
+        let m = Motion::new([0.0, 0.0, 0.4], [0.0, 0.02, 0.0]).unwrap();
+        let mut c = Chain::IDENTITY.then(&m, &b);
+        assert!((c.delta - 0.02).abs() < 1e-6 && (c.eps[0] - 0.004).abs() < 1e-6);
+        let cfg = c.config(&base).unwrap();
+        assert!(cfg.translation_error() >= 0.02);
+        let mut frames = 1;
+        // The rotation bounds sum past what a Config accepts (0.1 rad)
+        // after about 8 frames here: that ends a key frame.
+        while c.config(&base).is_ok() {
+            c = c.then(&m, &b);
+            frames += 1;
+            assert!(frames < 20);
+        }
+        assert!((7..=10).contains(&frames), "{frames}");
+    }
+}

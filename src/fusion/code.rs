@@ -1,0 +1,188 @@
+//! Depths in 16 bits, rounded outwards: the compact intervals of the fusion
+//! state (the rival interval of a point) and of the road map.
+//!
+//! A code is the top of an `f32`'s bits relative to a power of two `s` at
+//! or above the configuration's maximum depth: for `z/s` in `[2⁻¹⁵, 2)` the
+//! code is `(e − 112) · 2¹² + m`, with `e` the biased exponent of `z/s` and
+//! `m` the top 12 bits of its mantissa. Codes are ordered like the depths
+//! they stand for, so an interval's intersection is the larger of the near
+//! codes and the smaller of the far codes, and an interval is empty exactly
+//! when its near code exceeds its far code. A near end is rounded **down**
+//! (the mantissa cut: at most `2⁻¹²` of the value), a far end **up**, so
+//! the depths a coded interval stands for always include the interval
+//! coded: rounding never loses the truth. Near the ends of the range, code
+//! 0 is depth 0 (anything below `2⁻¹⁵ s`, where a far end becomes code 1)
+//! and `0xFFFF` is an unbounded far end (anything from `2 s` on, and NaN).
+//! Dividing by a power of two is exact, so the host and the vehicle
+//! controller compute the same codes.
+
+/// Smallest exponent (biased) of `z/s` with a code of its own: `2⁻¹⁵`.
+const EXP_BASE: u32 = 127 - 15;
+/// Exponents from `EXP_BASE` to `EXP_BASE + 15`: `z/s` below 2.
+const EXP_SPAN: u32 = 16;
+/// The unbounded far end.
+pub(crate) const UNBOUNDED: u16 = 0xFFFF;
+
+/// The power of two `s` the codes are relative to, and its inverse.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct DepthScale {
+    s: f32,
+    inv: f32,
+}
+
+impl DepthScale {
+    /// The smallest power of two at or above `max_depth` (between `2⁻¹²⁰`
+    /// and `2¹²⁰`; a NaN or non-positive value gives `2¹⁰`).
+    pub(crate) const fn for_max_depth(max_depth: f32) -> Self {
+        let mut e: i32 = 10;
+        if max_depth > 0.0 && max_depth.is_finite() {
+            let bits = max_depth.to_bits();
+            e = ((bits >> 23) & 0xFF) as i32 - 127;
+            if bits & 0x007F_FFFF != 0 {
+                e += 1;
+            }
+        }
+        if e < -120 {
+            e = -120;
+        }
+        if e > 120 {
+            e = 120;
+        }
+        Self {
+            s: f32::from_bits(((e + 127) as u32) << 23),
+            inv: f32::from_bits(((127 - e) as u32) << 23),
+        }
+    }
+
+    /// `s`.
+    #[cfg(test)]
+    pub(crate) fn scale(&self) -> f32 {
+        self.s
+    }
+
+    /// The code of a near end: the largest code not above `z`.
+    #[inline]
+    pub(crate) fn down(&self, z: f32) -> u16 {
+        // (A NaN fails the comparison.)
+        if !(z > 0.0) {
+            return 0;
+        }
+        let b = (z * self.inv).to_bits();
+        let e = b >> 23;
+        if e < EXP_BASE {
+            return 0;
+        }
+        if e >= EXP_BASE + EXP_SPAN {
+            return UNBOUNDED - 1;
+        }
+        // The top code is the unbounded far end: a near end just below 2 s
+        // takes the one below it.
+        let code = ((e - EXP_BASE) << 12) | ((b >> 11) & 0xFFF);
+        if code >= u32::from(UNBOUNDED) {
+            UNBOUNDED - 1
+        } else {
+            code as u16
+        }
+    }
+
+    /// The code of a far end: the smallest code not below `z`.
+    #[inline]
+    pub(crate) fn up(&self, z: f32) -> u16 {
+        if !(z > 0.0) {
+            return if z.is_nan() { UNBOUNDED } else { 0 };
+        }
+        let b = (z * self.inv).to_bits();
+        let e = b >> 23;
+        if e < EXP_BASE {
+            return 1;
+        }
+        if e >= EXP_BASE + EXP_SPAN {
+            return UNBOUNDED;
+        }
+        let code = (((e - EXP_BASE) << 12) | ((b >> 11) & 0xFFF)) + u32::from(b & 0x7FF != 0);
+        if code >= u32::from(UNBOUNDED) {
+            UNBOUNDED
+        } else {
+            code as u16
+        }
+    }
+
+    /// The depth a code stands for (0 for code 0, infinity for
+    /// [`UNBOUNDED`]).
+    #[inline]
+    pub(crate) fn depth(&self, code: u16) -> f32 {
+        if code == 0 {
+            return 0.0;
+        }
+        if code == UNBOUNDED {
+            return f32::INFINITY;
+        }
+        let c = u32::from(code);
+        f32::from_bits((((c >> 12) + EXP_BASE) << 23) | ((c & 0xFFF) << 11)) * self.s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_rng::Rng;
+
+    #[test]
+    fn scale_is_the_next_power_of_two() {
+        assert_eq!(DepthScale::for_max_depth(1000.0).scale(), 1024.0);
+        assert_eq!(DepthScale::for_max_depth(1024.0).scale(), 1024.0);
+        assert_eq!(DepthScale::for_max_depth(0.3).scale(), 0.5);
+        assert_eq!(DepthScale::for_max_depth(f32::NAN).scale(), 1024.0);
+        assert_eq!(DepthScale::for_max_depth(f32::MAX).scale(), 2f32.powi(120));
+    }
+
+    #[test]
+    fn codes_round_outwards_and_keep_the_order() {
+        let mut g = Rng(0x1234_5678);
+        for max_depth in [1000.0f32, 1.0, 3.0e5] {
+            let sc = DepthScale::for_max_depth(max_depth);
+            let mut prev = (0.0f32, 0u16, 0u16);
+            let mut zs: [f32; 4000] = [0.0; 4000];
+            for z in zs.iter_mut() {
+                // Log-uniform over 30 octaves around the scale.
+                *z = sc.scale() * 2f32.powf(g.next() * 30.0 - 25.0);
+            }
+            zs.sort_by(f32::total_cmp);
+            for z in zs {
+                let (lo, hi) = (sc.down(z), sc.up(z));
+                assert!(sc.depth(lo) <= z && z <= sc.depth(hi), "{z}: {lo} {hi}");
+                assert!(lo <= hi);
+                // Tight within the range: one code step, 2⁻¹² relative.
+                if z >= sc.scale() * 2f32.powi(-15) && z < sc.scale() {
+                    assert!(sc.depth(hi) - sc.depth(lo) <= z * 2f32.powi(-11), "{z}");
+                }
+                // Monotone.
+                assert!(z >= prev.0 && lo >= prev.1 && hi >= prev.2);
+                prev = (z, lo, hi);
+            }
+        }
+    }
+
+    #[test]
+    fn ends_of_the_range() {
+        let sc = DepthScale::for_max_depth(1000.0);
+        assert_eq!(sc.down(0.0), 0);
+        assert_eq!(sc.down(-1.0), 0);
+        assert_eq!(sc.down(f32::NAN), 0);
+        assert_eq!(sc.up(f32::NAN), UNBOUNDED);
+        assert_eq!(sc.up(-1.0), 0);
+        assert_eq!(sc.up(1e-9), 1);
+        assert!(sc.depth(1) >= 1e-9);
+        assert_eq!(sc.up(f32::INFINITY), UNBOUNDED);
+        assert_eq!(sc.up(2048.0), UNBOUNDED);
+        assert_eq!(sc.down(f32::INFINITY), UNBOUNDED - 1);
+        assert!(sc.depth(UNBOUNDED - 1) <= 2048.0);
+        assert_eq!(sc.depth(UNBOUNDED), f32::INFINITY);
+        // Just below 2 s the far end rounds up to unbounded, never wraps.
+        assert_eq!(sc.up(2047.9999), UNBOUNDED);
+        // Exact codes stay put.
+        assert_eq!(sc.down(1.0), sc.up(1.0));
+        assert_eq!(sc.depth(sc.down(1.0)), 1.0);
+    }
+}

@@ -1,0 +1,609 @@
+//! The fused intervals of one key frame's boundary points.
+//!
+//! Each later frame paired with the key frame gives every matched key-frame
+//! point a guaranteed stick on the **same key-frame ray**
+//! ([`crate::Processor::process_against_kept`]), so a point's sticks are
+//! intervals of one number, its depth `Z`, and the intersection of
+//! guaranteed intervals is guaranteed: the fused interval. No interpolation
+//! and no tracking of points: the association is exact. A pair that flags
+//! the point (grazing, at the FOE, ...) gives it nothing.
+//!
+//! # Consistency
+//! If the true point lies in every stick, the sticks share a point. An
+//! interval that misses the fused one therefore means a wrong pair (a wrong
+//! match, typically where the partner frame does not see the stretch of the
+//! boundary the point is on). The point is then
+//! [`FusedStatus::Inconsistent`] for good, and the interval kept is the one
+//! the most pairs agree on, by a two-candidate form of Marzullo's
+//! q-relaxed intersection:
+//!
+//! * the **majority** candidate is the intersection of the intervals that
+//!   agreed with it, stored exactly (`f32`), with their count;
+//! * the **rival** is the intersection of the intervals that missed the
+//!   majority but agree with each other, with their count (16-bit codes
+//!   rounded outwards, [`super::code`]);
+//! * an interval that misses both is counted as disagreeing with both;
+//! * when the rival's count exceeds the majority's the two swap.
+//!
+//! Every pair counts once, so `pairs = majority + rival + others`, and the
+//! kept interval is supported by `pairs − disagreeing` of them. Compared
+//! with Marzullo's algorithm over every interval (`O(m log m)` and `m`
+//! stored intervals), this keeps a point in 16 bytes and costs `O(1)` per
+//! pair; it finds the same majority whenever the intervals fall into at
+//! most two mutually consistent groups (the right matches, and the wrong
+//! ones from partners that see another stretch), and a flagged point's
+//! interval is advice, not a guarantee, either way. An interval that does
+//! not narrow the fused one is still checked against it: the pairs that add
+//! no information still vote.
+//!
+//! A point with one pair is [`FusedStatus::Single`]: a two-view stick that
+//! nothing has checked (a wrong two-view match cannot be told there); two
+//! or more agreeing pairs make it [`FusedStatus::Consistent`].
+
+use super::code::DepthScale;
+use crate::boundary::Frame;
+use crate::depth::DepthInterval;
+use crate::math::{fmax, fmin};
+use crate::structure::{Status, Structure};
+
+/// What the fusion knows about a key-frame point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FusedStatus {
+    /// No pair has given the point an interval yet.
+    Unmatched,
+    /// One pair has: its stick, guaranteed like any stick, but nothing has
+    /// checked the match.
+    Single,
+    /// Two or more pairs have, and all their intervals share the fused one.
+    Consistent,
+    /// Some interval missed the others: a pair matched wrongly. The
+    /// interval given is the one most pairs agree on (module docs), not a
+    /// guarantee.
+    Inconsistent,
+}
+
+impl FusedStatus {
+    /// Whether the point is flagged ([`FusedStatus::Inconsistent`]).
+    pub fn is_flagged(self) -> bool {
+        self == FusedStatus::Inconsistent
+    }
+
+    /// Short lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            FusedStatus::Unmatched => "unmatched",
+            FusedStatus::Single => "single",
+            FusedStatus::Consistent => "consistent",
+            FusedStatus::Inconsistent => "inconsistent",
+        }
+    }
+}
+
+/// One key-frame point's fusion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FusedPoint {
+    /// The status.
+    pub status: FusedStatus,
+    /// The fused interval (the majority's for an inconsistent point), if any.
+    pub interval: Option<DepthInterval>,
+    /// Pairs (and range constraints) that gave the point an interval.
+    pub pairs: u8,
+    /// Of those, the ones whose interval misses the one given.
+    pub disagreeing: u8,
+}
+
+/// What one interval did to a point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Added {
+    /// It agreed with the fused interval (or was the first).
+    Agreed,
+    /// It missed it: the point is inconsistent now (or was already). Before
+    /// it, whether the point was consistent and with how many pairs.
+    Conflict { was_clean: bool, was_major: u8 },
+}
+
+/// Whether a point enters the map ([`Cell::admit`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Admit {
+    Yes,
+    Inconsistent,
+    Unverified,
+}
+
+/// The state of one point (16 bytes).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct Cell {
+    near: f32,
+    far: f32,
+    /// Rival interval, codes.
+    rival: [u16; 2],
+    /// Pairs in the majority (0: no interval yet).
+    major: u8,
+    /// Pairs in the rival (0: none).
+    rival_n: u8,
+    /// Pairs that missed both.
+    others: u8,
+}
+
+impl Cell {
+    pub(crate) const EMPTY: Cell = Cell {
+        near: 0.0,
+        far: 0.0,
+        rival: [0; 2],
+        major: 0,
+        rival_n: 0,
+        others: 0,
+    };
+
+    /// Fuse the interval `[near, far]` (`near ≤ far`, both finite).
+    #[inline(always)]
+    pub(crate) fn add(&mut self, near: f32, far: f32, scale: &DepthScale) -> Added {
+        if self.major == 0 {
+            self.near = near;
+            self.far = far;
+            self.major = 1;
+            return Added::Agreed;
+        }
+        let (lo, hi) = (fmax(self.near, near), fmin(self.far, far));
+        if lo <= hi {
+            self.near = lo;
+            self.far = hi;
+            self.major = self.major.saturating_add(1);
+            return Added::Agreed;
+        }
+        let (was_clean, was_major) = (self.clean(), self.major);
+        self.conflict(near, far, scale);
+        Added::Conflict {
+            was_clean,
+            was_major,
+        }
+    }
+
+    /// No interval has missed the majority.
+    #[inline(always)]
+    fn clean(&self) -> bool {
+        self.rival_n == 0 && self.others == 0
+    }
+
+    /// An interval that missed the majority (out of line: rare).
+    #[inline(never)]
+    fn conflict(&mut self, near: f32, far: f32, scale: &DepthScale) {
+        let code = [scale.down(near), scale.up(far)];
+        if self.rival_n == 0 {
+            self.rival = code;
+            self.rival_n = 1;
+        } else {
+            let lo = self.rival[0].max(code[0]);
+            let hi = self.rival[1].min(code[1]);
+            if lo <= hi {
+                self.rival = [lo, hi];
+                self.rival_n = self.rival_n.saturating_add(1);
+            } else {
+                self.others = self.others.saturating_add(1);
+            }
+        }
+        if self.rival_n > self.major {
+            let old = [scale.down(self.near), scale.up(self.far)];
+            self.near = scale.depth(self.rival[0]);
+            self.far = scale.depth(self.rival[1]);
+            self.rival = old;
+            core::mem::swap(&mut self.major, &mut self.rival_n);
+        }
+    }
+
+    pub(crate) fn status(&self) -> FusedStatus {
+        match (self.major, self.rival_n, self.others) {
+            (0, _, _) => FusedStatus::Unmatched,
+            (1, 0, 0) => FusedStatus::Single,
+            (_, 0, 0) => FusedStatus::Consistent,
+            _ => FusedStatus::Inconsistent,
+        }
+    }
+
+    /// Whether the point goes into the map with at least `min_pairs`
+    /// agreeing pairs (no disagreeing one, a bounded interval).
+    /// (Every interval fused is finite, so a fused interval is bounded.)
+    #[inline]
+    pub(crate) fn admit(&self, min_pairs: u8) -> Admit {
+        if self.major == 0 {
+            Admit::Unverified
+        } else if !self.clean() {
+            Admit::Inconsistent
+        } else if self.major >= min_pairs {
+            Admit::Yes
+        } else {
+            Admit::Unverified
+        }
+    }
+
+    /// The fused interval's ends (meaningful when there is one).
+    #[inline]
+    pub(crate) fn ends(&self) -> (f32, f32) {
+        (self.near, self.far)
+    }
+
+    pub(crate) fn interval(&self) -> Option<DepthInterval> {
+        (self.major > 0).then_some(DepthInterval {
+            z_near: self.near,
+            z_far: self.far,
+        })
+    }
+
+    pub(crate) fn public(&self) -> FusedPoint {
+        let disagreeing = self.rival_n.saturating_add(self.others);
+        FusedPoint {
+            status: self.status(),
+            interval: self.interval(),
+            pairs: self.major.saturating_add(disagreeing),
+            disagreeing,
+        }
+    }
+
+    /// The bits, for digests.
+    pub(crate) fn words(&self) -> [u32; 4] {
+        [
+            self.near.to_bits(),
+            self.far.to_bits(),
+            u32::from(self.rival[0]) | u32::from(self.rival[1]) << 16,
+            u32::from(self.major) | u32::from(self.rival_n) << 8 | u32::from(self.others) << 16,
+        ]
+    }
+}
+
+/// Keep a boundary's admitted and inconsistent counts after `added` made
+/// cell `c` what it is: a point is admitted the moment its agreeing pairs
+/// reach `min` (they grow one at a time while it is consistent; `min` is
+/// at most 64, below the count's saturation), and leaves the admitted and
+/// joins the inconsistent at its first conflict.
+#[inline(always)]
+fn count(added: Added, c: &Cell, min: u8, admitted: &mut u16, inconsistent: &mut u16) {
+    match added {
+        Added::Agreed => {
+            if c.major == min && c.clean() {
+                *admitted = admitted.saturating_add(1);
+            }
+        }
+        Added::Conflict {
+            was_clean: true,
+            was_major,
+        } => {
+            *inconsistent = inconsistent.saturating_add(1);
+            if was_major >= min {
+                *admitted = admitted.saturating_sub(1);
+            }
+        }
+        Added::Conflict { .. } => {}
+    }
+}
+
+/// What fusing one pair's structure did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PairFused {
+    /// Key-frame points the pair matched (status `Ok`): each gave an interval.
+    pub matched: u32,
+    /// Of those, the ones whose interval missed the point's fused interval.
+    pub conflicts: u32,
+}
+
+/// Per-status counts of a key frame's points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FusedCounts {
+    /// [`FusedStatus::Unmatched`] points.
+    pub unmatched: u32,
+    /// [`FusedStatus::Single`] points.
+    pub single: u32,
+    /// [`FusedStatus::Consistent`] points.
+    pub consistent: u32,
+    /// [`FusedStatus::Inconsistent`] points.
+    pub inconsistent: u32,
+}
+
+/// The fusion state of one key frame: a [`Cell`] per boundary point.
+///
+/// Size: `16·B·N` bytes and a few words (`8 KiB + 32 B` for `N = 256`,
+/// `B = 2`).
+#[derive(Debug, Clone)]
+pub struct KeyFrame<const N: usize, const B: usize> {
+    cells: [[Cell; N]; B],
+    lens: [u16; B],
+    /// Per boundary, the points with at least `min_pairs` agreeing pairs
+    /// and no disagreeing one (the map's admission), and the inconsistent
+    /// ones: kept as the pairs come, so a retiring key frame need not
+    /// count them.
+    admitted: [u16; B],
+    inconsistent: [u16; B],
+    min_pairs: u8,
+    id: u32,
+    /// Frames paired with this key frame so far.
+    partners: u16,
+    /// The most points any of its pairs matched.
+    best_matched: u32,
+    scale: DepthScale,
+}
+
+impl<const N: usize, const B: usize> KeyFrame<N, B> {
+    pub(crate) const fn new(scale: DepthScale, min_pairs: u8) -> Self {
+        Self {
+            cells: [[Cell::EMPTY; N]; B],
+            lens: [0; B],
+            admitted: [0; B],
+            inconsistent: [0; B],
+            min_pairs,
+            id: 0,
+            partners: 0,
+            best_matched: 0,
+            scale,
+        }
+    }
+
+    /// Start over for the key frame with id `id` whose boundaries have
+    /// `lens` points: every point [`FusedStatus::Unmatched`].
+    pub(crate) fn start(&mut self, id: u32, lens: [u16; B]) {
+        self.id = id;
+        self.partners = 0;
+        self.best_matched = 0;
+        self.lens = lens;
+        self.admitted = [0; B];
+        self.inconsistent = [0; B];
+        for (&len, cells) in self.lens.iter().zip(self.cells.iter_mut()) {
+            for c in cells.iter_mut().take(usize::from(len)) {
+                *c = Cell::EMPTY;
+            }
+        }
+    }
+
+    /// The point counts of `frame`'s boundaries (at most `N`).
+    pub(crate) fn lens_of(frame: &Frame<N, B>) -> [u16; B] {
+        let mut lens = [0u16; B];
+        for (l, b) in lens.iter_mut().zip(frame.boundaries()) {
+            *l = u16::try_from(b.points().len().min(N)).unwrap_or(u16::MAX);
+        }
+        lens
+    }
+
+    /// Fuse one pair's reconstruction (the key frame against a later
+    /// frame): every `Ok` point's stick into its cell.
+    ///
+    /// Work: one pass over the structure's points (at most `B·N`), `O(1)`
+    /// each.
+    pub(crate) fn fuse(&mut self, s: &Structure<N, B>) -> PairFused {
+        let mut out = PairFused::default();
+        let scale = self.scale;
+        let min = self.min_pairs;
+        for ((((cells, len), adm), inc), b) in self
+            .cells
+            .iter_mut()
+            .zip(self.lens.iter())
+            .zip(self.admitted.iter_mut())
+            .zip(self.inconsistent.iter_mut())
+            .zip(s.boundaries())
+        {
+            let cells = cells.get_mut(..usize::from(*len)).unwrap_or(&mut []);
+            for (c, r) in cells.iter_mut().zip(b.points()) {
+                if r.status != Status::Ok {
+                    continue;
+                }
+                out.matched += 1;
+                let added = c.add(r.z_near, r.z_far, &scale);
+                if let Added::Conflict { .. } = added {
+                    out.conflicts += 1;
+                }
+                count(added, c, min, adm, inc);
+            }
+        }
+        self.partners = self.partners.saturating_add(1);
+        if out.matched > self.best_matched {
+            self.best_matched = out.matched;
+        }
+        out
+    }
+
+    /// Fuse an outside interval into point `index` of `boundary`.
+    pub(crate) fn constrain(
+        &mut self,
+        boundary: usize,
+        index: usize,
+        near: f32,
+        far: f32,
+    ) -> Option<Added> {
+        let len = usize::from(*self.lens.get(boundary)?);
+        if index >= len {
+            return None;
+        }
+        let (scale, min) = (self.scale, self.min_pairs);
+        let c = self.cells.get_mut(boundary)?.get_mut(index)?;
+        let added = c.add(near, far, &scale);
+        if let (Some(adm), Some(inc)) = (
+            self.admitted.get_mut(boundary),
+            self.inconsistent.get_mut(boundary),
+        ) {
+            count(added, c, min, adm, inc);
+        }
+        Some(added)
+    }
+
+    /// Points of `boundary` the map would admit now, and inconsistent ones.
+    pub(crate) fn admission(&self, boundary: usize) -> (u16, u16) {
+        (
+            self.admitted.get(boundary).copied().unwrap_or(0),
+            self.inconsistent.get(boundary).copied().unwrap_or(0),
+        )
+    }
+
+    /// The map's minimum of agreeing pairs.
+    pub(crate) fn min_pairs(&self) -> u8 {
+        self.min_pairs
+    }
+
+    /// The key frame's id.
+    pub fn id(&self) -> u32 {
+        self.id
+    }
+
+    /// Frames paired with the key frame so far.
+    pub fn partners(&self) -> u16 {
+        self.partners
+    }
+
+    /// The most points any pair of this key frame matched.
+    pub fn best_matched(&self) -> u32 {
+        self.best_matched
+    }
+
+    /// The number of boundaries (as in the key frame).
+    pub fn boundaries(&self) -> usize {
+        self.lens.iter().take_while(|&&l| l > 0).count()
+    }
+
+    /// The number of points of `boundary` (0 beyond the key frame's).
+    pub fn len(&self, boundary: usize) -> usize {
+        self.lens.get(boundary).map_or(0, |&l| usize::from(l))
+    }
+
+    /// Whether the key frame has no points at all.
+    pub fn is_empty(&self) -> bool {
+        self.lens.iter().all(|&l| l == 0)
+    }
+
+    /// Point `index` of `boundary`, if the key frame has it.
+    pub fn point(&self, boundary: usize, index: usize) -> Option<FusedPoint> {
+        Some(self.cell(boundary, index)?.public())
+    }
+
+    /// The cells of `boundary`'s points.
+    pub(crate) fn cells(&self, boundary: usize) -> &[Cell] {
+        let n = self.len(boundary);
+        self.cells
+            .get(boundary)
+            .and_then(|c| c.get(..n))
+            .unwrap_or(&[])
+    }
+
+    pub(crate) fn cell(&self, boundary: usize, index: usize) -> Option<&Cell> {
+        if index >= self.len(boundary) {
+            return None;
+        }
+        self.cells.get(boundary)?.get(index)
+    }
+
+    /// The points of `boundary`, in order.
+    pub fn points(&self, boundary: usize) -> impl Iterator<Item = FusedPoint> + '_ {
+        let n = self.len(boundary);
+        self.cells
+            .get(boundary)
+            .map(|c| c.get(..n).unwrap_or(&[]))
+            .unwrap_or(&[])
+            .iter()
+            .map(Cell::public)
+    }
+
+    /// How many points have each status.
+    pub fn counts(&self) -> FusedCounts {
+        let mut c = FusedCounts::default();
+        for k in 0..B {
+            for p in self.points(k) {
+                match p.status {
+                    FusedStatus::Unmatched => c.unmatched += 1,
+                    FusedStatus::Single => c.single += 1,
+                    FusedStatus::Consistent => c.consistent += 1,
+                    FusedStatus::Inconsistent => c.inconsistent += 1,
+                }
+            }
+        }
+        c
+    }
+
+    pub(crate) fn digest_into(&self, eat: &mut impl FnMut(u32)) {
+        eat(self.id);
+        eat(u32::from(self.partners));
+        for k in 0..B {
+            eat(0xCE11_0000 | self.len(k) as u32);
+            if let Some(cells) = self.cells.get(k) {
+                for c in cells.iter().take(self.len(k)) {
+                    for w in c.words() {
+                        eat(w);
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sc() -> DepthScale {
+        DepthScale::for_max_depth(1000.0)
+    }
+
+    #[test]
+    fn intersection_of_agreeing_sticks() {
+        let mut c = Cell::EMPTY;
+        assert_eq!(c.status(), FusedStatus::Unmatched);
+        assert_eq!(c.add(2.0, 4.0, &sc()), Added::Agreed);
+        assert_eq!(c.status(), FusedStatus::Single);
+        assert_eq!(c.add(3.0, 5.0, &sc()), Added::Agreed);
+        assert_eq!(c.add(2.5, 3.5, &sc()), Added::Agreed);
+        assert_eq!(c.status(), FusedStatus::Consistent);
+        assert_eq!(
+            c.interval(),
+            Some(DepthInterval {
+                z_near: 3.0,
+                z_far: 3.5
+            })
+        );
+        // An interval that adds nothing still agrees.
+        assert_eq!(c.add(1.0, 9.0, &sc()), Added::Agreed);
+        assert_eq!(c.public().pairs, 4);
+        // Touching ends agree (a point in common).
+        assert_eq!(c.add(3.5, 6.0, &sc()), Added::Agreed);
+        assert_eq!(c.interval().map(|i| (i.z_near, i.z_far)), Some((3.5, 3.5)));
+    }
+
+    #[test]
+    fn a_wrong_pair_is_flagged_and_outvoted() {
+        let mut c = Cell::EMPTY;
+        for (n, f) in [(2.0, 4.0), (3.0, 5.0), (2.8, 3.6)] {
+            c.add(n, f, &sc());
+        }
+        assert!(matches!(c.add(6.0, 7.0, &sc()), Added::Conflict { .. }));
+        let p = c.public();
+        assert_eq!(p.status, FusedStatus::Inconsistent);
+        assert_eq!((p.pairs, p.disagreeing), (4, 1));
+        assert_eq!(p.interval.map(|i| (i.z_near, i.z_far)), Some((3.0, 3.6)));
+        // A later agreeing pair still narrows the majority.
+        assert_eq!(c.add(3.1, 3.4, &sc()), Added::Agreed);
+        assert_eq!(c.interval().map(|i| (i.z_near, i.z_far)), Some((3.1, 3.4)));
+        // One missing both counts against both.
+        assert!(matches!(c.add(0.5, 1.0, &sc()), Added::Conflict { .. }));
+        assert_eq!((c.public().pairs, c.public().disagreeing), (6, 2));
+    }
+
+    #[test]
+    fn the_rival_takes_over_when_it_has_more_pairs() {
+        let mut c = Cell::EMPTY;
+        c.add(2.0, 2.5, &sc());
+        // Three later pairs agree with each other, not with the first.
+        c.add(3.0, 4.0, &sc());
+        c.add(3.2, 4.2, &sc());
+        assert_eq!(c.public().disagreeing, 1, "tie: the first keeps it");
+        c.add(3.1, 3.9, &sc());
+        let p = c.public();
+        assert_eq!((p.pairs, p.disagreeing), (4, 1));
+        let iv = p.interval.unwrap();
+        // The rival's coded interval, rounded outwards: holds [3.2, 3.9].
+        assert!(iv.z_near <= 3.2 && iv.z_near > 3.19 && iv.z_far >= 3.9 && iv.z_far < 3.91);
+        assert_eq!(p.status, FusedStatus::Inconsistent);
+    }
+
+    #[test]
+    fn cell_is_16_bytes() {
+        assert_eq!(core::mem::size_of::<Cell>(), 16);
+    }
+}

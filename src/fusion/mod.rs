@@ -1,0 +1,659 @@
+//! Fusing the error ranges of many frames (paper, Sec. 5: "the final goal
+//! ... is to obtain a more accurate 3-D road structure by fusing the error
+//! ranges of depth information from many more frames and/or from range
+//! sensors").
+//!
+//! [`Fusion`] drives a [`Processor`] over a stream of frames with a **key
+//! frame**: every later frame is paired with the key frame
+//! ([`Processor::process_against_kept`]), so each pair gives the key
+//! frame's points guaranteed sticks on their own rays, and the fused
+//! interval of a point is the intersection of its sticks ([`KeyFrame`]
+//! explains the fusion and the consistency check that catches wrong
+//! matches). When the key frame retires, its fused points move into the
+//! [`RoadMap`], which carries them forward in the current vehicle frame.
+//!
+//! # The motion from the key frame
+//! Each frame comes with the motion from the frame before it, named by
+//! frame ids ([`ChainedMotion`]); the motion from the key frame is their
+//! composition ([`Motion::then`]). When the processor's configuration
+//! bounds the per-frame motion errors, the composed motion's bounds are
+//! composed too (`src/fusion/chain.rs` derives them) and the processor
+//! pairs with them, so the fused interval stays guaranteed: the translation
+//! bound grows with the travel since the key frame, the rotation bound with
+//! the number of frames.
+//!
+//! # Longer baselines, informative pairs
+//! Pairing with the key frame rather than with the previous frame makes the
+//! baseline grow frame by frame: the disparity grows about in proportion
+//! (the motion factor `F ≈ n` of eq. 3.4) and a stick's relative length
+//! shrinks as `1/d` (Sec. 4.1.1), so the later pairs are the informative
+//! ones and the intersection is set by them. The key frame is kept as long
+//! as its points are still matched (the policy below) to let the baseline
+//! grow; a pair that flags a point (grazing, at the FOE, out of view) gives
+//! it nothing, and one that matches it is checked against its fused
+//! interval even when it does not narrow it.
+//!
+//! # Key-frame policy
+//! The first frame with boundary points becomes the key frame. After each
+//! pair the next frame is made the key frame's **last partner** (paired
+//! with it by [`Processor::process`], which then keeps that frame as the
+//! new key frame) when
+//!
+//! * the key frame has had `max_partners − 1` partners
+//!   ([`FusionConfig::new`], default 8 partners in all), or
+//! * the pair matched fewer than `keep_permille` ‰ of the most points any
+//!   pair of this key frame matched (default 500: half), or nothing at all
+//!   after two partners.
+//!
+//! A new key frame also starts, without a last pair, when the composed
+//! motion is not one the processor accepts (a turn beyond
+//! [`crate::motion::MAX_ROTATION_RAD`], a translation beyond `1e6`, no
+//! baseline) or its composed error bound is not (rotation errors summing
+//! beyond 0.1 rad, see [`crate::Config::with_rotation_error`]). A frame
+//! without boundary points never becomes a key frame: the switch waits for
+//! the next frame that has some (the frame is still paired and the map
+//! still carried). Every frame is matched exactly once, so the fusion adds
+//! no matching work.
+//!
+//! # Range sensors
+//! [`Fusion::constrain`] intersects a key-frame point's interval with a
+//! range interval along its ray from another sensor (a lidar or radar
+//! return), checked for consistency like a pair.
+//!
+//! # Memory and work
+//! Beside the processor, `Fusion<N, B, M>` holds a [`KeyFrame`] (`16·B·N`
+//! bytes), a [`RoadMap`] (`12·B·M` bytes and [`crate::map::MAP_BATCHES`]
+//! batches) and a few words: 21 340 bytes for `N = 256`, `B = 2`,
+//! `M = 512` on the Cortex-M4F, asserted at compile time there (at most
+//! 24 KiB). Per frame the fusion costs one pass over the key frame's points
+//! (`O(1)` each: an intersection, or the consistency check), `O(MAP_BATCHES)`
+//! to carry the map and at most [`crate::map::SWEEP_PER_FRAME`] point tests
+//! per boundary for points the vehicle has passed; a retiring key frame
+//! one more pass to copy its points into the map. The depths of the map
+//! and of the rival intervals are 16-bit codes relative to a power of two
+//! at or above the configuration's maximum depth (resolution `2⁻¹²` of the
+//! depth for depths within `2¹⁵` of it, rounded outwards). README
+//! ("Fusing many frames") gives the instructions measured.
+
+mod chain;
+pub(crate) mod code;
+mod key;
+
+use core::fmt;
+
+pub(crate) use chain::{Chain, StepBounds};
+pub(crate) use key::Admit;
+pub use key::{FusedCounts, FusedPoint, FusedStatus, KeyFrame, PairFused};
+
+use crate::boundary::Frame;
+use crate::config::Config;
+use crate::map::{Retired, RoadMap};
+use crate::math::{sin_cos, sqrt};
+use crate::motion::Motion;
+use crate::processor::Processor;
+use crate::structure::{Step, Structure};
+use code::DepthScale;
+use key::Added;
+
+/// Most partners a key frame may be given ([`FusionConfig::new`]).
+pub const MAX_PARTNERS: u16 = 64;
+
+/// The fusion's policy: the key-frame rule, the map's admission rule and
+/// the camera's mounting tilt (for the map's vehicle frame).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FusionConfig {
+    max_partners: u16,
+    keep_permille: u16,
+    map_min_pairs: u8,
+    tilt: f32,
+    tilt_sc: (f32, f32),
+}
+
+/// Why a [`FusionConfig`] was rejected.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FusionConfigError {
+    /// `max_partners` is not in `1..=MAX_PARTNERS`.
+    Partners,
+    /// `keep_permille` is above 1000.
+    KeepShare,
+    /// The map's minimum of agreeing pairs is not in `1..=64`.
+    MinPairs,
+    /// The tilt is NaN or beyond ±90°.
+    Tilt,
+}
+
+impl core::error::Error for FusionConfigError {}
+
+impl fmt::Display for FusionConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Partners => "partners per key frame must be in 1..=64",
+            Self::KeepShare => "the share of matched points must be at most 1000 permille",
+            Self::MinPairs => "the map's minimum of agreeing pairs must be in 1..=64",
+            Self::Tilt => "the tilt must be finite and within 90 degrees",
+        })
+    }
+}
+
+impl Default for FusionConfig {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+impl FusionConfig {
+    /// 8 partners per key frame, a new key frame when a pair matches less
+    /// than half of the best pair's points, points with 2 or more agreeing
+    /// pairs into the map, no tilt (the vehicle frame is the camera frame).
+    pub const DEFAULT: FusionConfig = match FusionConfig::new(8, 500) {
+        Ok(c) => c,
+        Err(_) => panic!("the default fusion configuration is valid"),
+    };
+
+    /// A key frame is given at most `max_partners` frames (1 to
+    /// [`MAX_PARTNERS`]), and none after a pair that matched fewer than
+    /// `keep_permille` ‰ of the most points a pair of it matched (0
+    /// switches the share rule off).
+    ///
+    /// ```
+    /// use roadstereo::fusion::FusionConfig;
+    /// let c = FusionConfig::new(6, 400)?.with_tilt(23f32.to_radians())?;
+    /// assert_eq!(c.max_partners(), 6);
+    /// assert!(FusionConfig::new(0, 400).is_err());
+    /// # Ok::<(), roadstereo::fusion::FusionConfigError>(())
+    /// ```
+    pub const fn new(max_partners: u16, keep_permille: u16) -> Result<Self, FusionConfigError> {
+        if max_partners == 0 || max_partners > MAX_PARTNERS {
+            return Err(FusionConfigError::Partners);
+        }
+        if keep_permille > 1000 {
+            return Err(FusionConfigError::KeepShare);
+        }
+        Ok(Self {
+            max_partners,
+            keep_permille,
+            map_min_pairs: 2,
+            tilt: 0.0,
+            tilt_sc: (0.0, 1.0),
+        })
+    }
+
+    /// The same policy with the camera pitched down by `tilt` radians
+    /// (`|tilt| ≤ π/2`): the map's vehicle frame is the camera frame turned
+    /// by it ([`crate::analysis::camera_to_vehicle`]).
+    pub const fn with_tilt(mut self, tilt: f32) -> Result<Self, FusionConfigError> {
+        // (A NaN fails.)
+        if !(tilt.abs() <= core::f32::consts::FRAC_PI_2) {
+            return Err(FusionConfigError::Tilt);
+        }
+        self.tilt = tilt;
+        self.tilt_sc = sin_cos(tilt);
+        Ok(self)
+    }
+
+    /// The same policy with points entering the map only with at least
+    /// `pairs` agreeing pairs, 1 to 64 (1 admits [`FusedStatus::Single`]
+    /// points, which nothing has checked).
+    pub const fn with_map_min_pairs(mut self, pairs: u8) -> Result<Self, FusionConfigError> {
+        if pairs == 0 || pairs > 64 {
+            return Err(FusionConfigError::MinPairs);
+        }
+        self.map_min_pairs = pairs;
+        Ok(self)
+    }
+
+    /// Most partners per key frame.
+    pub const fn max_partners(&self) -> u16 {
+        self.max_partners
+    }
+    /// The share rule, permille.
+    pub const fn keep_permille(&self) -> u16 {
+        self.keep_permille
+    }
+    /// Fewest agreeing pairs of a map point.
+    pub const fn map_min_pairs(&self) -> u8 {
+        self.map_min_pairs
+    }
+    /// The mounting tilt, radians.
+    pub const fn tilt(&self) -> f32 {
+        self.tilt
+    }
+}
+
+/// A frame's motion from the frame before it, named by that frame's id.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ChainedMotion {
+    /// The id of the frame the motion starts from.
+    pub from: u32,
+    /// The motion (conventions of [`crate::motion`]).
+    pub motion: Motion,
+}
+
+/// Why a frame or a constraint was rejected. Nothing changes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FusionError {
+    /// A previous frame exists but no motion was given.
+    MissingMotion,
+    /// The motion starts from another frame than the last one accepted.
+    BrokenChain {
+        /// The last accepted frame's id.
+        expected: u32,
+        /// The id the motion starts from.
+        given: u32,
+    },
+    /// The frame has the id of the last accepted frame.
+    RepeatedFrame(u32),
+    /// There is no key frame (to constrain).
+    NoKeyFrame,
+    /// The key frame has no such boundary point.
+    NoSuchPoint,
+    /// A range is not `0 ≤ near ≤ far` with both finite.
+    InvalidRange,
+}
+
+impl core::error::Error for FusionError {}
+
+impl fmt::Display for FusionError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::MissingMotion => f.write_str("a motion from the previous frame is required"),
+            Self::BrokenChain { expected, given } => write!(
+                f,
+                "the motion starts from frame {given}, the last frame was {expected}"
+            ),
+            Self::RepeatedFrame(id) => write!(f, "frame {id} was the last frame already"),
+            Self::NoKeyFrame => f.write_str("there is no key frame"),
+            Self::NoSuchPoint => f.write_str("the key frame has no such point"),
+            Self::InvalidRange => f.write_str("a range must be finite with 0 <= near <= far"),
+        }
+    }
+}
+
+/// Why a key frame started.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum KeyReason {
+    /// There was no key frame (the first frame with points).
+    First,
+    /// The old one had its `max_partners`.
+    Partners,
+    /// The old one's points were no longer matched.
+    FewMatched,
+    /// The composed motion is not one the processor accepts.
+    MotionLimit,
+    /// The composed motion's error bound is not one the processor accepts.
+    ErrorLimit,
+}
+
+/// What one frame did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FusionStep {
+    /// What the pair with the key frame fused (none when the frame was not
+    /// paired: the first frame, or after a motion limit).
+    pub paired: Option<PairFused>,
+    /// The frame's place among the key frame's partners (1 = first).
+    pub partner: u16,
+    /// The key frame that retired into the map, if one did.
+    pub retired: Option<Retired>,
+    /// Why this frame became the key frame, if it did.
+    pub new_key: Option<KeyReason>,
+}
+
+/// The key-frame fusion and its road map, around the per-frame processor
+/// (module docs). `N`, `B` as for [`Processor`]; `M` points per boundary in
+/// the map.
+#[derive(Debug, Clone)]
+pub struct Fusion<const N: usize, const B: usize, const M: usize> {
+    processor: Processor<N, B>,
+    base: Config,
+    config: FusionConfig,
+    key: KeyFrame<N, B>,
+    has_key: bool,
+    /// The key frame's motion to the last accepted frame.
+    chain: Chain,
+    last: Option<u32>,
+    /// The next frame is the key frame's last partner.
+    due: bool,
+    /// A key frame the processor keeps whose fusion has not started yet:
+    /// `key` still shows the one that just retired (its id, its lengths).
+    pending: Option<(u32, [u16; B])>,
+    map: RoadMap<B, M>,
+}
+
+impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
+    /// A fusion with no frame yet: the processor's configuration `base`
+    /// (its error bounds are per frame) and the policy `config`.
+    pub const fn new(base: Config, config: FusionConfig) -> Self {
+        let scale = DepthScale::for_max_depth(base.max_depth());
+        Self {
+            processor: Processor::new(base),
+            base,
+            config,
+            key: KeyFrame::new(scale, config.map_min_pairs),
+            has_key: false,
+            chain: Chain::IDENTITY,
+            last: None,
+            due: false,
+            pending: None,
+            map: RoadMap::new(config.tilt_sc, scale),
+        }
+    }
+
+    /// Forget every frame and the map (e.g. after a camera reset, when the
+    /// motion chain is broken). The counters of the map start over.
+    pub fn reset(&mut self) {
+        self.processor.reset();
+        self.processor.set_config(self.base);
+        self.has_key = false;
+        self.chain = Chain::IDENTITY;
+        self.last = None;
+        self.due = false;
+        self.pending = None;
+        self.map.clear();
+    }
+
+    /// Process frame `id` with the motion from the last accepted frame
+    /// (ignored for the first frame, or the first after
+    /// [`Fusion::reset`]).
+    ///
+    /// Errors (nothing changes): [`FusionError::MissingMotion`],
+    /// [`FusionError::BrokenChain`] when the motion does not start at the
+    /// last accepted frame, [`FusionError::RepeatedFrame`].
+    ///
+    /// Work: one [`Processor`] call (the matching), one pass over the key
+    /// frame's points, carrying the map (module docs).
+    ///
+    /// ```
+    /// use roadstereo::fusion::{ChainedMotion, FusedStatus, Fusion, FusionConfig};
+    /// use roadstereo::{Camera, Config, Frame, Motion, Pixel};
+    /// let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).unwrap();
+    /// let mut fusion = Fusion::<64, 2, 128>::new(Config::DEFAULT, FusionConfig::DEFAULT);
+    /// // A straight road edge on the ground 1 unit below the camera and 1
+    /// // to the left, at depths 5 to 16, seen after `n` steps of 0.25
+    /// // forward and 0.05 to the right.
+    /// let edge = |n: f32| {
+    ///     let mut f = Frame::new(cam);
+    ///     let pts: Vec<Pixel> = (0..12)
+    ///         .map(|i| {
+    ///             let (x, z) = (-1.0 - 0.05 * n, 5.0 + i as f32 - 0.25 * n);
+    ///             Pixel::new(255.5 + 800.0 * x / z, 239.5 + 800.0 / z)
+    ///         })
+    ///         .collect();
+    ///     f.push_boundary(&pts).unwrap();
+    ///     f
+    /// };
+    /// fusion.step(0, &edge(0.0), None).unwrap();
+    /// let step = Motion::new([0.05, 0.0, 0.25], [0.0; 3]).unwrap();
+    /// for id in 1..=3 {
+    ///     let m = ChainedMotion { from: id - 1, motion: step };
+    ///     fusion.step(id, &edge(id as f32), Some(&m)).unwrap();
+    /// }
+    /// // The key frame (frame 0) has three partners; its points' fused
+    /// // intervals hold the true depths 5 + i.
+    /// let key = fusion.key().unwrap();
+    /// assert_eq!(key.partners(), 3);
+    /// let p = key.point(0, 4).unwrap();
+    /// assert_eq!(p.status, FusedStatus::Consistent);
+    /// let iv = p.interval.unwrap();
+    /// assert!(iv.z_near <= 9.0 && 9.0 <= iv.z_far);
+    /// ```
+    pub fn step(
+        &mut self,
+        id: u32,
+        frame: &Frame<N, B>,
+        motion: Option<&ChainedMotion>,
+    ) -> Result<FusionStep, FusionError> {
+        let mut out = FusionStep {
+            paired: None,
+            partner: 0,
+            retired: None,
+            new_key: None,
+        };
+        // 1. Validate (nothing changes on an error).
+        let Some(last) = self.last else {
+            self.last = Some(id);
+            out.new_key = self.start_key(id, frame, KeyReason::First, false);
+            return Ok(out);
+        };
+        let m = motion.ok_or(FusionError::MissingMotion)?;
+        if m.from != last {
+            return Err(FusionError::BrokenChain {
+                expected: last,
+                given: m.from,
+            });
+        }
+        if id == last {
+            return Err(FusionError::RepeatedFrame(id));
+        }
+        self.last = Some(id);
+        let bounds = StepBounds::of(&self.base);
+        self.settle();
+        if !self.has_key {
+            self.map.carry(&m.motion, &bounds, true);
+            out.new_key = self.start_key(id, frame, KeyReason::First, false);
+            return Ok(out);
+        }
+        // 2. The motion from the key frame, and the pair.
+        let chain = self.chain.then(&m.motion, &bounds);
+        let pair = match chain.motion() {
+            Err(_) => Err(KeyReason::MotionLimit),
+            Ok(motion) => match chain.config(&self.base) {
+                Err(_) => Err(KeyReason::ErrorLimit),
+                Ok(cfg) => Ok((motion, cfg)),
+            },
+        };
+        let last_partner = self.due && has_points(frame);
+        // 3. The map follows the vehicle; its sweep rests in a frame where
+        // a key frame retires (that frame copies its points instead).
+        self.map
+            .carry(&m.motion, &bounds, !(last_partner || pair.is_err()));
+        let (motion, cfg) = match pair {
+            Ok(p) => p,
+            Err(reason) => {
+                // No last pair: retire what the key frame has, start anew.
+                out.retired = self.retire(&chain);
+                let shown = out.retired.is_some();
+                out.new_key = self.start_key(id, frame, reason, shown);
+                return Ok(out);
+            }
+        };
+        if bounds.any() {
+            self.processor.set_config(cfg);
+        }
+        let fused = if last_partner {
+            match self.processor.process(frame, Some(&motion)) {
+                Ok(Step::Structure(s)) => self.key.fuse(s),
+                // (A kept frame exists and a motion is given: not reached.)
+                _ => PairFused::default(),
+            }
+        } else {
+            match self.processor.process_against_kept(frame, &motion) {
+                Ok(s) => self.key.fuse(s),
+                Err(_) => PairFused::default(),
+            }
+        };
+        // 4. The pair fused; a last partner retires the key frame.
+        out.paired = Some(fused);
+        out.partner = self.key.partners();
+        if last_partner {
+            out.retired = self.retire(&chain);
+            out.new_key = Some(if self.key.partners() >= self.config.max_partners {
+                KeyReason::Partners
+            } else {
+                KeyReason::FewMatched
+            });
+            // The processor keeps this frame: the new key frame. Its fusion
+            // starts with the next frame; until then `key` shows the
+            // retired one's final state.
+            self.pending = Some((id, KeyFrame::lens_of(frame)));
+            self.chain = Chain::IDENTITY;
+            self.due = self.config.max_partners <= 1;
+            return Ok(out);
+        }
+        self.chain = chain;
+        // 5. The policy: is the next frame the last partner?
+        let p = self.key.partners();
+        let best = self.key.best_matched();
+        let few = u64::from(fused.matched) * 1000
+            < u64::from(self.config.keep_permille) * u64::from(best)
+            || (best == 0 && p >= 2);
+        self.due = p.saturating_add(1) >= self.config.max_partners || few;
+        Ok(out)
+    }
+
+    /// Make frame `id` the key frame (if it has points): the processor
+    /// keeps it, every point unmatched. With `show_retired` the fusion
+    /// state keeps showing the key frame that just retired until the next
+    /// frame ([`Fusion::key`]).
+    fn start_key(
+        &mut self,
+        id: u32,
+        frame: &Frame<N, B>,
+        reason: KeyReason,
+        show_retired: bool,
+    ) -> Option<KeyReason> {
+        self.processor.reset();
+        self.processor.set_config(self.base);
+        self.chain = Chain::IDENTITY;
+        self.due = self.config.max_partners <= 1;
+        self.pending = None;
+        if !has_points(frame) {
+            self.has_key = false;
+            return None;
+        }
+        let _ = self.processor.process(frame, None);
+        self.pending = Some((id, KeyFrame::lens_of(frame)));
+        if !show_retired {
+            self.settle();
+        }
+        self.has_key = true;
+        Some(reason)
+    }
+
+    /// Start the fusion of a key frame the processor keeps.
+    fn settle(&mut self) {
+        if let Some((id, lens)) = self.pending.take() {
+            self.key.start(id, lens);
+        }
+    }
+
+    /// Move the key frame's fused points into the map, posed by `chain`.
+    fn retire(&mut self, chain: &Chain) -> Option<Retired> {
+        if !self.has_key || self.key.partners() == 0 {
+            return None;
+        }
+        Some(
+            self.map
+                .retire(&self.key, self.processor.structure(), chain),
+        )
+    }
+
+    /// Intersect point `index` of key-frame boundary `boundary` with a
+    /// range interval from another sensor: the point is between `near` and
+    /// `far` along its ray, as **distances from the key-frame camera
+    /// centre** (what a lidar or radar return gives), `0 ≤ near ≤ far`,
+    /// both finite. It counts as one more pair: an interval missing the
+    /// fused one flags the point. Returns the point after.
+    ///
+    /// The distance `r` along the ray through normalised `(x, y)` is the
+    /// depth `Z = r / √(1 + x² + y²)`; the conversion is rounded outwards.
+    pub fn constrain(
+        &mut self,
+        boundary: usize,
+        index: usize,
+        near: f32,
+        far: f32,
+    ) -> Result<FusedPoint, FusionError> {
+        if !(near.is_finite() && far.is_finite() && 0.0 <= near && near <= far) {
+            return Err(FusionError::InvalidRange);
+        }
+        self.settle();
+        let kept = self
+            .processor
+            .previous()
+            .filter(|_| self.has_key)
+            .ok_or(FusionError::NoKeyFrame)?;
+        let p = kept
+            .boundaries()
+            .get(boundary)
+            .and_then(|b| b.points().get(index))
+            .copied()
+            .ok_or(FusionError::NoSuchPoint)?;
+        let (x, y) = kept.camera().normalise(p);
+        let n = sqrt(1.0 + x * x + y * y);
+        // (sqrt is within 2e-7 of the truth; 1e-6 covers it and the division.)
+        let (zn, zf) = (near / n * (1.0 - 1.0e-6), far / n * (1.0 + 1.0e-6));
+        match self.key.constrain(boundary, index, zn, zf) {
+            Some(Added::Agreed | Added::Conflict { .. }) => {}
+            None => return Err(FusionError::NoSuchPoint),
+        }
+        self.key
+            .point(boundary, index)
+            .ok_or(FusionError::NoSuchPoint)
+    }
+
+    /// The current key frame's fusion, if there is a key frame. Right
+    /// after a step that retired a key frame ([`FusionStep::retired`]) and
+    /// until the next step, the retired key frame's final state (its
+    /// [`KeyFrame::id`] tells): what went into the map, and what the pairs
+    /// made of every point.
+    pub fn key(&self) -> Option<&KeyFrame<N, B>> {
+        self.has_key.then_some(&self.key)
+    }
+
+    /// The road map.
+    pub fn map(&self) -> &RoadMap<B, M> {
+        &self.map
+    }
+
+    /// The last pair's reconstruction (the key frame against the last
+    /// paired frame, in key-frame camera coordinates).
+    pub fn structure(&self) -> &Structure<N, B> {
+        self.processor.structure()
+    }
+
+    /// The processor (its kept frame is the key frame).
+    pub fn processor(&self) -> &Processor<N, B> {
+        &self.processor
+    }
+
+    /// The policy.
+    pub fn config(&self) -> &FusionConfig {
+        &self.config
+    }
+
+    /// A 32-bit FNV-1a digest of the key frame's fusion and the map, bit
+    /// for bit (to compare the firmware with the host build).
+    pub fn digest(&self) -> u32 {
+        let mut h: u32 = 0x811c_9dc5;
+        let mut eat = |x: u32| {
+            for b in x.to_le_bytes() {
+                h = (h ^ u32::from(b)).wrapping_mul(0x0100_0193);
+            }
+        };
+        eat(u32::from(self.has_key));
+        if self.has_key {
+            self.key.digest_into(&mut eat);
+        }
+        self.map.digest_into(&mut eat);
+        h
+    }
+}
+
+fn has_points<const N: usize, const B: usize>(frame: &Frame<N, B>) -> bool {
+    frame.boundaries().iter().any(|b| !b.points().is_empty())
+}
+
+// The fusion state and the map beside the processor fit 24 KiB on the
+// vehicle controller (issue 13): 2 × 256 key-frame points, 2 × 512 map
+// points. A change that grows them past it fails the build.
+#[cfg(target_pointer_width = "32")]
+const _: () = assert!(
+    core::mem::size_of::<Fusion<256, 2, 512>>() - core::mem::size_of::<Processor<256, 2>>()
+        <= 24 * 1024
+);

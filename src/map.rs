@@ -1,0 +1,792 @@
+//! The road map a vehicle controller consumes: fused boundary points with
+//! their intervals, per boundary, in the **current vehicle frame**, with a
+//! fixed capacity.
+//!
+//! # Representation
+//! A retired key frame's fused points enter the map together, as a
+//! **batch**: each point is stored as its key-frame ray and fused interval
+//! (normalised `x`, `y` and the interval `[Z_near, Z_far]` in 16-bit
+//! outward-rounded codes, 12 bytes), and the batch holds the key frame's
+//! pose in the current camera frame, `P = A P_K + b`. Carrying the map
+//! forward by a frame's motion (`P' = Rᵀ (P − T)`) updates each batch's
+//! pose (`A ← Rᵀ A`, `b ← Rᵀ (b − T)`): `O(batches)` arithmetic, exact up to
+//! the `f32` rounding of one matrix product per frame, and no point is
+//! re-rounded frame after frame. [`RoadMap::points`] gives each point's
+//! stick in the current **vehicle frame** (the camera frame turned by the
+//! mounting tilt, Appendix I, [`crate::analysis::camera_to_vehicle`]).
+//!
+//! # Motion errors
+//! When the configuration bounds the per-frame motion errors, a carried
+//! point may be off its computed position by at most `ρ + φ |P_K|`, `|P_K|`
+//! its distance from the key-frame camera: the batch starts with the bound
+//! of its key frame's composed motion ([`crate::fusion`]) and each frame
+//! adds `√3 δ + ω |b'|` to `ρ` and `ω` to `φ` (`δ` the translation error
+//! per component, `ω` the rotation error angle, `b'` the key-frame camera's
+//! new position): the true point `Ωᵀ Rᵀ (P_t − T − d)` is off by at most
+//! the old error plus `|d| + ω |P'|`, and `|P'| ≤ |P_K| + |b'|`. A
+//! [`MapPoint`] carries that bound as its `radius`: the true point is within
+//! `radius` of the stick.
+//!
+//! # What leaves the map, all counted ([`MapDrops`])
+//! * **Behind**: a point whose whole stick, widened by its radius, is
+//!   behind the camera (negative forward coordinate in the vehicle frame)
+//!   is left out of every query ([`RoadMap::points`], [`RoadMap::samples`])
+//!   from the frame it gets there. Its slot is reclaimed, and the drop
+//!   counted, by a sweep: a batch wholly behind the camera goes at once (a
+//!   bound on its points' forward coordinates), one wholly ahead is
+//!   skipped, and of the batches the camera is passing at most
+//!   [`SWEEP_PER_FRAME`] points per boundary are tested each frame, from
+//!   the oldest on (except in a frame where a key frame retires, which
+//!   copies its points instead): a bounded cost per frame whatever `M` is.
+//! * **Capacity**: a boundary holds at most `M` points and the map at most
+//!   [`MAP_BATCHES`] batches; a retiring key frame makes room by dropping
+//!   the oldest points first (the oldest batch's, in the order they
+//!   entered; any of them already behind count as behind), and leaves out
+//!   its own farthest points beyond `M`.
+//!
+//! Size: `12·B·M` bytes of points and [`MAP_BATCHES`] batches of
+//! `72 + 4·B` bytes (12 968 bytes in all for `B = 2`, `M = 512`).
+
+use crate::fusion::code::DepthScale;
+use crate::fusion::{Admit, Chain, KeyFrame, StepBounds};
+use crate::geometry::Sample;
+use crate::math::{fmax, fmin, mat3_mul, mat3_transpose, mat3_vec, sqrt, Mat3};
+use crate::motion::Motion;
+use crate::structure::Structure;
+
+/// The most batches (retired key frames) the map holds at once.
+pub const MAP_BATCHES: usize = 8;
+
+/// Points per boundary the sweep for points behind the camera tests each
+/// frame (module docs).
+pub const SWEEP_PER_FRAME: usize = 32;
+
+/// Rounding allowance of a bound's arithmetic.
+const ROUND_UP: f32 = 1.0 + 1.0 / 65_536.0;
+
+/// One stored point: its key-frame ray and coded interval (12 bytes).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Entry {
+    x: f32,
+    y: f32,
+    near: u16,
+    /// 0: dropped (a live far end is at least code 1).
+    far: u16,
+}
+
+impl Entry {
+    const DEAD: Entry = Entry {
+        x: 0.0,
+        y: 0.0,
+        near: 0,
+        far: 0,
+    };
+    fn live(&self) -> bool {
+        self.far != 0
+    }
+}
+
+/// A retired key frame in the map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Batch<const B: usize> {
+    /// Key-frame camera coordinates → current camera coordinates.
+    a: Mat3,
+    b: [f32; 3],
+    /// The carried error bound `ρ + φ |P_K|`.
+    rho: f32,
+    phi: f32,
+    /// The key frame's id.
+    key: u32,
+    /// Slots of each boundary's ring the batch occupies (live or not).
+    len: [u16; B],
+    /// Of those, the live ones (all 0: the whole batch is gone).
+    live: [u16; B],
+    /// The smallest and largest forward coordinate of a stick end in the
+    /// key frame's vehicle frame, and an upper bound of `|P_K|` over them.
+    forward: (f32, f32),
+    reach: f32,
+}
+
+impl<const B: usize> Batch<B> {
+    const EMPTY: Self = Self {
+        a: [[0.0; 3]; 3],
+        b: [0.0; 3],
+        rho: 0.0,
+        phi: 0.0,
+        key: 0,
+        len: [0; B],
+        live: [0; B],
+        forward: (0.0, 0.0),
+        reach: 0.0,
+    };
+
+    fn live_total(&self) -> u32 {
+        self.live.iter().map(|&l| u32::from(l)).sum()
+    }
+
+    fn live_on(&self, boundary: usize) -> bool {
+        self.live.get(boundary).is_some_and(|&l| l > 0)
+    }
+}
+
+/// One map point in the current vehicle frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct MapPoint {
+    /// The near end of the fused stick, vehicle frame (`x` right, `y` down
+    /// perpendicular to the ground, `z` forward; origin at the camera).
+    pub near: [f32; 3],
+    /// The far end.
+    pub far: [f32; 3],
+    /// The true point is within this distance of the stick (0 without
+    /// motion-error bounds).
+    pub radius: f32,
+    /// The id of the key frame the point was fused in.
+    pub key: u32,
+    /// The point's ray in that key frame: normalised `(x, y)` of its pixel
+    /// ([`crate::Camera::normalise`]).
+    pub ray: (f32, f32),
+}
+
+/// Points that left the map, by reason, since it was made or cleared.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct MapDrops {
+    /// Behind the vehicle.
+    pub behind: u32,
+    /// Dropped for room (oldest first) when a key frame retired.
+    pub capacity: u32,
+}
+
+/// What one retiring key frame brought to the map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Retired {
+    /// The key frame's id.
+    pub key: u32,
+    /// Points that entered the map.
+    pub entered: u32,
+    /// Points left out: fewer agreeing pairs than the configured minimum
+    /// (unmatched or single).
+    pub unverified: u32,
+    /// Points left out: inconsistent.
+    pub inconsistent: u32,
+    /// Older points dropped to make room (also in [`MapDrops::capacity`]).
+    pub dropped: u32,
+    /// This key frame's own points beyond a boundary's capacity `M` (the
+    /// farthest along the boundary), left out.
+    pub unfit: u32,
+}
+
+/// The forward axis of the vehicle frame in camera coordinates.
+fn forward_axis(tilt: (f32, f32)) -> [f32; 3] {
+    [0.0, -tilt.0, tilt.1]
+}
+
+fn dot3(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Where a batch is against the camera this frame.
+enum Whole {
+    Ahead,
+    Behind,
+    Passing,
+}
+
+/// A batch's forward coordinates this frame: a key-frame point `P` is
+/// `g · P + g0` ahead of the camera (vehicle frame), `g = Aᵀ w`, `g0 = w · b`
+/// with `w` the forward axis; `dg = |g − w|` bounds how far that is from
+/// the key frame's own forward coordinate `w · P` (`|(g − w) · P| ≤ dg |P|`).
+struct View {
+    g: [f32; 3],
+    g0: f32,
+    dg: f32,
+    rho: f32,
+    phi: f32,
+}
+
+impl View {
+    fn of<const B: usize>(b: &Batch<B>, tilt: (f32, f32)) -> View {
+        let w = forward_axis(tilt);
+        let g = mat3_vec(&mat3_transpose(&b.a), w);
+        let d = [g[0] - w[0], g[1] - w[1], g[2] - w[2]];
+        View {
+            g,
+            g0: dot3(w, b.b),
+            dg: sqrt(dot3(d, d)) * 1.000_01 + 1e-7,
+            rho: b.rho,
+            phi: b.phi,
+        }
+    }
+
+    /// The whole batch ahead, behind (sticks and radii), or neither.
+    fn whole<const B: usize>(&self, b: &Batch<B>) -> Whole {
+        let slack = self.dg * b.reach;
+        let radius = self.rho + self.phi * b.reach;
+        if b.forward.1 + self.g0 + slack + radius < 0.0 {
+            Whole::Behind
+        } else if b.forward.0 + self.g0 - slack >= 0.0 {
+            Whole::Ahead
+        } else {
+            Whole::Passing
+        }
+    }
+
+    /// Whether a point's whole stick, widened by its radius, is behind.
+    #[inline]
+    fn behind(&self, e: &Entry, scale: &DepthScale) -> bool {
+        let dir = self.g[0] * e.x + self.g[1] * e.y + self.g[2];
+        // The stick's forward coordinate is largest at its far end when it
+        // points forward, at its near end otherwise.
+        let ahead = dir * scale.depth(if dir >= 0.0 { e.far } else { e.near }) + self.g0;
+        if self.rho == 0.0 && self.phi == 0.0 {
+            return ahead < 0.0;
+        }
+        let r = self.rho + self.phi * scale.depth(e.far) * (1.0 + 0.5 * (e.x * e.x + e.y * e.y));
+        ahead + r < 0.0
+    }
+}
+
+/// The fixed-capacity road map: up to `M` points on each of `B`
+/// boundaries (module docs).
+#[derive(Debug, Clone)]
+pub struct RoadMap<const B: usize, const M: usize> {
+    entries: [[Entry; M]; B],
+    /// Per boundary, the ring's oldest slot and the slots in use.
+    tail: [u16; B],
+    used: [u16; B],
+    batches: [Batch<B>; MAP_BATCHES],
+    first: u8,
+    count: u8,
+    /// Per boundary, the sweep's next slot (counted from the ring's tail).
+    sweep: [u16; B],
+    /// Sine and cosine of the mounting tilt.
+    tilt: (f32, f32),
+    scale: DepthScale,
+    drops: MapDrops,
+}
+
+impl<const B: usize, const M: usize> RoadMap<B, M> {
+    const CHECK: () = assert!(M > 0 && M < u16::MAX as usize, "0 < M < 65535");
+
+    /// An empty map for a camera tilted down by the angle whose sine and
+    /// cosine are `tilt`; depths coded with `scale`.
+    pub(crate) const fn new(tilt: (f32, f32), scale: DepthScale) -> Self {
+        #[allow(clippy::let_unit_value)]
+        let () = Self::CHECK;
+        Self {
+            entries: [[Entry::DEAD; M]; B],
+            tail: [0; B],
+            used: [0; B],
+            batches: [Batch::EMPTY; MAP_BATCHES],
+            first: 0,
+            count: 0,
+            sweep: [0; B],
+            tilt,
+            scale,
+            drops: MapDrops {
+                behind: 0,
+                capacity: 0,
+            },
+        }
+    }
+
+    /// Forget every point (the counters too).
+    pub(crate) fn clear(&mut self) {
+        self.tail = [0; B];
+        self.used = [0; B];
+        self.first = 0;
+        self.count = 0;
+        self.sweep = [0; B];
+        self.drops = MapDrops::default();
+    }
+
+    /// Points stored on `boundary` now: those [`RoadMap::points`] gives and
+    /// those behind the vehicle the sweep has not reclaimed yet.
+    pub fn len(&self, boundary: usize) -> usize {
+        self.batch_iter()
+            .map(|b| b.live.get(boundary).map_or(0, |&l| usize::from(l)))
+            .sum()
+    }
+
+    /// Whether the map holds no point.
+    pub fn is_empty(&self) -> bool {
+        self.batch_iter().all(|b| b.live_total() == 0)
+    }
+
+    /// Batches (retired key frames) in the map, oldest first.
+    pub fn batches(&self) -> usize {
+        usize::from(self.count)
+    }
+
+    /// The id of batch `batch`'s key frame (0 = oldest).
+    pub fn batch_key(&self, batch: usize) -> Option<u32> {
+        self.batch_iter().nth(batch).map(|b| b.key)
+    }
+
+    /// The points that left the map so far.
+    pub fn drops(&self) -> MapDrops {
+        self.drops
+    }
+
+    fn slot(&self, i: usize) -> usize {
+        (usize::from(self.first) + i) % MAP_BATCHES
+    }
+
+    fn batch_iter(&self) -> impl Iterator<Item = &Batch<B>> {
+        (0..usize::from(self.count)).filter_map(move |i| self.batches.get(self.slot(i)))
+    }
+
+    /// The ring slots of batch `i` (0 = oldest) on `boundary`: start and
+    /// length.
+    fn range(&self, i: usize, boundary: usize) -> (usize, usize) {
+        let mut start = self.tail.get(boundary).map_or(0, |&t| usize::from(t));
+        let mut len = 0;
+        for (j, b) in self.batch_iter().enumerate() {
+            let l = b.len.get(boundary).map_or(0, |&l| usize::from(l));
+            if j == i {
+                len = l;
+                break;
+            }
+            start += l;
+        }
+        (start % M, len)
+    }
+
+    /// Each point of `boundary` not behind the vehicle, oldest first, in
+    /// the current vehicle frame.
+    ///
+    /// Work: 2 matrix-vector products per stored point.
+    pub fn points(&self, boundary: usize) -> impl Iterator<Item = MapPoint> + '_ {
+        (0..usize::from(self.count)).flat_map(move |i| {
+            let batch = self
+                .batches
+                .get(self.slot(i))
+                .copied()
+                .filter(|b| b.live_on(boundary))
+                .unwrap_or(Batch::EMPTY);
+            let (start, len) = self.range(i, boundary);
+            let len = if batch.live_on(boundary) { len } else { 0 };
+            let ring = self.entries.get(boundary).map_or(&[][..], |e| &e[..]);
+            (0..len).filter_map(move |j| {
+                let e = ring.get((start + j) % M)?;
+                let p = self.map_point(&batch, e);
+                (e.live() && fmax(p.near[2], p.far[2]) + p.radius >= 0.0).then_some(p)
+            })
+        })
+    }
+
+    fn map_point(&self, b: &Batch<B>, e: &Entry) -> MapPoint {
+        let (zn, zf) = (self.scale.depth(e.near), self.scale.depth(e.far));
+        let (s, c) = self.tilt;
+        let at = |z: f32| {
+            let p = mat3_vec(&b.a, [e.x * z, e.y * z, z]);
+            let p = [p[0] + b.b[0], p[1] + b.b[1], p[2] + b.b[2]];
+            [p[0], c * p[1] + s * p[2], -s * p[1] + c * p[2]]
+        };
+        MapPoint {
+            near: at(zn),
+            far: at(zf),
+            radius: b.rho + b.phi * zf * (1.0 + 0.5 * (e.x * e.x + e.y * e.y)),
+            key: b.key,
+            ray: (e.x, e.y),
+        }
+    }
+
+    /// The points of `boundary` in batch `batch` (0 = oldest) not behind
+    /// the vehicle, as samples of [`crate::geometry::road_geometry`]: each
+    /// point's ray and fused interval in its key frame's camera coordinates
+    /// (one view per key frame; the intervals are those of the key frame,
+    /// not widened by the carrying). Fewer if `out` fills up.
+    pub fn samples<const N: usize>(
+        &self,
+        batch: usize,
+        boundary: usize,
+        out: &mut heapless::Vec<Sample, N>,
+    ) {
+        out.clear();
+        let Some(b) = self.batch_iter().nth(batch).copied() else {
+            return;
+        };
+        if !b.live_on(boundary) {
+            return;
+        }
+        let (start, len) = self.range(batch, boundary);
+        let Some(ring) = self.entries.get(boundary) else {
+            return;
+        };
+        let view = View::of(&b, self.tilt);
+        for j in 0..len {
+            let Some(e) = ring.get((start + j) % M) else {
+                continue;
+            };
+            if e.live() && !view.behind(e, &self.scale) {
+                let _ = out.push(Sample {
+                    x: e.x,
+                    y: e.y,
+                    z_near: self.scale.depth(e.near),
+                    z_far: self.scale.depth(e.far),
+                });
+            }
+        }
+    }
+
+    /// Carry every batch into the next frame by the motion `m` (from the
+    /// current frame to the next) with per-frame error bounds `bounds`,
+    /// and reclaim points behind the vehicle (module docs); the
+    /// point-by-point sweep only if `sweep`.
+    ///
+    /// Work: `O(MAP_BATCHES)` plus at most [`SWEEP_PER_FRAME`] point tests
+    /// per boundary.
+    pub(crate) fn carry(&mut self, m: &Motion, bounds: &StepBounds, sweep: bool) {
+        let rt = mat3_transpose(&m.rotation_matrix());
+        let t = m.translation();
+        let widen = bounds.any();
+        // By batch slot: whether the camera is passing the batch.
+        let mut passing = [false; MAP_BATCHES];
+        for i in 0..usize::from(self.count) {
+            let slot = self.slot(i);
+            let (Some(b), Some(pass)) = (self.batches.get_mut(slot), passing.get_mut(slot)) else {
+                continue;
+            };
+            // P' = Rᵀ (A P_K + b − T): A ← Rᵀ A, b ← Rᵀ (b − T).
+            b.a = mat3_mul(&rt, &b.a);
+            let d = [b.b[0] - t[0], b.b[1] - t[1], b.b[2] - t[2]];
+            b.b = mat3_vec(&rt, d);
+            if widen {
+                let nb = sqrt(dot3(b.b, b.b));
+                b.rho = (b.rho + 1.732_051 * bounds.delta + bounds.omega * nb) * ROUND_UP;
+                b.phi = (b.phi + bounds.omega) * ROUND_UP;
+            }
+            if b.live_total() == 0 {
+                continue;
+            }
+            match View::of(b, self.tilt).whole(b) {
+                Whole::Ahead => {}
+                Whole::Behind => {
+                    self.drops.behind = self.drops.behind.saturating_add(b.live_total());
+                    b.live = [0; B];
+                }
+                Whole::Passing => *pass = true,
+            }
+        }
+        self.pop_dead();
+        if sweep {
+            for k in 0..B {
+                self.sweep_boundary(k, &passing);
+            }
+            self.pop_dead();
+        }
+    }
+
+    /// Test up to [`SWEEP_PER_FRAME`] points of `boundary` in the batches
+    /// the camera is passing (`passing`, by batch slot), from the sweep's
+    /// slot on; drop those behind.
+    fn sweep_boundary(&mut self, boundary: usize, passing: &[bool; MAP_BATCHES]) {
+        let used = self.used.get(boundary).map_or(0, |&u| usize::from(u));
+        let mut pos = self.sweep.get(boundary).map_or(0, |&c| usize::from(c));
+        if pos >= used {
+            pos = 0;
+        }
+        let tail = self.tail.get(boundary).map_or(0, |&t| usize::from(t));
+        let mut left = SWEEP_PER_FRAME;
+        let mut offset = 0usize;
+        for i in 0..usize::from(self.count) {
+            let slot = self.slot(i);
+            let Some(b) = self.batches.get(slot).copied() else {
+                break;
+            };
+            let len = b.len.get(boundary).map_or(0, |&l| usize::from(l));
+            let end = offset + len;
+            let pass = passing.get(slot).copied().unwrap_or(false);
+            if pos >= end || left == 0 {
+                offset = end;
+                continue;
+            }
+            if !pass || !b.live_on(boundary) {
+                pos = end;
+                offset = end;
+                continue;
+            }
+            let view = View::of(&b, self.tilt);
+            let n = (end - pos).min(left);
+            let mut dropped = 0u16;
+            if let Some(ring) = self.entries.get_mut(boundary) {
+                for j in pos..pos + n {
+                    if let Some(e) = ring.get_mut((tail + j) % M) {
+                        if e.live() && view.behind(e, &self.scale) {
+                            *e = Entry::DEAD;
+                            dropped += 1;
+                        }
+                    }
+                }
+            }
+            if let Some(lv) = self
+                .batches
+                .get_mut(slot)
+                .and_then(|b| b.live.get_mut(boundary))
+            {
+                *lv = lv.saturating_sub(dropped);
+            }
+            self.drops.behind = self.drops.behind.saturating_add(u32::from(dropped));
+            left -= n;
+            pos += n;
+            offset = end;
+        }
+        if pos >= used {
+            pos = 0;
+        }
+        if let Some(c) = self.sweep.get_mut(boundary) {
+            *c = pos as u16;
+        }
+    }
+
+    /// Remove the oldest batches that have no live point left.
+    fn pop_dead(&mut self) {
+        while self.count > 0 {
+            let Some(b) = self.batches.get(usize::from(self.first)) else {
+                return;
+            };
+            if b.live_total() > 0 {
+                return;
+            }
+            let lens = b.len;
+            self.pop_oldest(&lens);
+        }
+    }
+
+    /// Remove the oldest batch whose ring lengths are `lens` (its live
+    /// points are counted by the caller).
+    fn pop_oldest(&mut self, lens: &[u16; B]) {
+        for (((t, u), c), &l) in self
+            .tail
+            .iter_mut()
+            .zip(self.used.iter_mut())
+            .zip(self.sweep.iter_mut())
+            .zip(lens)
+        {
+            *t = ((usize::from(*t) + usize::from(l)) % M) as u16;
+            *u = u.saturating_sub(l);
+            *c = c.saturating_sub(l);
+        }
+        self.first = ((usize::from(self.first) + 1) % MAP_BATCHES) as u8;
+        self.count -= 1;
+    }
+
+    /// Free `need` slots on `boundary` by dropping its oldest points;
+    /// returns the live points dropped for room (those found behind count
+    /// as behind).
+    fn free_slots(&mut self, boundary: usize, need: usize) -> u32 {
+        let mut dropped = 0u32;
+        let mut need = need;
+        // Slots are taken from the oldest batches that hold any on this
+        // boundary (at most MAP_BATCHES of them).
+        for i in 0..usize::from(self.count) {
+            if need == 0 {
+                break;
+            }
+            let slot = self.slot(i);
+            let Some(b) = self.batches.get(slot).copied() else {
+                break;
+            };
+            let alive = b.live_on(boundary);
+            let view = View::of(&b, self.tilt);
+            let (start, len) = self.range(i, boundary);
+            let take = len.min(need);
+            let Some(ring) = self.entries.get_mut(boundary) else {
+                break;
+            };
+            let (mut live, mut behind) = (0u16, 0u16);
+            for j in 0..take {
+                if let Some(e) = ring.get_mut((start + j) % M) {
+                    if alive && e.live() {
+                        if view.behind(e, &self.scale) {
+                            behind += 1;
+                        } else {
+                            live += 1;
+                        }
+                    }
+                    *e = Entry::DEAD;
+                }
+            }
+            if let (Some(b), Some(t), Some(u), Some(c)) = (
+                self.batches.get_mut(slot),
+                self.tail.get_mut(boundary),
+                self.used.get_mut(boundary),
+                self.sweep.get_mut(boundary),
+            ) {
+                if let (Some(l), Some(lv)) = (b.len.get_mut(boundary), b.live.get_mut(boundary)) {
+                    *l = l.saturating_sub(take as u16);
+                    *lv = lv.saturating_sub(live + behind);
+                }
+                // This batch's slots start at the ring's tail: every older
+                // batch has none left on this boundary.
+                *t = ((usize::from(*t) + take) % M) as u16;
+                *u = u.saturating_sub(take as u16);
+                *c = c.saturating_sub(take as u16);
+            }
+            self.drops.behind = self.drops.behind.saturating_add(u32::from(behind));
+            dropped += u32::from(live);
+            need -= take;
+        }
+        dropped
+    }
+
+    /// Put a retiring key frame's fused points into the map: the points
+    /// [`crate::fusion::FusedStatus::Consistent`] (or
+    /// [`crate::fusion::FusedStatus::Single`] if `min_pairs ≤ 1`) with at
+    /// least `min_pairs` agreeing pairs and a bounded interval, as one
+    /// batch posed by `chain` (the key frame's motion to the current
+    /// frame). `s` is a reconstruction of the key frame (its pixels). The
+    /// oldest points make room.
+    ///
+    /// Work: two passes over the key frame's points (`B·N`), plus the
+    /// points dropped for room.
+    pub(crate) fn retire<const N: usize>(
+        &mut self,
+        key: &KeyFrame<N, B>,
+        s: &Structure<N, B>,
+        chain: &Chain,
+    ) -> Retired {
+        let min_pairs = key.min_pairs();
+        let mut out = Retired {
+            key: key.id(),
+            ..Retired::default()
+        };
+        // 1. How many, per boundary (the key frame keeps the counts).
+        let mut want = [0usize; B];
+        for (k, w) in want.iter_mut().enumerate() {
+            let (admitted, inconsistent) = key.admission(k);
+            *w = usize::from(admitted);
+            out.inconsistent += u32::from(inconsistent);
+            out.unverified +=
+                (key.len(k) - usize::from(admitted) - usize::from(inconsistent)) as u32;
+        }
+        if want.iter().all(|&w| w == 0) {
+            return out;
+        }
+        // 2. Room: a batch slot, then ring slots, oldest first.
+        if usize::from(self.count) >= MAP_BATCHES {
+            if let Some(b) = self.batches.get(usize::from(self.first)).copied() {
+                out.dropped += b.live_total();
+                self.pop_oldest(&b.len);
+            }
+        }
+        for (k, w) in want.iter_mut().enumerate() {
+            if *w > M {
+                out.unfit += (*w - M) as u32;
+                *w = M;
+            }
+            let used = self.used.get(k).map_or(0, |&u| usize::from(u));
+            let free = M - used.min(M);
+            if free < *w {
+                out.dropped += self.free_slots(k, *w - free);
+            }
+        }
+        self.pop_dead();
+        self.drops.capacity = self.drops.capacity.saturating_add(out.dropped);
+        // 3. The batch.
+        let (a, b, rho, phi) = chain.pose();
+        let mut batch = Batch::<B> {
+            a,
+            b,
+            rho,
+            phi,
+            key: key.id(),
+            ..Batch::EMPTY
+        };
+        let (ts, tc) = self.tilt;
+        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+        let mut reach = 0.0f32;
+        let cam = s.camera1();
+        let scale = self.scale;
+        for (k, &w) in want.iter().enumerate() {
+            let start = self.tail.get(k).map_or(0, |&t| usize::from(t))
+                + self.used.get(k).map_or(0, |&u| usize::from(u));
+            let (Some(ring), Some(results)) = (self.entries.get_mut(k), s.boundaries().get(k))
+            else {
+                continue;
+            };
+            let mut n = 0usize;
+            for (c, r) in key.cells(k).iter().zip(results.points()) {
+                if n >= w {
+                    break;
+                }
+                if c.admit(min_pairs) != Admit::Yes {
+                    continue;
+                }
+                let (x, y) = cam.normalise(r.pixel1());
+                let (z_near, z_far) = c.ends();
+                let e = Entry {
+                    x,
+                    y,
+                    near: scale.down(z_near),
+                    far: scale.up(z_far).max(1),
+                };
+                // Forward coordinate (key frame's vehicle frame) of both
+                // ends; the coded ends are within 2⁻¹² of these (widened
+                // below).
+                let dir = tc - ts * y;
+                let (a, b) = (z_near * dir, z_far * dir);
+                lo = fmin(lo, fmin(a, b));
+                hi = fmax(hi, fmax(a, b));
+                reach = fmax(reach, z_far * (1.0 + 0.5 * (x * x + y * y)));
+                if let Some(slot) = ring.get_mut((start + n) % M) {
+                    *slot = e;
+                }
+                n += 1;
+            }
+            let n16 = n as u16;
+            if let (Some(l), Some(lv), Some(u)) = (
+                batch.len.get_mut(k),
+                batch.live.get_mut(k),
+                self.used.get_mut(k),
+            ) {
+                *l = n16;
+                *lv = n16;
+                *u = u.saturating_add(n16);
+            }
+            out.entered += n as u32;
+        }
+        // The coded ends are up to 2⁻¹² beyond the fused ones, and the
+        // products round: widened by 2⁻¹⁰ of the reach.
+        let reach = reach * (1.0 + 1.0 / 1024.0);
+        batch.forward = (lo - reach / 1024.0, hi + reach / 1024.0);
+        batch.reach = reach;
+        let slot = self.slot(usize::from(self.count));
+        if let Some(b) = self.batches.get_mut(slot) {
+            *b = batch;
+            self.count += 1;
+        }
+        out
+    }
+
+    pub(crate) fn digest_into(&self, eat: &mut impl FnMut(u32)) {
+        for (i, b) in self.batch_iter().enumerate() {
+            eat(0xBA7C_0000 | i as u32);
+            eat(b.key);
+            for v in b.a.iter().flatten().chain(b.b.iter()) {
+                eat(v.to_bits());
+            }
+            eat(b.rho.to_bits());
+            eat(b.phi.to_bits());
+            for k in 0..B {
+                let (start, len) = self.range(i, k);
+                if let Some(ring) = self.entries.get(k) {
+                    for j in 0..len {
+                        if let Some(e) = ring.get((start + j) % M) {
+                            eat(e.x.to_bits());
+                            eat(e.y.to_bits());
+                            eat(u32::from(e.near) | u32::from(e.far) << 16);
+                        }
+                    }
+                }
+            }
+        }
+        eat(self.drops.behind);
+        eat(self.drops.capacity);
+    }
+}

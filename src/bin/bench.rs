@@ -27,6 +27,7 @@ use cortex_m_rt::entry;
 use defmt_semihosting as _;
 use roadstereo::fusion::{ChainedMotion, Fusion, FusionConfig};
 use roadstereo::{Config, Frame, Motion, Processor, Status, Structure};
+use static_cell::ConstStaticCell;
 
 static BENCH: [(u32, &[u8]); 5] = [
     (32, include_bytes!("data/bench_32.bin")),
@@ -52,6 +53,19 @@ const CAP: usize = 512;
 /// The demo drive (`cargo xtask demo`), for the fusion's cost.
 static DRIVE: &[u8] = include_bytes!("data/drive.bin");
 
+/// The fusion policy of the demo drive (its camera is tilted 23° down).
+const POLICY: FusionConfig = match FusionConfig::DEFAULT.with_tilt(23f32.to_radians()) {
+    Ok(p) => p,
+    Err(_) => panic!("the demo's tilt is within 90 degrees"),
+};
+
+/// The processor of the bench pairs and the fusion of the demo drive, in
+/// statics (their constructors are `const`), as a firmware keeps them.
+static PROCESSOR: ConstStaticCell<Processor<CAP, 2>> =
+    ConstStaticCell::new(Processor::new(Config::DEFAULT));
+static FUSION: ConstStaticCell<Fusion<256, 2, 512>> =
+    ConstStaticCell::new(Fusion::new(Config::DEFAULT, POLICY));
+
 /// The fusion over the demo drive: per frame the whole step, the processor
 /// call inside it (replayed on a copy of the processor, with the motion
 /// composed the same way, and checked to give the same structure), and
@@ -60,10 +74,7 @@ fn fusion_bench() -> bool {
     let Ok(mut drive) = fw::Drive::new(DRIVE) else {
         return false;
     };
-    let Ok(policy) = FusionConfig::DEFAULT.with_tilt(23f32.to_radians()) else {
-        return false;
-    };
-    let mut fusion = Fusion::<256, 2, 512>::new(Config::default(), policy);
+    let fusion: &'static mut Fusion<256, 2, 512> = FUSION.take();
     let mut frame = Frame::<256, 2>::new(drive.camera);
     // The motion from the key frame to the previous frame.
     let mut key_motion: Option<Motion> = None;
@@ -264,7 +275,7 @@ fn main() -> ! {
         fw::exit(false)
     };
     fw::start_counter(&mut core.SYST);
-    let mut processor = Processor::<CAP, 2>::new(Config::default());
+    let processor: &'static mut Processor<CAP, 2> = PROCESSOR.take();
     let cam = match roadstereo::Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480) {
         Ok(c) => c,
         Err(_) => fw::exit(false),
@@ -276,7 +287,7 @@ fn main() -> ! {
             defmt::error!("bad bench data for n={=u32}", n);
             fw::exit(false)
         };
-        let r = measure_pair(&mut processor, &f1, &f2, &m);
+        let r = measure_pair(processor, &f1, &f2, &m);
         defmt::info!(
             "bench n={=u32} points={=u32} instr={=u32} per_point={=u32} ok={=u32} digest={=u32:08x} processed={=bool} work_spent={=u32} work_granted={=u32}",
             n,
@@ -303,7 +314,7 @@ fn main() -> ! {
             defmt::error!("bad stress data for n={=u32}", n);
             fw::exit(false)
         };
-        let r = measure_pair(&mut processor, &f1, &f2, &m);
+        let r = measure_pair(processor, &f1, &f2, &m);
         defmt::info!(
             "stress n={=u32} points={=u32} instr={=u32} per_point={=u32} ok={=u32} processed={=bool}",
             n,
@@ -319,7 +330,7 @@ fn main() -> ! {
             defmt::error!("bad adversarial data for {=str} n={=u32}", name, n);
             fw::exit(false)
         };
-        let r = measure_pair(&mut processor, &f1, &f2, &m);
+        let r = measure_pair(processor, &f1, &f2, &m);
         defmt::info!(
             "adversarial name={=str} n={=u32} points={=u32} instr={=u32} per_point={=u32} digest={=u32:08x} processed={=bool} work_spent={=u32} work_granted={=u32} {=str}",
             name,
@@ -334,6 +345,7 @@ fn main() -> ! {
             status_fields(processor.structure()).as_str()
         );
     }
+    worst_case_sweep(processor, &mut f1, &mut f2);
     wire_cost();
     if !fusion_bench() {
         defmt::error!("fusion bench failed");
@@ -359,6 +371,87 @@ fn main() -> ! {
         p - f - s
     );
     fw::exit(true)
+}
+
+/// Budgets of the work sweep, units per point: the smallest accepted, the
+/// default and up to 16 times it.
+const SWEEP: [u32; 5] = [
+    Config::MIN_WORK_PER_POINT,
+    16,
+    Config::DEFAULT_WORK_PER_POINT,
+    160,
+    640,
+];
+
+/// The measurements behind README's worst-case formula ("Worst case"):
+/// the fixed cost of a frame (one and two boundaries of two points each,
+/// from the N = 32 bench pair), and every 2 × 256 member of the adversarial
+/// family under each budget of [`SWEEP`] (instructions against the work
+/// units spent; the points flagged `over_budget`).
+fn worst_case_sweep(
+    processor: &mut Processor<CAP, 2>,
+    f1: &mut Frame<CAP, 2>,
+    f2: &mut Frame<CAP, 2>,
+) {
+    defmt::info!(
+        "work default_per_point={=u32}",
+        Config::DEFAULT_WORK_PER_POINT
+    );
+    let over = Status::ALL
+        .iter()
+        .position(|s| *s == Status::OverBudget)
+        .unwrap_or(0);
+    if let Some((_, data)) = BENCH.first() {
+        if let Some(m) = load(data, f1, f2) {
+            for b in 1..=2usize {
+                let (mut t1, mut t2) = (
+                    Frame::<CAP, 2>::new(*f1.camera()),
+                    Frame::<CAP, 2>::new(*f2.camera()),
+                );
+                let mut pushed = true;
+                for (src, dst) in [(&*f1, &mut t1), (&*f2, &mut t2)] {
+                    for bd in src.boundaries().iter().take(b) {
+                        let two = bd.points().get(..2).unwrap_or(&[]);
+                        pushed &= dst.push_boundary(two).is_ok();
+                    }
+                }
+                let r = measure_pair(processor, &t1, &t2, &m);
+                defmt::info!(
+                    "fixed boundaries={=usize} points={=u32} instr={=u32} processed={=bool} pushed={=bool}",
+                    b,
+                    r.points,
+                    r.instr,
+                    r.processed,
+                    pushed
+                );
+            }
+        }
+    }
+    for (name, n, data) in ADVERSARIAL.iter().filter(|a| a.1 == 256) {
+        let Some(m) = load(data, f1, f2) else {
+            continue;
+        };
+        for w in SWEEP {
+            let Ok(c) = Config::DEFAULT.with_work_budget(w) else {
+                continue;
+            };
+            processor.set_config(c);
+            let r = measure_pair(processor, f1, f2, &m);
+            let s = processor.structure();
+            defmt::info!(
+                "sweep name={=str} n={=u32} w={=u32} points={=u32} instr={=u32} processed={=bool} work_spent={=u32} over_budget={=usize}",
+                name,
+                n,
+                w,
+                r.points,
+                r.instr,
+                r.processed,
+                s.work_units().0,
+                s.status_counts().get(over).copied().unwrap_or(0)
+            );
+        }
+    }
+    processor.set_config(Config::DEFAULT);
 }
 
 /// The link's decoder on the emulated controller (issue 12): the first

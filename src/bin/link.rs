@@ -19,6 +19,7 @@ use defmt_semihosting as _;
 use roadstereo::link::{write_packet, UartLink};
 use roadstereo::wire::{self, encode, DataIds, Event, Receiver};
 use roadstereo::{Config, Processor, Status, Step};
+use static_cell::ConstStaticCell;
 
 /// Capacity: two boundaries of up to 256 points.
 const N: usize = 256;
@@ -105,6 +106,13 @@ use uart0::Uart0;
 
 const RAW: usize = wire::result_packet_max(N, B);
 
+/// The receiver (its frame under assembly) and the processor in statics,
+/// laid out at build time: their constructors are `const`.
+static RECEIVER: ConstStaticCell<Receiver<N, B>> =
+    ConstStaticCell::new(Receiver::new(DataIds::DEFAULT, Config::DEFAULT));
+static PROCESSOR: ConstStaticCell<Processor<N, B>> =
+    ConstStaticCell::new(Processor::new(Config::DEFAULT));
+
 #[entry]
 fn main() -> ! {
     let Some(mut core) = cortex_m::Peripherals::take() else {
@@ -114,8 +122,8 @@ fn main() -> ! {
     let mut link = UartLink::new(Uart0::init());
     let mut tx = Uart0;
     let ids = DataIds::DEFAULT;
-    let mut rx = Receiver::<N, B>::new(ids, Config::DEFAULT);
-    let mut processor = Processor::<N, B>::new(Config::DEFAULT);
+    let rx: &'static mut Receiver<N, B> = RECEIVER.take();
+    let processor: &'static mut Processor<N, B> = PROCESSOR.take();
     let mut raw = [0u8; RAW];
     let mut framed = [0u8; wire::cobs_max(RAW)];
     let (mut results, mut reports) = (0u16, 0u16);
@@ -133,9 +141,9 @@ fn main() -> ! {
     );
     loop {
         let mut end = false;
-        let polled = link.poll(&mut rx, |ev| match ev {
+        let polled = link.poll(rx, |ev| match ev {
             Event::Frame(job) => {
-                let (step, instr) = fw::measure(|| job.run(&mut processor));
+                let (step, instr) = fw::measure(|| job.run(processor));
                 let Ok(step) = step else {
                     defmt::error!("frame {=u32}: processor refused", job.info.frame_id);
                     return;

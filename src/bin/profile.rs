@@ -17,6 +17,7 @@ use core::hint::black_box;
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
 use roadstereo::{Config, Frame, Processor};
+use static_cell::ConstStaticCell;
 
 /// The traced windows, in order: a name (no spaces) and a frame pair in the
 /// format of `host_tests/src/drive.rs` (the first two frames are used). To
@@ -30,10 +31,18 @@ static WINDOWS: &[(&str, &[u8])] = &[
     ("stress", include_bytes!("data/stress_256.bin")),
     // The demo drive's costliest frame pair (frames 14 and 15).
     ("demo_15", include_bytes!("data/demo_15.bin")),
+    // Spurious frame-2 detector points (N = 256): the wedge path's lean walk
+    // with the index's aside entries merged in.
+    ("spur_f2", include_bytes!("data/adv_spur_f2_256.bin")),
 ];
 
 /// Capacity: the bench's, so the per-frame code is the bench's too.
 const CAP: usize = 512;
+
+/// The processor, in a static as a firmware keeps it (its constructor is
+/// `const`).
+static PROCESSOR: ConstStaticCell<Processor<CAP, 2>> =
+    ConstStaticCell::new(Processor::new(Config::DEFAULT));
 
 #[inline(never)]
 fn marker(tag: u32) -> u32 {
@@ -42,19 +51,20 @@ fn marker(tag: u32) -> u32 {
 
 #[entry]
 fn main() -> ! {
+    let processor: &'static mut Processor<CAP, 2> = PROCESSOR.take();
     let mut ok = true;
     for (k, (name, data)) in WINDOWS.iter().enumerate() {
-        ok &= window(k, name, data);
+        ok &= window(processor, k, name, data);
     }
     ok &= wire_window(WINDOWS.len());
     fw::exit(ok)
 }
 
-/// Window `k`: a fresh processor takes the pair's first frame, then its
+/// Window `k`: the processor, reset, takes the pair's first frame, then its
 /// second between `marker(2k + 1)` and `marker(2k + 2)`; log the result.
 /// Whether the data was read and the call succeeded.
-fn window(k: usize, name: &str, data: &'static [u8]) -> bool {
-    let mut processor = Processor::<CAP, 2>::new(Config::default());
+fn window(processor: &mut Processor<CAP, 2>, k: usize, name: &str, data: &'static [u8]) -> bool {
+    processor.reset();
     let Ok(mut d) = fw::Drive::new(data) else {
         return false;
     };

@@ -1,19 +1,49 @@
-//! `cargo xtask demo [--check]`: the demo drive on the emulated controller,
-//! its summary table, and (with `--check`) the comparison with the host build.
+//! `cargo xtask demo [--check] [--board f405]`: the demo drive on the
+//! emulated controller (mps2-an386 by default, or the STM32F405 build on
+//! QEMU's netduinoplus2), its summary table, and (with `--check`) the
+//! comparison with the host build.
 
 use std::process::Command;
 
-use crate::firmware::{build_firmware, field, num, records, run_firmware, Record};
+use crate::firmware::{
+    build_firmware_for, field, num, records, run_firmware_on, vector_table, Board, Record,
+};
 use crate::setup::setup_emulator;
 use crate::util::root;
 
 /// Keys the firmware logs that the host cannot know.
 const FIRMWARE_ONLY: [&str; 2] = ["instr", "budget_permille"];
 
-pub fn demo(check: bool) -> Result<(), String> {
+/// `cargo xtask demo [--check] [--board mps2|f405|both]` (`both`: on each
+/// board, checked, and the boards compared).
+pub fn demo_args(args: &[String]) -> Result<(), String> {
+    let check = args.iter().any(|a| a == "--check");
+    let name = match args.iter().position(|a| a == "--board") {
+        None => "mps2",
+        Some(i) => args.get(i + 1).map(String::as_str).unwrap_or(""),
+    };
+    if name == "both" {
+        return demo_on_both_boards();
+    }
+    let board = Board::from_name(name)
+        .ok_or_else(|| format!("unknown board {name:?} (mps2, f405 or both)"))?;
+    demo_on(check, board).map(|_| ())
+}
+
+/// The demo on `board`; with `check`, compared with the host build. Returns
+/// the frames' records.
+pub fn demo_on(check: bool, board: Board) -> Result<Vec<Record>, String> {
     setup_emulator()?;
-    let elf = build_firmware("demo")?;
-    let log = run_firmware(&elf)?;
+    let elf = build_firmware_for("demo", board)?;
+    // Linked with the board's own map.
+    let vma = vector_table(&elf)?;
+    if vma != board.flash_origin() {
+        return Err(format!(
+            "the demo for {board:?} has its vector table at 0x{vma}, not at the board's flash origin 0x{}",
+            board.flash_origin()
+        ));
+    }
+    let log = run_firmware_on(&elf, board)?;
     let frames: Vec<Record> = records(&log, " frame=")
         .into_iter()
         .filter(|r| field(r, "points").is_some())
@@ -28,6 +58,44 @@ pub fn demo(check: bool) -> Result<(), String> {
     if check {
         compare_with_host(&frames)?;
     }
+    Ok(frames)
+}
+
+/// The demo on both boards: the same results, and the same instruction
+/// counts (within SysTick's resolution, a few instructions a frame), which
+/// holds only if each board converts its ticks with its own core clock.
+pub fn demo_on_both_boards() -> Result<(), String> {
+    let mps2 = demo_on(true, Board::Mps2)?;
+    let f405 = demo_on(true, Board::F405)?;
+    if mps2.len() != f405.len() {
+        return Err(format!(
+            "mps2-an386 logged {} frames, stm32f405 {}",
+            mps2.len(),
+            f405.len()
+        ));
+    }
+    let mut worst = 0.0f64;
+    for (a, b) in mps2.iter().zip(&f405) {
+        let frame = num(a, "frame");
+        if field(a, "digest") != field(b, "digest")
+            || field(a, "fusion_digest") != field(b, "fusion_digest")
+        {
+            return Err(format!("frame {frame}: the boards' digests differ"));
+        }
+        let (ia, ib) = (num(a, "instr") as f64, num(b, "instr") as f64);
+        let rel = (ia - ib).abs() / ia.max(1.0);
+        worst = worst.max(rel);
+        if rel > 0.001 {
+            return Err(format!(
+                "frame {frame}: {ia} instructions on mps2-an386, {ib} on stm32f405 (a board's clock is wrong)"
+            ));
+        }
+    }
+    println!(
+        "xtask: mps2-an386 and stm32f405 agree on all {} frames (digests equal, instruction counts within {:.3} %)",
+        mps2.len(),
+        worst * 100.0
+    );
     Ok(())
 }
 

@@ -8,7 +8,8 @@
 
 use std::fs;
 
-use crate::util::{capture, root, run, tool};
+use crate::firmware::vector_table;
+use crate::util::{root, run};
 
 /// Build the fixture and check its link.
 pub fn downstream() -> Result<(), String> {
@@ -38,14 +39,7 @@ pub fn downstream() -> Result<(), String> {
         return Err("downstream: no build script output of the library found".into());
     }
     // The linked ELF: the vector table at the fixture's own flash origin.
-    let elf = release.join("downstream");
-    let elf = elf.to_string_lossy().to_string();
-    let headers = capture(&tool("llvm-objdump")?, &["-h", &elf])?;
-    let vma = headers
-        .lines()
-        .find(|l| l.contains(".vector_table"))
-        .and_then(|l| l.split_whitespace().nth(3))
-        .ok_or("downstream: no .vector_table in the ELF")?;
+    let vma = vector_table(&release.join("downstream"))?;
     if vma != "08000000" {
         return Err(format!(
             "downstream: .vector_table at 0x{vma}, not at the crate's own flash origin 0x08000000"

@@ -2,11 +2,14 @@
 //! instruction counter and the semihosting exit.
 //!
 //! Instruction counting: QEMU does not emulate the DWT cycle counter, but
-//! SysTick on the core clock (25 MHz on mps2-an386, 40 ns a tick) counts
-//! virtual time, and with `-icount shift=5` every instruction takes 32 ns:
-//! instructions = ticks × 40 / 32, the same on every run.
+//! SysTick on the core clock (the board's, [`board::CORE_HZ`]: 25 MHz on
+//! mps2-an386, 40 ns a tick; 168 MHz on the STM32F405) counts virtual time,
+//! and with `-icount shift=5` every instruction takes 32 ns: instructions =
+//! ticks × (10⁹ / CORE_HZ) / 32, the same on every run.
 
 #![allow(dead_code)]
+
+pub mod board;
 
 use core::sync::atomic::{AtomicU32, Ordering};
 
@@ -55,9 +58,11 @@ pub fn ticks() -> u64 {
     }
 }
 
-/// Instructions executed in `ticks` core-clock ticks under `-icount shift=5`.
+/// Instructions executed in `ticks` core-clock ticks under `-icount shift=5`
+/// (32 ns each).
 pub fn instructions(ticks: u64) -> u32 {
-    u32::try_from(ticks * 40 / 32).unwrap_or(u32::MAX)
+    let ns = ticks.saturating_mul(1_000_000_000) / board::CORE_HZ;
+    u32::try_from(ns / 32).unwrap_or(u32::MAX)
 }
 
 /// Run `f` and return its result with the instructions it took (the

@@ -6,7 +6,8 @@
 //! budget table (instructions per point at every N, and at N = 256), the
 //! stress pairs, the scaling and deadline checks, the adversarial family
 //! (issue 11: a table per member and N, the per-member scaling and log-log
-//! slope, the 2 × 256 worst case against the deadline),
+//! slope, the 2 × 256 worst case against the deadline), the work sweep and
+//! the worst-case formula (`worst.rs`),
 //! the memory table, the symbol checks, and the verdict.
 
 use std::collections::BTreeMap;
@@ -118,6 +119,7 @@ pub fn bench(b: &Budget) -> Result<(), String> {
     stress_table(&log);
     scaling_and_deadline(&per, b, &mut misses);
     adversarial(&log, b, &mut misses);
+    crate::worst::worst_case(&log, b.deadline(), OPEN, &mut misses);
     fusion_table(&log, &per, b, &mut misses);
     memory_table(&log, &demo_elf, b, &mut misses)?;
     wire_table(&log);
@@ -577,10 +579,19 @@ fn memory_table(
     );
     println!("|     `RoadMap<2, 512>` | {} |", num(&fusion, "map_2_512"));
     println!("| worst-case stack of one per-frame call (painted) | {stack} |");
+    // The fusion (with its processor) is a static, in .bss; the frame is on
+    // main's stack.
+    let needed = ram + num(&sizes, "frame_256_2") + stack;
     println!(
-        "| RAM the demo needs: .data + .bss + fusion (with its processor) + one frame (both on main's stack) + one call's stack | {} |",
-        ram + whole + num(&sizes, "frame_256_2") + stack
+        "| RAM the demo needs: .data + .bss (the fusion with its processor, a static) + one frame (on main's stack) + one call's stack | {needed} |"
     );
+    // The smaller board's RAM (src/bin/fw/boards/stm32f405.x).
+    const F405_RAM: u64 = 128 * 1024;
+    if needed > F405_RAM {
+        misses.push(format!(
+            "the demo needs {needed} B of RAM > the STM32F405's {F405_RAM} B"
+        ));
+    }
     if stack > b.stack {
         misses.push(format!("stack {stack} B > {} B", b.stack));
     }

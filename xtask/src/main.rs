@@ -44,6 +44,7 @@ mod profile;
 mod setup;
 mod stream;
 mod util;
+mod worst;
 
 use std::process::ExitCode;
 
@@ -56,7 +57,7 @@ fn main() -> ExitCode {
     let result = match task.as_str() {
         "test" => ci::test(),
         "fuzz" => ci::fuzz(rest),
-        "demo" => demo::demo(rest.iter().any(|a| a == "--check")),
+        "demo" => demo::demo_args(rest),
         "bench" if rest.iter().any(|a| a == "--help" || a == "-h") => {
             println!("{BENCH_USAGE}");
             Ok(())
@@ -74,7 +75,7 @@ fn main() -> ExitCode {
         "setup" => setup::setup_emulator(),
         _ => {
             eprintln!(
-                "usage: cargo xtask <test|fuzz [options]|demo [--check]|stream FILE [options]|bench [options]|profile [options]|figures|downstream|ci|setup>"
+                "usage: cargo xtask <test|fuzz [options]|demo [--check] [--board mps2|f405|both]|stream FILE [options]|bench [options]|profile [options]|figures|downstream|ci|setup>"
             );
             return ExitCode::from(2);
         }

@@ -24,6 +24,7 @@
 //! (`host_tests/tests/angles.rs` checks every function at and beyond its
 //! range against `f64`).
 
+use crate::geometry::Range;
 use crate::math::{atan, fmax, reduce_angle, sin_cos, sin_cos_reduced, AngleError};
 
 /// Vehicle-frame translation `(U, V, W)` → camera frame, camera pitched
@@ -79,20 +80,20 @@ pub fn disparity_tilted(f: f32, h: f32, w: f32, z: f32, tilt: f32) -> Result<f32
 }
 
 /// The stretch of flat ground in the vertical field of view: the nearest
-/// and farthest horizontal distances seen by a camera at height `h`, tilted
-/// down by `tilt`, with half vertical field of view `half_fov` (radians;
-/// `atan(rows / 2 / f_y)`). The far end is infinite when the upper edge of
-/// the view is at or above the horizon. `Ok(None)` if the ground is not
-/// seen. `half_fov` must be in `(0, π/2)` ([`AngleError::OutOfDomain`]
-/// otherwise); `tilt` is reduced to `[−π, π]`.
-pub fn ground_interval(h: f32, tilt: f32, half_fov: f32) -> Result<Option<(f32, f32)>, AngleError> {
+/// and farthest horizontal distances (`lo`, `hi`) seen by a camera at
+/// height `h`, tilted down by `tilt`, with half vertical field of view
+/// `half_fov` (radians; `atan(rows / 2 / f_y)`). The far end is infinite
+/// when the upper edge of the view is at or above the horizon. `Ok(None)`
+/// if the ground is not seen. `half_fov` must be in `(0, π/2)`
+/// ([`AngleError::OutOfDomain`] otherwise); `tilt` is reduced to `[−π, π]`.
+pub fn ground_interval(h: f32, tilt: f32, half_fov: f32) -> Result<Option<Range>, AngleError> {
     if !half_fov.is_finite() {
         return Err(AngleError::NotFinite);
     }
     if !(half_fov > 0.0 && half_fov < core::f32::consts::FRAC_PI_2) {
         return Err(AngleError::OutOfDomain);
     }
-    Ok(ground_in_view(h, reduce_angle(tilt)?, half_fov))
+    Ok(ground_in_view(h, reduce_angle(tilt)?, half_fov).map(|(lo, hi)| Range { lo, hi }))
 }
 
 /// [`ground_interval`] for a tilt in `[−π, π]` and a half field of view in

@@ -17,6 +17,7 @@ use crate::camera::{Camera, Pixel};
 /// Why a boundary was rejected. Indices refer to the offending point.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum BoundaryError {
     /// Fewer than two points.
     TooFewPoints,

@@ -63,6 +63,7 @@ pub struct Flow {
 /// Why an FOE or a calibration could not be computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum CalibrationError {
     /// A coordinate or an intrinsic parameter is NaN or infinite.
     NotFinite,

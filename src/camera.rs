@@ -47,6 +47,7 @@ pub const MAX_IMAGE_SIDE: u16 = 16384;
 /// Why a camera was rejected.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum CameraError {
     /// A parameter is NaN or infinite.
     NotFinite,
@@ -163,15 +164,15 @@ impl Camera {
         self.height
     }
 
-    /// Pixel → normalised image coordinates `(x, y)` (the ray `(x, y, 1)`).
+    /// Pixel → normalised image coordinates `[x, y]` (the ray `(x, y, 1)`).
     ///
     /// ```
     /// # use roadstereo::{Camera, Pixel};
     /// let cam = Camera::new(800.0, 800.0, 256.0, 240.0, 512, 480).unwrap();
-    /// assert_eq!(cam.normalise(Pixel::new(656.0, 240.0)), (0.5, 0.0));
+    /// assert_eq!(cam.normalise(Pixel::new(656.0, 240.0)), [0.5, 0.0]);
     /// ```
-    pub fn normalise(&self, p: Pixel) -> (f32, f32) {
-        ((p.u - self.cx) / self.fx, (p.v - self.cy) / self.fy)
+    pub fn normalise(&self, p: Pixel) -> [f32; 2] {
+        [(p.u - self.cx) / self.fx, (p.v - self.cy) / self.fy]
     }
 
     /// Normalised image coordinates → pixel.

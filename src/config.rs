@@ -21,6 +21,7 @@ pub struct Config {
 /// Why a configuration was rejected.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum ConfigError {
     /// A localisation error is negative, NaN or above 100 px.
     LocalisationError,
@@ -68,9 +69,13 @@ impl Config {
     };
 
     /// Work units each point brings to the frame's budget by default (see
-    /// [`Config::with_work_budget`]): sized so that a frame of two
-    /// boundaries of 256 points fits its deadline on the Cortex-M4F
-    /// (README, "Worst case").
+    /// [`Config::with_work_budget`]): sized so that no input of the
+    /// project's realistic and adversarial sets is flagged
+    /// [`crate::Status::OverBudget`] (a straight road with its edges
+    /// rounded to the pixel grid needs 34 per point at 2 × 256). The bound
+    /// it gives a frame is README's formula ("Worst case"); at 2 × 256 it
+    /// is above the 5 % share of a 33 ms frame at 168 MHz, which issue 11
+    /// keeps open.
     pub const DEFAULT_WORK_PER_POINT: u32 = 40;
     /// The smallest accepted work budget per point: enough for the usual
     /// point (a few probes and the two or three segments of its run).

@@ -65,15 +65,35 @@ pub struct PairGeometry {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Compensated {
-    /// `p₁' = K₂ Rᵀ K₁⁻¹ p₁`, frame-2 pixels.
-    pub pixel: [f32; 2],
+    /// `p₁' = K₂ Rᵀ K₁⁻¹ p₁`, frame-2 pixels, as `[u, v]` (the per-frame
+    /// path's form; [`Compensated::pixel`] gives the [`Pixel`]).
+    pub(crate) pixel: [f32; 2],
     /// `1/q_z`: frame-1 depth `Z` and compensated depth `s` relate as
     /// `Z = s / q_z`.
-    pub inv_depth_scale: f32,
+    pub(crate) inv_depth_scale: f32,
     /// Upper bound on how much the homography stretches a small
     /// displacement at `p₁` (max of the 1- and ∞-norms of its Jacobian,
     /// both ≥ the spectral norm).
-    pub stretch: f32,
+    pub(crate) stretch: f32,
+}
+
+impl Compensated {
+    /// `p₁' = K₂ Rᵀ K₁⁻¹ p₁`: where the frame-1 pixel lies in frame 2 once
+    /// the rotation is undone.
+    pub fn pixel(&self) -> Pixel {
+        Pixel::new(self.pixel[0], self.pixel[1])
+    }
+    /// `1/q_z`: frame-1 depth `Z` and compensated depth `s` relate as
+    /// `Z = s / q_z`.
+    pub fn inv_depth_scale(&self) -> f32 {
+        self.inv_depth_scale
+    }
+    /// Upper bound on how much the homography stretches a small
+    /// displacement at `p₁` (max of the 1- and ∞-norms of its Jacobian,
+    /// both ≥ the spectral norm).
+    pub fn stretch(&self) -> f32 {
+        self.stretch
+    }
 }
 
 impl PairGeometry {

@@ -84,6 +84,7 @@ pub struct SampleIndex {
 /// Why no geometry could be estimated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum GeometryError {
     /// No views, or fewer than [`MIN_POINTS`] points on a boundary.
     TooFewPoints,
@@ -449,7 +450,7 @@ pub fn samples<const N: usize, const B: usize>(
                 continue;
             }
             if let Some(i) = r.interval() {
-                let (x, y) = cam.normalise(r.pixel1());
+                let [x, y] = cam.normalise(r.pixel1());
                 let _ = out.push(Sample {
                     x,
                     y,

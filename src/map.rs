@@ -145,9 +145,9 @@ pub struct MapPoint {
     pub radius: f32,
     /// The id of the key frame the point was fused in.
     pub key: u32,
-    /// The point's ray in that key frame: normalised `(x, y)` of its pixel
+    /// The point's ray in that key frame: normalised `[x, y]` of its pixel
     /// ([`crate::Camera::normalise`]).
-    pub ray: (f32, f32),
+    pub ray: [f32; 2],
 }
 
 /// Points that left the map, by reason, since it was made or cleared.
@@ -392,7 +392,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             far: at(zf),
             radius: b.rho + b.phi * zf * (1.0 + 0.5 * (e.x * e.x + e.y * e.y)),
             key: b.key,
-            ray: (e.x, e.y),
+            ray: [e.x, e.y],
         }
     }
 
@@ -718,7 +718,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
                 if c.admit(min_pairs) != Admit::Yes {
                     continue;
                 }
-                let (x, y) = cam.normalise(r.pixel1());
+                let [x, y] = cam.normalise(r.pixel1());
                 let (z_near, z_far) = c.ends();
                 let e = Entry {
                     x,

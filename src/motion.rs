@@ -35,6 +35,7 @@ pub const MIN_TRANSLATION: f32 = 1.0e-6;
 /// Why a motion was rejected.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum MotionError {
     /// A component is NaN or infinite.
     NotFinite,

@@ -136,11 +136,28 @@ pub(crate) fn spread(
 
 /// Upper bound (pixels) on how far an error of at most `eps` (radians, about
 /// the `x`, `y`, `z` axes) in the rotation moves a rotation-compensated
-/// point at `p` (frame-2 pixels) of a camera with intrinsics
-/// `(f_x, f_y, c_x, c_y)`. See the module docs. Infinite for
-/// `Σ |eps| > 0.1` rad (or NaN), where the bound is not claimed; the sign
-/// of a component does not matter (`|ω_k| ≤ |eps_k|`).
-pub fn rotation_shift_bound(p: [f32; 2], cam2: (f32, f32, f32, f32), eps: [f32; 3]) -> f32 {
+/// point at `p` (frame-2 pixels) seen by `cam2`. See the module docs.
+/// Infinite for `Σ |eps| > 0.1` rad (or NaN), where the bound is not
+/// claimed; the sign of a component does not matter (`|ω_k| ≤ |eps_k|`).
+///
+/// ```
+/// use roadstereo::{motion_error::rotation_shift_bound, Camera, Pixel};
+/// let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).unwrap();
+/// let b = rotation_shift_bound(Pixel::new(255.5, 239.5), &cam, [0.001, 0.0, 0.0]);
+/// assert!((b - 0.8).abs() < 0.01); // f·ε at the principal point
+/// ```
+pub fn rotation_shift_bound(p: Pixel, cam2: &Camera, eps: [f32; 3]) -> f32 {
+    shift_bound(
+        [p.u, p.v],
+        (cam2.fx(), cam2.fy(), cam2.cx(), cam2.cy()),
+        eps,
+    )
+}
+
+/// [`rotation_shift_bound`] on the per-frame path: `p` as `[u, v]`, the
+/// intrinsics as `(f_x, f_y, c_x, c_y)`.
+#[inline]
+pub(crate) fn shift_bound(p: [f32; 2], cam2: (f32, f32, f32, f32), eps: [f32; 3]) -> f32 {
     let (fx, fy, cx, cy) = cam2;
     let total = eps[0].abs() + eps[1].abs() + eps[2].abs();
     if total.is_nan() || total > 0.1 {

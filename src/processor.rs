@@ -448,7 +448,7 @@ fn compensate_point(
             Some(r1) => r1,
             None => {
                 config.e1 * c.stretch
-                    + crate::motion_error::rotation_shift_bound(
+                    + crate::motion_error::shift_bound(
                         c.pixel,
                         pair.geom.camera2_intrinsics(),
                         config.rotation_error,
@@ -518,18 +518,17 @@ fn fold<const N: usize>(
         work.grant(allowance.saturating_mul(n));
         return;
     }
-    for (i, r) in slots.iter_mut().enumerate() {
-        work.grant(allowance);
-        let k = r.z_far;
-        if r.status != Status::NoIntersection || !k.is_finite() {
-            continue;
-        }
-        match index.folds(i, k, FOLD_WINDOW, work) {
+    index.folds_all(
+        slots,
+        (FOLD_WINDOW, allowance),
+        work,
+        |r| (r.status == Status::NoIntersection && r.z_far.is_finite()).then_some(r.z_far),
+        |r, folds| match folds {
             Err(OutOfWork) => *r = PointResult::flagged(r.pixel1, Status::OverBudget),
             Ok(true) => *r = PointResult::flagged(r.pixel1, Status::Folded),
             Ok(false) => {}
-        }
-    }
+        },
+    );
 }
 
 /// Step 3: index the frame-2 polyline; with `W' < 0` and the FOE near, the
@@ -585,7 +584,7 @@ fn match_boundary<const N: usize>(
         keying.pencil,
         pair.geom.w() > 0.0 && pair.translation <= 0.0,
     ) {
-        if matcher == Matcher::Indexed && index.tight().is_some() {
+        if matcher == Matcher::Indexed && index.lean().is_some() {
             match_wedge_tight(pair, keying, (foe, side), slots, b2, index, &mut credit);
         } else {
             match_wedge(
@@ -610,8 +609,9 @@ fn match_boundary<const N: usize>(
     *work = credit;
 }
 
-/// The wedge path through a tight index: every point's run walked in
-/// locals ([`TightWalk::point`]).
+/// The wedge path through a lean index ([`Index::lean`]): every point's
+/// run walked in locals ([`TightWalk::point`]), the aside entries, if any,
+/// merged in by index ([`TightWalk::point_aside`]).
 #[inline(never)]
 fn match_wedge_tight<const N: usize>(
     pair: &Pair,
@@ -623,12 +623,13 @@ fn match_wedge_tight<const N: usize>(
     work: &mut Work,
 ) {
     let mut hint = index.hint();
-    let Some((segs, orient)) = index.tight() else {
+    let Some((segs, orient, aside)) = index.lean() else {
         return;
     };
     let walk = TightWalk {
         pair,
         segs,
+        aside,
         b2,
         foe,
         side,
@@ -638,18 +639,27 @@ fn match_wedge_tight<const N: usize>(
         cot_twice: pair.config.cot_twice,
         segments: b2.len().saturating_sub(1),
     };
-    for r in slots.iter_mut() {
-        if r.status == Status::NoIntersection {
-            hint = walk.point(r, hint, work);
+    if aside.is_empty() {
+        for r in slots.iter_mut() {
+            if r.status == Status::NoIntersection {
+                hint = walk.point(r, hint, work);
+            }
+        }
+    } else {
+        for r in slots.iter_mut() {
+            if r.status == Status::NoIntersection {
+                hint = walk.point_aside(r, hint, work);
+            }
         }
     }
     index.set_hint(hint);
 }
 
-/// What every point of a boundary shares on the tight wedge path.
+/// What every point of a boundary shares on the lean wedge path.
 struct TightWalk<'a> {
     pair: &'a Pair<'a>,
     segs: &'a [crate::search::Seg],
+    aside: &'a [crate::search::Aside],
     b2: &'a [Pixel],
     foe: [f32; 2],
     side: f32,
@@ -667,13 +677,12 @@ impl TightWalk<'_> {
     /// in registers.)
     #[inline(never)]
     fn point(&self, r: &mut PointResult, hint: usize, work: &mut Work) -> usize {
-        let (p1, p, iz, r1) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near);
+        let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
         let Ok(wedge) = Wedge::new(
             p,
             (self.foe, self.side),
             (r1, self.e2),
-            self.key_scale,
-            self.orient,
+            (key, self.key_scale, self.orient),
         ) else {
             *r = PointResult::flagged(p1, Status::AtFoe);
             return hint;
@@ -684,6 +693,31 @@ impl TightWalk<'_> {
             hint,
             self.segments,
             self.cot_twice,
+            work,
+        );
+        *r = conclude_wedge(self.pair, p1, iz, r1, &wedge, outcome);
+        a
+    }
+
+    /// [`Self::point`] with the index's aside entries merged into the run
+    /// ([`wedge_run_aside`]).
+    #[inline(never)]
+    fn point_aside(&self, r: &mut PointResult, hint: usize, work: &mut Work) -> usize {
+        let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
+        let Ok(wedge) = Wedge::new(
+            p,
+            (self.foe, self.side),
+            (r1, self.e2),
+            (key, self.key_scale, self.orient),
+        ) else {
+            *r = PointResult::flagged(p1, Status::AtFoe);
+            return hint;
+        };
+        let (outcome, a) = wedge_run_aside(
+            &wedge,
+            (self.segs, self.b2, self.aside),
+            hint,
+            (self.segments, self.cot_twice),
             work,
         );
         *r = conclude_wedge(self.pair, p1, iz, r1, &wedge, outcome);
@@ -715,8 +749,9 @@ fn match_wedge<const N: usize>(
         if r.status != Status::NoIntersection {
             continue;
         }
-        let (p1, p, iz, r1) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near);
-        let Ok(wedge) = Wedge::new(p, (foe, side), (r1, e2), keying.key_scale, orient) else {
+        let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
+        let key3 = (key, keying.key_scale, orient);
+        let Ok(wedge) = Wedge::new(p, (foe, side), (r1, e2), key3) else {
             *r = PointResult::flagged(p1, Status::AtFoe);
             continue;
         };
@@ -765,10 +800,10 @@ fn raw_interval(keying: &Keying, a: [f32; 2], b: [f32; 2]) -> (f32, f32) {
     }
 }
 
-/// The wedge walk over a tight index's run (as [`Index::visit`] offers it
-/// and [`WedgeWalker`] takes it: each segment looked at costs a unit, each
-/// one whose interval meets the query [`CLIP_UNITS`] more), with the
-/// walk's values in locals. Returns the outcome and where the run started.
+/// The wedge walk over a lean index's run without aside entries (as
+/// [`Index::visit`] offers it and [`WedgeWalker`] takes it: each segment
+/// looked at costs a unit, each one whose interval meets the query
+/// [`CLIP_UNITS`] more), with the walk's values in locals. Returns the outcome and where the run started.
 #[inline(always)]
 fn wedge_run(
     wedge: &Wedge,
@@ -796,9 +831,8 @@ fn wedge_run(
         // The interval's low end decides first: below `kl` the segment
         // reaches past the low edge, above `kh` it misses (and past the
         // suffix minimum, at most the low end, the run ends).
-        let cut_lo = g.lo < kl;
         // (A NaN fails.)
-        let lo_meets = cut_lo || g.lo <= kh;
+        let lo_meets = g.lo < kl || g.lo <= kh;
         if !lo_meets {
             if g.sm > kh {
                 break;
@@ -815,8 +849,7 @@ fn wedge_run(
             break;
         }
         c -= 1;
-        let cut_hi = g.hi > kh;
-        let hi_meets = cut_hi || g.hi >= kl;
+        let hi_meets = g.hi > kh || g.hi >= kl;
         if !hi_meets {
             continue;
         }
@@ -832,7 +865,7 @@ fn wedge_run(
             }
         }
         let vb = wedge.vertex(v1.arr());
-        if let Err(s) = walk.take_met(wedge, j, (&va, &vb), (cut_lo, cut_hi), segments, cot_twice) {
+        if let Err(s) = walk.take_met(wedge, j, (&va, &vb), segments, cot_twice) {
             stop = Some(s);
             break;
         }
@@ -845,6 +878,175 @@ fn wedge_run(
         None => walk.outcome(),
     };
     (outcome, a)
+}
+
+/// [`wedge_run`] through a lean index with aside entries: each one offered
+/// in its place by index ([`offer`]: a look one unit, a met one
+/// [`CLIP_UNITS`] more), before the run's segments after it and, past the
+/// run, in order. Returns the outcome and where the run started.
+#[inline(always)]
+fn wedge_run_aside(
+    wedge: &Wedge,
+    (segs, b2, aside): (&[crate::search::Seg], &[Pixel], &[crate::search::Aside]),
+    hint: usize,
+    (segments, cot_twice): (usize, f32),
+    work: &mut Work,
+) -> (Outcome, usize) {
+    let (kl, kh) = (wedge.kl, wedge.kh);
+    let a = match run_start_in(segs, hint, kl, work) {
+        Ok(a) => a,
+        Err(OutOfWork) => return (Outcome::Flag(Status::OverBudget), hint),
+    };
+    let mut walk = WedgeWalk::NEW;
+    let mut c = work.credit();
+    // The vertex that starts segment `cached`, when it is `va`.
+    let mut cached = usize::MAX;
+    let mut va = WVertex::NONE;
+    let mut stop = None;
+    // The aside entries not yet offered.
+    let mut rest = aside.iter();
+    let mut next = rest.next();
+    let cx = (segments, cot_twice);
+    'walk: for j in a..segs.len().min(b2.len().saturating_sub(1)) {
+        let (Some(g), Some(v1)) = (segs.get(j), b2.get(j + 1)) else {
+            break;
+        };
+        // The aside entries before segment `j` come first.
+        while let Some(&(k, l, h)) = next.filter(|e| usize::from(e.0) < j) {
+            next = rest.next();
+            if let Err(s) = offer(
+                wedge,
+                b2,
+                usize::from(k),
+                (l, h),
+                &mut c,
+                &mut walk,
+                (&mut cached, &mut va),
+                cx,
+            ) {
+                stop = Some(s);
+                break 'walk;
+            }
+        }
+        // The interval's low end decides first: below `kl` the segment
+        // reaches past the low edge, above `kh` it misses (and past the
+        // suffix minimum, at most the low end, the run ends).
+        // (A NaN fails.)
+        let lo_meets = g.lo < kl || g.lo <= kh;
+        if !lo_meets {
+            if g.sm > kh {
+                break;
+            }
+            if c == 0 {
+                stop = Some(Status::OverBudget);
+                break;
+            }
+            c -= 1;
+            continue;
+        }
+        if c == 0 {
+            stop = Some(Status::OverBudget);
+            break;
+        }
+        c -= 1;
+        let hi_meets = g.hi > kh || g.hi >= kl;
+        if !hi_meets {
+            continue;
+        }
+        if c < CLIP_UNITS {
+            c = 0;
+            stop = Some(Status::OverBudget);
+            break;
+        }
+        c -= CLIP_UNITS;
+        if cached != j {
+            if let Some(v0) = b2.get(j) {
+                va = wedge.vertex(v0.arr());
+            }
+        }
+        let vb = wedge.vertex(v1.arr());
+        if let Err(s) = walk.take_met(wedge, j, (&va, &vb), segments, cot_twice) {
+            stop = Some(s);
+            break;
+        }
+        va = vb;
+        cached = j + 1;
+    }
+    // The aside entries past the run.
+    if stop.is_none() {
+        while let Some(&(k, l, h)) = next {
+            next = rest.next();
+            if let Err(s) = offer(
+                wedge,
+                b2,
+                usize::from(k),
+                (l, h),
+                &mut c,
+                &mut walk,
+                (&mut cached, &mut va),
+                cx,
+            ) {
+                stop = Some(s);
+                break;
+            }
+        }
+    }
+    work.set_credit(c);
+    let outcome = match stop {
+        Some(s) => Outcome::Flag(s),
+        None => walk.outcome(),
+    };
+    (outcome, a)
+}
+
+/// An aside segment `k` with its interval `(l, h)` offered to the walk
+/// as [`wedge_run`] takes a run's segment: one unit to look at it,
+/// [`CLIP_UNITS`] more when its interval meets the wedge's; `Err` when the
+/// walk stops ([`Status::OverBudget`] included).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn offer(
+    wedge: &Wedge,
+    b2: &[Pixel],
+    k: usize,
+    (l, h): (f32, f32),
+    c: &mut u32,
+    walk: &mut WedgeWalk,
+    (cached, va): (&mut usize, &mut WVertex),
+    (segments, cot_twice): (usize, f32),
+) -> Result<(), Status> {
+    if *c == 0 {
+        return Err(Status::OverBudget);
+    }
+    *c -= 1;
+    // (A NaN fails.)
+    if !(l <= wedge.kh && h >= wedge.kl) {
+        return Ok(());
+    }
+    if *c < CLIP_UNITS {
+        *c = 0;
+        return Err(Status::OverBudget);
+    }
+    *c -= CLIP_UNITS;
+    let Some(v1) = b2.get(k + 1) else {
+        return Ok(());
+    };
+    if *cached != k {
+        if let Some(v0) = b2.get(k) {
+            *va = wedge.vertex(v0.arr());
+        }
+    }
+    let vb = wedge.vertex(v1.arr());
+    // An aside segment (a spurious point's) often lies wholly before
+    // `X_min`: then the walk finds no part (within three roundings the
+    // clip's ends stay below the larger end's `X`), and its clip is skipped.
+    let r = if wedge.before(&*va, &vb) {
+        Ok(())
+    } else {
+        walk.take_met(wedge, k, (va, &vb), segments, cot_twice)
+    };
+    (*cached, *va) = (k + 1, vb);
+    r
 }
 
 /// The point's result from a wedge walk's outcome: depth and stick

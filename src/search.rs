@@ -43,7 +43,9 @@
 //! range misses the query (at an aligned position, the largest such block),
 //! so a long run costs about one step per block it crosses and per segment
 //! it visits, not one per segment. A tight index never builds or reads the
-//! tree.
+//! tree, and neither does a *lean* one (non-periodic keys, envelopes no
+//! longer loose once the outliers are aside: the wedge path walks its short
+//! runs itself and merges the aside entries in by index, `Index::lean`).
 //!
 //! Periodic keys (pseudo-angles) are searched at each copy `q + 4m` that
 //! can meet the keys' range (at most [`MAX_COPIES`], else every segment is
@@ -54,6 +56,8 @@ use crate::pencil::NO_KEY;
 
 /// Segments kept aside (see the module docs).
 pub(crate) const MAX_ASIDE: usize = 8;
+/// An aside segment: its index and (oriented) interval.
+pub(crate) type Aside = (u16, f32, f32);
 /// Frame-2 segments near the FOE listed for bands that run into it.
 pub(crate) const MAX_NEAR: usize = 8;
 /// Linear probes before a search for the run's start falls back to
@@ -221,6 +225,9 @@ pub(crate) struct Index<const N: usize> {
     /// segment but its own two. (`false` too where the build did not test
     /// the order: [`Builder::push_all`]'s lean loop.)
     strict: bool,
+    /// The envelopes, the aside segments left out, are more than
+    /// [`WIDE`] average widths apart somewhere: runs may be long.
+    loose: bool,
 }
 
 impl<const N: usize> Default for Index<N> {
@@ -247,6 +254,7 @@ impl<const N: usize> Index<N> {
             near_overflow: false,
             hint: 0,
             strict: false,
+            loose: false,
         }
     }
 
@@ -358,9 +366,8 @@ impl<const N: usize> Index<N> {
             run = fmax(run, g.hi);
             g.pm = run;
         }
-        // The block tree only where the envelopes are still loose without
-        // the segments set aside.
-        self.suffix_minima(wide);
+        // The block tree for runs through the rebuilt envelopes.
+        self.loose = self.suffix_minima(wide);
         self.build_tree();
     }
 
@@ -489,6 +496,48 @@ impl<const N: usize> Index<N> {
         }
     }
 
+    /// [`Self::folds`] for every item of `items` in order (vertex `i` the
+    /// `i`-th, `key` its raw key where it is to be tested), each bringing
+    /// `allowance` to `work` first; `flag` gets the answer of each tested
+    /// one. Without a period and with nothing aside, the envelopes' `O(1)`
+    /// answer ([`Self::may_fold`]) is taken in the loop itself, and only the
+    /// vertices it cannot clear go through [`Self::folds`].
+    #[inline(always)]
+    pub(crate) fn folds_all<T>(
+        &mut self,
+        items: &mut [T],
+        (w, allowance): (usize, u32),
+        work: &mut Work,
+        key: impl Fn(&T) -> Option<f32>,
+        mut flag: impl FnMut(&mut T, Result<bool, OutOfWork>),
+    ) {
+        let lean = self.period <= 0.0 && self.aside.is_empty();
+        let (s, o) = (self.segments.min(N), self.orient);
+        for (i, it) in items.iter_mut().enumerate() {
+            work.grant(allowance);
+            let Some(k) = key(it) else {
+                continue;
+            };
+            if lean {
+                let (ko, e) = (o * k, self.margin.get(i).copied().unwrap_or(0.0));
+                let before = i
+                    .checked_sub(w + 1)
+                    .and_then(|j| self.seg.get(j))
+                    .is_some_and(|g| ko - e <= g.pm);
+                let after = i + w < s && self.seg.get(i + w).is_some_and(|g| ko + e >= g.sm);
+                if !(before || after) {
+                    continue;
+                }
+            }
+            let r = if lean && !self.strict {
+                self.folds_query(i, k, w, work)
+            } else {
+                self.folds(i, k, w, work)
+            };
+            flag(it, r);
+        }
+    }
+
     /// Whether no vertex's key meets a segment other than its own two (so
     /// no vertex of this polyline folds); `false` says nothing.
     pub(crate) fn strict(&self) -> bool {
@@ -534,6 +583,21 @@ impl<const N: usize> Index<N> {
         if !self.may_fold(i, key, w) {
             return Ok(false);
         }
+        self.folds_query(i, key, w, work)
+    }
+
+    /// The query of [`Self::folds`] (the index's segments outside `i − w
+    /// ..= i + w − 1`, each one unit of `work`), for a vertex neither the
+    /// aside list nor the envelopes settled.
+    fn folds_query(
+        &mut self,
+        i: usize,
+        key: f32,
+        w: usize,
+        work: &mut Work,
+    ) -> Result<bool, OutOfWork> {
+        let e = self.margin(i);
+        let skip = (i.saturating_sub(w), i.saturating_add(w).saturating_sub(1));
         let mut met = Met(false);
         self.visit(
             Query::Keys(key - e, key + e),
@@ -545,16 +609,19 @@ impl<const N: usize> Index<N> {
         Ok(met.0)
     }
 
-    /// For a *tight* index (non-periodic keys, nothing aside, no block
-    /// tree): its segments and orientation, for a caller that walks the run
-    /// itself ([`Self::run_start`], then `sm`, `lo`, `hi` as
-    /// [`Self::visit`] does); `None` otherwise.
+    /// For a *lean* index (non-periodic keys, envelopes not loose once the
+    /// aside segments are left out): its segments, orientation and aside
+    /// list, for a caller that walks the run itself and merges the aside
+    /// entries into it by index ([`Self::run_start`], then `sm`, `lo`, `hi`
+    /// as [`Self::visit`] does; the block tree, if any, is not needed for
+    /// such short runs); `None` otherwise.
     #[inline(always)]
-    pub(crate) fn tight(&self) -> Option<(&[Seg], f32)> {
-        (self.period <= 0.0 && self.aside.is_empty() && self.levels == 0).then(|| {
+    pub(crate) fn lean(&self) -> Option<(&[Seg], f32, &[Aside])> {
+        (self.period <= 0.0 && !self.loose).then(|| {
             (
                 self.seg.get(..self.segments.min(N)).unwrap_or(&[]),
                 self.orient,
+                self.aside.as_slice(),
             )
         })
     }
@@ -1171,6 +1238,16 @@ impl<const N: usize> Builder<'_, N> {
         self.push_rest(next);
     }
 
+    /// One vertex, raw key and margin, through [`Self::push_stored`] (the
+    /// tests' way past the lean loop).
+    #[cfg(test)]
+    fn push(&mut self, raw: f32, e: f32) {
+        if let Some(m) = self.index.margin.get_mut(self.n) {
+            *m = e;
+            self.push_stored(raw);
+        }
+    }
+
     /// The rest of [`Self::push_run`], one [`Self::push_stored`] at a time.
     fn push_rest(&mut self, mut next: impl FnMut(&mut f32) -> Option<f32>) {
         while let Some(raw) = self.index.margin.get_mut(self.n).and_then(&mut next) {
@@ -1249,6 +1326,7 @@ impl<const N: usize> Builder<'_, N> {
         index.orient = o;
         let wide = WIDE * sum / fmax(s as f32, 1.0);
         let loose = index.suffix_minima(wide);
+        index.loose = loose;
         if loose || odd || flip {
             index.rebuild(if flip { -o } else { o }, wide);
         }
@@ -1442,7 +1520,13 @@ mod tests {
             let ks = keys(&mut rng, shape, n, period);
             let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
             let mut b = index.builder((if period { 4.0 } else { 0.0 }, orient), Unkeyed::MeetAll);
-            b.push_all(ks.iter().copied());
+            if case % 2 == 0 {
+                b.push_all(ks.iter().copied());
+            } else {
+                for &(k, e) in &ks {
+                    b.push(k, e);
+                }
+            }
             b.finish(None);
             let ivs = intervals(&ks, period);
             for _ in 0..8 {
@@ -1497,7 +1581,13 @@ mod tests {
             let ks = keys(&mut rng, shape, n, period);
             let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
             let mut b = index.builder((if period { 4.0 } else { 0.0 }, orient), Unkeyed::MeetNone);
-            b.push_all(ks.iter().copied());
+            if case % 2 == 0 {
+                b.push_all(ks.iter().copied());
+            } else {
+                for &(k, e) in &ks {
+                    b.push(k, e);
+                }
+            }
             b.finish(None);
             let ivs = intervals(&ks, period);
             for (i, &(k, e)) in ks.iter().enumerate() {

@@ -12,6 +12,7 @@ use crate::depth::DepthInterval;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[repr(u8)]
+#[non_exhaustive]
 pub enum Status {
     /// Matched; depth and stick given. The band of the point's error
     /// meets the corresponding frame-2 boundary in one piece, the exact
@@ -43,7 +44,7 @@ pub enum Status {
     /// (no far end), or the near end is not above zero.
     Unbounded,
     /// The point's epipolar line meets the frame-1 boundary again, more
-    /// than [`FOLD_WINDOW`] points away: the boundary folds across the
+    /// than 4 points away: the boundary folds across the
     /// epipolar lines, so a frame-2 crossing may be the image of another
     /// part of the curve (one possibly not visible in frame 2). Not
     /// searched; no depth.
@@ -63,7 +64,7 @@ pub enum Status {
 }
 
 /// Points on either side of a point whose segments the fold test skips.
-pub const FOLD_WINDOW: usize = 4;
+pub(crate) const FOLD_WINDOW: usize = 4;
 
 impl Status {
     /// Whether a depth, 3-D point and stick are given.
@@ -271,14 +272,14 @@ impl<const N: usize, const B: usize> Structure<N, B> {
     /// 3-D point `(X, Y, Z)` of a result: `X = x₁ Z`, `Y = y₁ Z` (eq. 2.3).
     pub fn point(&self, r: &PointResult) -> Option<[f32; 3]> {
         let z = r.depth()?;
-        let (x, y) = self.camera1.normalise(r.pixel1);
+        let [x, y] = self.camera1.normalise(r.pixel1);
         Some([x * z, y * z, z])
     }
 
     /// The stick's two 3-D end points (near, far) on the frame-1 ray.
     pub fn stick(&self, r: &PointResult) -> Option<([f32; 3], [f32; 3])> {
         let i = r.interval()?;
-        let (x, y) = self.camera1.normalise(r.pixel1);
+        let [x, y] = self.camera1.normalise(r.pixel1);
         Some((
             [x * i.z_near, y * i.z_near, i.z_near],
             [x * i.z_far, y * i.z_far, i.z_far],
@@ -335,6 +336,7 @@ pub enum Step<'a, const N: usize, const B: usize> {
 /// Why a frame was rejected. The kept state is unchanged.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum ProcessError {
     /// A previous frame exists but no motion was given.
     MissingMotion,

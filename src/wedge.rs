@@ -20,52 +20,86 @@
 //! r₁ + e₂)/(ρ₁ − r₁ − e₂)` on either side, a few hundredths of a pixel
 //! for a point 100 px from the FOE with a disparity of 10 px.
 //!
-//! # Keys decide most segments
+//! # Keys filter, the edges decide
 //! The half-plane key is a strictly monotone function of a ray's angle
 //! about `F` over the half-plane, and along a segment (which cannot pass
 //! through `F`) the angle is monotone, so a segment's rays have the keys
-//! between those of its end points. The wedge's rays have the keys between
-//! those of its two edges (the edge directions `d ± T d⊥`, `d = p₁' − F`;
-//! an edge outside the half-plane stands for the key limit `±1` on its
-//! side, as the wedge leaves the half-plane through the FOE's row). With
-//! every key widened by its rounding margin, a segment whose interval
-//! ([`crate::search`]) misses the wedge's is outside it; one whose interval
-//! lies inside the wedge's is taken whole (it reaches at most its keys'
-//! margins past an edge, which only lengthens the piece: the stick stays a
-//! bound); only a segment whose interval straddles an edge's key is
-//! clipped by that edge's line, exactly (one division per edge it
-//! crosses). The segment's part in the wedge then has the range `[λ₀, λ₁]`
-//! of `λ = â·(q − p₁')` (`â = d/ρ₁`; `λ` is linear along the segment, so
-//! the ends of the part give it), cut at `λ ≥ −(r₁ + e₂)`.
+//! between those of its end points. The wedge's rays, within `θ = atan T
+//! ≤ T` of `d = p₁' − F`, have keys within `δ` of `d`'s own `k_d`: for a
+//! unit direction at the angle `φ` from the row, `k = cos φ/(|cos φ| +
+//! sin φ)` changes at the rate `|dk/dφ| = 1/(|cos φ| + sin φ)² = S(k) =
+//! 1 − 2|k| + 2k²` (from `|k| (|cos φ| + sin φ) = |cos φ|` and `cos² +
+//! sin² = 1`), and `S` changes by at most 2 per key unit, so over the
+//! wedge the keys stay within `δ ≤ θ (S(k_d) + 2δ)`, `δ ≤ T S(k_d)/(1 −
+//! 2T) ≤ T S(k_d) (1 + 2T + 6T²)` for `T ≤ 1/8` (past the FOE's row the
+//! half-plane ends and the keys with it). Step 1 computed `k_d` (the
+//! point's own key) to within its margin `m ≤ 2⁻²⁰ (S/ρ₁ + 1)` (its `D =
+//! |d_u| + t ≥ ρ₁`), so `[k_d − m − δ, k_d + m + δ]` with `S(k_d) + 2m` for
+//! the rate holds every key of the wedge: no division. A wider wedge (`T >
+//! 1/8`, close to the FOE) or a point without a key takes the keys of the
+//! wedge's two edges instead (the edge directions `d ± T d⊥`; an edge
+//! outside the half-plane stands for the key limit `±1` on its side, as
+//! the wedge leaves the half-plane through the FOE's row). With every key
+//! widened by its rounding margin, a segment whose interval
+//! ([`crate::search`]) misses the wedge's is outside it.
+//!
+//! Every other segment is decided by the geometry. For a frame-2 point
+//! `q`, `w = q − F`, let `X = d·w` and `Y = d × w` (`ρ₁ |w|` times the
+//! cosine and the sine of its angle from `d`): the wedge is `|Y| ≤ T X`,
+//! that is both *edge values* `T X ∓ Y` at least 0 (each linear in `w`:
+//! the edges' lines through `F`, with the normals `T d ∓ d⊥`). A segment
+//! with both ends inside is taken whole; one with an end outside an edge
+//! is clipped by that edge's line, exactly (one division per edge it
+//! crosses); one with both ends outside the same edge has no part in the
+//! wedge. `X` is linear along the segment, so the ends of the part give
+//! its range `[X₀, X₁]`, and as `X = ρ₁ (ρ₁ + λ)` (`λ = â·(q − p₁')`, `â
+//! = d/ρ₁`), `λ ≥ −(r₁ + e₂)` is `X ≥ X_min = R − ρ₁ (r₁ + e₂)` with `R =
+//! |d|² = ρ₁²`: the walk works in `X` throughout and never needs `λ`.
 //!
 //! The walk over the segments (in order, with the rules of
 //! [`crate::matching`]: one piece, not grazing, no end vertex inside,
 //! the exact line's nearest crossing for the estimate, where the segment's
-//! ends lie on the line's two sides: a segment whose keys miss the line's,
-//! widened by the margins, has both ends farther from the line than the
-//! sides' rounding, so no key test is needed there) gives the piece's
-//! range `[lo, hi]` and the crossing's `λ`, and with `|a| = W' ρ₁`
-//! the depth and stick of [`crate::depth`] become
+//! ends lie on the line's two sides (`Y` changes sign): a segment whose
+//! keys miss the line's, widened by the margins, has both ends farther
+//! from the line than the sides' rounding, so no key test is needed there)
+//! gives the piece's range `[lo, hi]` and the crossing's `X`, and with
+//! `|a| = W' ρ₁` and `λ = (X − R)/ρ₁` the depth and stick of
+//! [`crate::depth`] become
 //!
-//! `s = W' (1 + ρ₁/λ)`,   `s_far = W' (1 + (ρ₁ + r₁)/(lo − r₁ − e₂))`,
-//! `s_near = W' (1 + (ρ₁ − r₁)/(hi + r₁ + e₂))`
+//! `s = W' (1 + R/(X − R))`,   `s_far = W' (1 + (R + ρ₁ r₁)/(lo − R − ρ₁ (r₁ + e₂)))`,
+//! `s_near = W' (1 + (R − ρ₁ r₁)/(hi − R + ρ₁ (r₁ + e₂)))`
 //!
-//! (numerators and denominators ordered as the IEEE operations keep them,
-//! so the rounded stick holds the rounded estimate). A piece is grazing
-//! when it is longer than the wedge's width at its near end over
-//! `tan φ_min`, `hi − lo > T (ρ₁ + lo) · 2 cot φ_min`: a test that only
-//! becomes true as the piece grows, so the walk may stop at the first
-//! segment that makes it true and get the outcome a walk to the end would.
+//! (`s_far`'s numerator and `s_near`'s denominator are the larger ones,
+//! `(lo − R) − ρ₁ (r₁ + e₂) ≤ X − R ≤ (hi − R) + ρ₁ (r₁ + e₂)`, each
+//! computed in that order: IEEE operations keep the order, so the rounded
+//! stick holds the rounded estimate). A piece is grazing when it is longer
+//! than the wedge's width at its near end over `tan φ_min`, in `λ`
+//! `hi − lo > T (ρ₁ + lo) · 2 cot φ_min`, in `X` (times `ρ₁`) `hi − lo >
+//! T lo · 2 cot φ_min`: a test that only becomes true as the piece grows
+//! (`lo ≥ X_min > 0`), so the walk may stop at the first segment that makes
+//! it true and get the outcome a walk to the end would.
 //!
 //! # Rounding
-//! `T` is rounded up by `2⁻¹⁶` relative; the edge directions, the keys and
-//! the `λ`s are computed from coordinates below the frame's scale `S` and
-//! are off by a few `2⁻²⁴ S` at most, which the slack of `2⁻²⁰ S` in `r₁`
-//! and `e₂` covers (see [`crate::depth`]).
+//! `ρ₁` enters only through `X_min`, `T` and the stick's small terms
+//! `ρ₁ r₁`, `ρ₁ (r₁ + e₂)`, and each of them is a bound in the right
+//! direction for any `ρ₊ ≥ ρ₁`: `X_min` falls (more of the band's near
+//! end), `T` grows (a wider wedge), `s_far` grows (its numerator grows and
+//! its positive denominator shrinks) and `s_near` falls (`R − ρ₊ r₁ > 0`
+//! shrinks, its denominator grows). So `ρ₊` is `R` times the division-free
+//! reciprocal square root ([`crate::math::rsqrt_pos`], within `3.1 · 2⁻²⁴`)
+//! times `1 + 2⁻²¹`, and `T = x/(1 − x)` with `x = (r₁ + e₂)/ρ₁ < 1/3`
+//! (bounded above the same way) is bounded by `x (1 + x + x² + 2x³)` and
+//! rounded up by `2⁻¹⁶` relative: no division and no square root. The
+//! key interval's `δ` is rounded up by `2⁻¹⁶` too, and the margin of each
+//! end is the key's own ([`crate::pencil`]). `R`,
+//! `X`, `Y` and the edge values are computed from coordinates below the
+//! frame's scale `S` and, as distances (divided by `ρ₁`), are off by a few
+//! `2⁻²⁴ S` at most, which the slack of `2⁻²⁰ S` in `r₁` and `e₂` covers
+//! (see [`crate::depth`]).
 
 use crate::camera::Pixel;
 use crate::matching::Outcome;
-use crate::math::{dot, fmax, fmin, sqrt_pos, sub};
+use crate::math::{dot, fmax, fmin, rsqrt_pos, sub, RSQRT_UP};
 use crate::search::{Flow, Visitor, CLIP_UNITS};
 use crate::structure::Status;
 
@@ -76,22 +110,23 @@ const ULP20: f32 = 9.536_743e-7;
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Wedge {
     foe: [f32; 2],
-    /// `p₁'`, `d = p₁' − F`, `â = d/ρ₁`, `ρ₁`.
+    /// `p₁'`, `d = p₁' − F`.
     p: [f32; 2],
     d: [f32; 2],
-    u: [f32; 2],
+    /// `R = |d|² = ρ₁²`, and `1/R` (to rounding).
+    r2: f32,
+    inv_r2: f32,
+    /// `ρ₊ ≥ ρ₁`, and `ρ₊ (r₁ + e₂)`.
     pub(crate) rho: f32,
-    /// `T`, the tangent of the half-angle.
+    rho_re: f32,
+    /// `T`, the tangent of the half-angle (rounded up).
     t: f32,
     /// The wedge's key interval (oriented, widened by the edges' margins):
     /// the index query.
     pub(crate) kl: f32,
     pub(crate) kh: f32,
-    /// Inward normals of the edges whose keys are `kl` and `kh`.
-    nl: [f32; 2],
-    nh: [f32; 2],
-    /// `−(r₁ + e₂)`.
-    pub(crate) lam_lo: f32,
+    /// `X_min = R − ρ₊ (r₁ + e₂)`: `λ ≥ −(r₁ + e₂)` is `X ≥ X_min`.
+    pub(crate) x_min: f32,
 }
 
 /// A point without a wedge: it lies within `3 (r₁ + e₂)` of the FOE
@@ -102,200 +137,229 @@ pub(crate) struct AtFoe;
 impl Wedge {
     /// The wedge of compensated point `p` for a FOE `foe`, the boundary on
     /// the `side` of its row (+1 below), errors `r1`, `e2`, keys with
-    /// `key_scale` (`crate::pencil::Keying`) oriented by `orient`.
+    /// `key_scale` (`crate::pencil::Keying`) oriented by `orient`; `key` is
+    /// `p`'s own raw half-plane key (step 1's; [`crate::pencil::NO_KEY`]
+    /// where it has none).
     #[inline(always)]
     pub(crate) fn new(
         p: [f32; 2],
         (foe, side): ([f32; 2], f32),
         (r1, e2): (f32, f32),
-        key_scale: f32,
-        orient: f32,
+        (key, key_scale, orient): (f32, f32, f32),
     ) -> Result<Self, AtFoe> {
         let d = sub(p, foe);
         let re = r1 + e2;
-        let rho = sqrt_pos(dot(d, d));
-        // (A NaN fails.)
-        if !(rho > 3.0 * re) {
+        let r2 = dot(d, d);
+        // ρ₁ > 3 (r₁ + e₂), and R in `rsqrt_pos`'s range. (A NaN fails.)
+        if !(r2 > 9.0 * (re * re) && r2 < 1.0e30) {
             return Err(AtFoe);
         }
-        let inv = 1.0 / rho;
-        let t = re / (rho - re) * (1.0 + 1.53e-5);
-        // The edge directions d ∓ s T d⊥ (d⊥ = (−d_v, d_u)), named so that
-        // the first has the lower key: turning d by +90° moves its key by
-        // −side, then the orientation (s = ±1, so the products are those
-        // of d ± T d⊥ exactly).
-        let s = if side * orient > 0.0 { -1.0 } else { 1.0 };
-        let st = s * t;
-        let el = [d[0] + st * d[1], d[1] - st * d[0]];
-        let eh = [d[0] - st * d[1], d[1] + st * d[0]];
-        let (tl, th) = (side * el[1], side * eh[1]);
-        let (kl, kh, nl, nh) = if tl > 0.0 && th > 0.0 {
-            // Both edges in the half-plane (the usual wedge).
-            let (il, ih) = (1.0 / (el[0].abs() + tl), 1.0 / (eh[0].abs() + th));
-            let (k0, k1) = (orient * (el[0] * il), orient * (eh[0] * ih));
-            if k0 < k1 {
-                // Inward normals: s perp(e_l) and −s perp(e_h) point
-                // towards d.
-                (
-                    k0 - (key_scale * il + ULP20),
-                    k1 + (key_scale * ih + ULP20),
-                    [-s * el[1], s * el[0]],
-                    [s * eh[1], -s * eh[0]],
-                )
-            } else {
-                edge_keys(d, (el, eh, s), side, key_scale, orient)
-            }
+        let y = rsqrt_pos(r2);
+        let y_up = y * RSQRT_UP;
+        let rho = (r2 * y) * RSQRT_UP;
+        // T = x/(1 − x) with x = (r₁ + e₂)/ρ₁ < 1/3, bounded above by
+        // x (1 + x + x² + 2x³) (the rest of the series, x⁴/(1 − x), is at
+        // most 1.5 x⁴ there), x itself from above.
+        let x = re * y_up;
+        let t = x * (1.0 + x * (1.0 + x * (1.0 + 2.0 * x))) * (1.0 + 1.53e-5);
+        let k = orient * key;
+        // (A NaN fails.)
+        let (kl, kh) = if t <= 0.125 && k.is_finite() {
+            // The keys of the rays within atan T of d's, from d's own
+            // (module docs): `m` bounds its margin (D ≥ ρ₁), `S(k) + 2m`
+            // the keys' rate of change at d, and `δ` the change over the
+            // wedge.
+            let m = key_scale * y_up + ULP20;
+            let ka = k.abs();
+            let rate = 1.0 + ka * (2.0 * ka - 2.0) + 2.0 * m;
+            let delta = t * rate * (1.0 + t * (2.0 + 6.0 * t)) * (1.0 + 1.53e-5) + m;
+            (k - delta, k + delta)
         } else {
-            edge_keys(d, (el, eh, s), side, key_scale, orient)
+            exact_keys(d, t, side, key_scale, orient)
         };
+        let rho_re = rho * re;
         Ok(Self {
             foe,
             p,
             d,
-            u: [d[0] * inv, d[1] * inv],
+            r2,
+            inv_r2: y * y,
             rho,
+            rho_re,
             t,
             kl,
             kh,
-            nl,
-            nh,
-            lam_lo: -re,
+            x_min: r2 - rho_re,
         })
     }
 
-    /// A vertex in the wedge's frame: `w = v − F`, its `λ` and its side of
-    /// the exact line.
+    /// A vertex in the wedge's frame: `w = v − F`, `X = d·w`, `Y = d × w`
+    /// and `T X` (the edge values are `T X ∓ Y`, both at least 0 inside
+    /// the wedge: `|Y| ≤ T X`).
     #[inline(always)]
     pub(crate) fn vertex(&self, v: [f32; 2]) -> WVertex {
         let w = sub(v, self.foe);
+        let x = dot(self.d, w);
         WVertex {
-            w,
-            lam: dot(self.u, w) - self.rho,
-            side: self.d[0] * w[1] - self.d[1] * w[0],
+            x,
+            y: self.d[0] * w[1] - self.d[1] * w[0],
+            tx: self.t * x,
         }
     }
 
-    /// The part of segment `a → b` in the wedge, as [`WedgeWalk::take`]
-    /// takes a segment whose key interval meets the wedge's (`cut`: it
-    /// reaches past the low edge's key, the high edge's): clipped by those
-    /// edges, its `λ` range cut at `λ ≥ −(r₁ + e₂)`; `None` when nothing is
-    /// left.
+    /// The part of segment `a → b` in the wedge: clipped exactly by both
+    /// edges' lines, its `X` range cut at `X ≥ X_min`; `None` when nothing
+    /// is left.
     #[inline(always)]
-    pub(crate) fn part(&self, a: &WVertex, b: &WVertex, cut: (bool, bool)) -> Option<Part> {
-        let dl = b.lam - a.lam;
-        // The part's ends, and whether each is the segment's own end.
-        let (mut l0, mut l1, mut whole) = (a.lam, b.lam, (true, true));
-        if cut.0 || cut.1 {
-            let (t0, t1) = self.clip(a, b, cut)?;
+    pub(crate) fn part(&self, a: &WVertex, b: &WVertex) -> Option<(f32, f32)> {
+        let (mut l0, mut l1) = (a.x, b.x);
+        if !(a.inside() && b.inside()) {
+            let (t0, t1) = clip(a, b)?;
+            let dl = b.x - a.x;
             if t0 != 0.0 {
-                (l0, whole.0) = (a.lam + t0 * dl, false);
+                l0 = a.x + t0 * dl;
             }
             if t1 != 1.0 {
-                (l1, whole.1) = (a.lam + t1 * dl, false);
+                l1 = a.x + t1 * dl;
             }
         }
         let (lo, hi) = if l0 <= l1 { (l0, l1) } else { (l1, l0) };
-        // At λ ≥ −(r₁ + e₂) only. (A NaN fails.)
-        let lo = if lo > self.lam_lo {
+        // At X ≥ X_min only. (A NaN fails.)
+        let lo = if lo > self.x_min {
             lo
-        } else if hi >= self.lam_lo {
-            self.lam_lo
+        } else if hi >= self.x_min {
+            self.x_min
         } else {
             return None;
         };
-        Some(Part { lo, hi, whole })
+        Some((lo, hi))
     }
 
-    /// Whether a piece with the `λ` range `[lo, hi]` is grazing (module
+    /// Whether segment `a → b` certainly has no part ([`Self::part`] gives
+    /// `None`): both ends' `X` below `X_min` by more than the clip's
+    /// interpolation can round (`X_a + t (X_b − X_a)` is within `3.1 · 2⁻²⁴
+    /// (|X_a| + |X_b|)` of the exact value, which is at most the larger
+    /// `X`; the margin taken is `8 · 2⁻²⁴`).
+    #[inline(always)]
+    pub(crate) fn before(&self, a: &WVertex, b: &WVertex) -> bool {
+        fmax(a.x, b.x) + (a.x.abs() + b.x.abs()) * 4.77e-7 < self.x_min
+    }
+
+    /// Whether a piece with the `X` range `[lo, hi]` is grazing (module
     /// docs); it stays so as the piece grows.
     #[inline(always)]
     pub(crate) fn grazing(&self, lo: f32, hi: f32, cot_twice: f32) -> bool {
-        hi - lo > self.t * (self.rho + lo) * cot_twice
+        hi - lo > (self.t * cot_twice) * lo
     }
 
     /// `best` lowered to the exact line's crossing of segment `a → b`, if
     /// it has one (its ends on the line's two sides) nearer than `best`
-    /// and beyond `λ = −(r₁ + e₂)`.
+    /// and beyond `X_min`.
     #[inline(always)]
     pub(crate) fn crossing(&self, a: &WVertex, b: &WVertex, best: f32) -> f32 {
-        let (sa, sb) = (a.side, b.side);
+        let (sa, sb) = (a.y, b.y);
         if crate::depth::side_bit(sa) != crate::depth::side_bit(sb) {
-            let lam = a.lam + sa / (sa - sb) * (b.lam - a.lam);
-            if lam < best && lam > self.lam_lo {
-                return lam;
+            let x = a.x + sa / (sa - sb) * (b.x - a.x);
+            if x < best && x > self.x_min {
+                return x;
             }
         }
         best
     }
 
-    /// The part of the segment `a → b` inside the edges' lines where `cut`
-    /// says (low edge, high edge; the side towards `d` is inside), as its
-    /// range `(t0, t1)` along the segment; `None` when it has none.
+    /// The point of the exact line at `X` (for a crossing: the frame-2
+    /// point, on the polyline up to rounding): `p₁' + d (X − R)/R`.
     #[inline(always)]
-    fn clip(&self, a: &WVertex, b: &WVertex, cut: (bool, bool)) -> Option<(f32, f32)> {
-        let (mut t0, mut t1) = (0.0f32, 1.0f32);
-        for (cut, n) in [(cut.0, self.nl), (cut.1, self.nh)] {
-            if cut {
-                let (ca, cb) = (dot(n, a.w), dot(n, b.w));
-                if ca < 0.0 {
-                    if cb < 0.0 {
-                        return None;
-                    }
-                    t0 = fmax(t0, ca / (ca - cb));
-                } else if cb < 0.0 {
-                    t1 = fmin(t1, ca / (ca - cb));
-                }
-            }
-        }
-        // (A NaN fails.)
-        (t0 <= t1).then_some((t0, t1))
-    }
-
-    /// The point of the exact line at `λ` (for a crossing: the frame-2
-    /// point, on the polyline up to rounding).
-    #[inline(always)]
-    pub(crate) fn point_at(&self, lam: f32) -> [f32; 2] {
-        [self.p[0] + lam * self.u[0], self.p[1] + lam * self.u[1]]
+    pub(crate) fn point_at(&self, x: f32) -> [f32; 2] {
+        let f = (x - self.r2) * self.inv_r2;
+        [self.p[0] + f * self.d[0], self.p[1] + f * self.d[1]]
     }
 
     /// The depth estimate and the stick's ends in the compensated frame,
-    /// `(s, s_near, s_far)` (module docs), for `w = W'`; `None` when the
-    /// far end is unbounded (the disparity is not larger than its error).
+    /// `(s, s_near, s_far)` (module docs), for `w = W'`, from the
+    /// crossing's `X` and the piece's range; `None` when the far end is
+    /// unbounded (the disparity is not larger than its error).
     #[inline(always)]
     pub(crate) fn depths(
         &self,
         w: f32,
         r1: f32,
-        (lam, lo, hi): (f32, f32, f32),
+        (x, lo, hi): (f32, f32, f32),
     ) -> Option<(f32, f32, f32)> {
-        let den_far = lo + self.lam_lo;
+        let r2 = self.r2;
+        let den_far = (lo - r2) - self.rho_re;
         // (A NaN fails.)
         if !(den_far > 0.0) {
             return None;
         }
-        let s = w + w * (self.rho / lam);
-        let s_far = w + w * ((self.rho + r1) / den_far);
-        let s_near = w + w * ((self.rho - r1) / (hi - self.lam_lo));
+        let rr1 = self.rho * r1;
+        let s = w + w * (r2 / (x - r2));
+        let s_far = w + w * ((r2 + rr1) / den_far);
+        let s_near = w + w * ((r2 - rr1) / ((hi - r2) + self.rho_re));
         Some((s, s_near, s_far))
     }
 }
 
-/// The wedge's key interval and the inward normals of the edges whose
-/// keys bound it, in general: the keys of the edge directions `el`, `eh`
-/// (named as in [`Wedge::new`]), each widened by its margin; an edge
-/// outside the half-plane stands for the key limit where the wedge crosses
-/// the FOE's row, on the side of `d` (the wedge is narrower than 53°); the
-/// lower key is the low end (the first edge's on a tie), and the interval
-/// is empty when the whole wedge lies beyond the row.
+/// The part of the segment `a → b` inside both edges' lines (the side of
+/// `d` is inside), as its range `(t0, t1)` along the segment; `None` when
+/// it has none.
+#[inline(always)]
+fn clip(a: &WVertex, b: &WVertex) -> Option<(f32, f32)> {
+    let (mut t0, mut t1) = (0.0f32, 1.0f32);
+    // The `−` edge (T X − Y), then the `+` edge (T X + Y).
+    let (ca, cb) = (a.tx - a.y, b.tx - b.y);
+    if ca < 0.0 {
+        if cb < 0.0 {
+            return None;
+        }
+        t0 = ca / (ca - cb);
+    } else if cb < 0.0 {
+        t1 = ca / (ca - cb);
+    }
+    let (ca, cb) = (a.tx + a.y, b.tx + b.y);
+    if ca < 0.0 {
+        if cb < 0.0 {
+            return None;
+        }
+        t0 = fmax(t0, ca / (ca - cb));
+    } else if cb < 0.0 {
+        t1 = fmin(t1, ca / (ca - cb));
+    }
+    // (A NaN fails.)
+    (t0 <= t1).then_some((t0, t1))
+}
+
+/// The wedge's key interval from its edges' own keys, each widened by its
+/// margin (a wide wedge, `T > 1/8`, or a point without a key): for `d`,
+/// `T`, and the keys as in [`Wedge::new`].
 #[cold]
 #[inline(never)]
+fn exact_keys(d: [f32; 2], t: f32, side: f32, key_scale: f32, orient: f32) -> (f32, f32) {
+    // The edge directions d ∓ s T d⊥ (d⊥ = (−d_v, d_u)), named so that
+    // the first has the lower key: turning d by +90° moves its key by
+    // −side, then the orientation (s = ±1, so the products are those of
+    // d ± T d⊥ exactly).
+    let s = if side * orient > 0.0 { -1.0 } else { 1.0 };
+    let st = s * t;
+    let el = [d[0] + st * d[1], d[1] - st * d[0]];
+    let eh = [d[0] - st * d[1], d[1] + st * d[0]];
+    edge_keys(d, (el, eh, s), side, key_scale, orient)
+}
+
+/// The wedge's key interval in general: the keys of the edge directions
+/// `el`, `eh` (named as in [`Wedge::new`]), each widened by its margin; an
+/// edge outside the half-plane stands for the key limit where the wedge
+/// crosses the FOE's row, on the side of `d` (the wedge is narrower than
+/// 53°); the lower key is the low end, and the interval is empty when the
+/// whole wedge lies beyond the row.
+#[inline(always)]
 fn edge_keys(
     d: [f32; 2],
     (el, eh, s): ([f32; 2], [f32; 2], f32),
     side: f32,
     key_scale: f32,
     orient: f32,
-) -> (f32, f32, [f32; 2], [f32; 2]) {
+) -> (f32, f32) {
     let limit = orient * if d[0] >= 0.0 { 1.0 } else { -1.0 };
     let key = |e: [f32; 2]| {
         let te = side * e[1];
@@ -307,46 +371,43 @@ fn edge_keys(
         }
     };
     let ((k0, m0, in0), (k1, m1, in1)) = (key(el), key(eh));
-    // Inward normals: s perp(e_l) and −s perp(e_h) point towards d.
-    let (n0, n1) = ([-s * el[1], s * el[0]], [s * eh[1], -s * eh[0]]);
     // The first edge's is the lower key on a tie when it is d − T d⊥'s.
     let first_low = if s > 0.0 { k0 <= k1 } else { k0 < k1 };
-    let (kl, nl, kh, nh) = if first_low {
-        (k0 - m0, n0, k1 + m1, n1)
-    } else {
-        (k1 - m1, n1, k0 + m0, n0)
-    };
     if !(side * d[1] > 0.0 || in0 || in1) {
         // The whole wedge lies beyond the FOE's row: no keyed point.
-        return (f32::INFINITY, f32::NEG_INFINITY, nl, nh);
+        return (f32::INFINITY, f32::NEG_INFINITY);
     }
-    (kl, kh, nl, nh)
+    if first_low {
+        (k0 - m0, k1 + m1)
+    } else {
+        (k1 - m1, k0 + m0)
+    }
 }
 
-/// A frame-2 vertex in a wedge's frame ([`Wedge::vertex`]).
+/// A frame-2 vertex in a wedge's frame ([`Wedge::vertex`]): `X`, `Y` and
+/// `T X`.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct WVertex {
-    w: [f32; 2],
-    lam: f32,
-    side: f32,
+    x: f32,
+    y: f32,
+    tx: f32,
 }
 
 impl WVertex {
     /// A placeholder, never read before it is overwritten.
     pub(crate) const NONE: WVertex = WVertex {
-        w: [0.0; 2],
-        lam: 0.0,
-        side: 0.0,
+        x: 0.0,
+        y: 0.0,
+        tx: 0.0,
     };
-}
 
-/// A segment's part in a wedge ([`Wedge::part`]): its `λ` range, and
-/// whether each end is the segment's own (no edge cut it off).
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Part {
-    pub(crate) lo: f32,
-    pub(crate) hi: f32,
-    whole: (bool, bool),
+    /// Whether both edge values are at least 0, `|Y| ≤ T X` (`T X − Y ≥ 0`
+    /// exactly when `T X ≥ Y` in IEEE arithmetic, and `T X + Y ≥ 0` when
+    /// `T X ≥ −Y`). (A NaN fails.)
+    #[inline(always)]
+    fn inside(&self) -> bool {
+        self.y.abs() <= self.tx
+    }
 }
 
 /// The walk over a polyline's segments through one wedge (the rules of
@@ -357,7 +418,7 @@ pub(crate) struct WedgeWalk {
     next: usize,
     lo: f32,
     hi: f32,
-    /// The nearest crossing's `λ` (infinite: none).
+    /// The nearest crossing's `X` (infinite: none).
     best: f32,
     open: bool,
 }
@@ -389,27 +450,22 @@ impl WedgeWalk {
         if klo > wedge.kh || khi < wedge.kl {
             return Ok(());
         }
-        let cut = (klo < wedge.kl, khi > wedge.kh);
-        self.take_met(wedge, j, (a, b), cut, segments, cot_twice)
+        self.take_met(wedge, j, (a, b), segments, cot_twice)
     }
 
-    /// [`Self::take`] for a segment whose interval meets the wedge's;
-    /// `cut`: whether it reaches past the low edge's key, and past the
-    /// high edge's.
+    /// [`Self::take`] for a segment whose interval meets the wedge's.
     #[inline(always)]
     pub(crate) fn take_met(
         &mut self,
         wedge: &Wedge,
         j: usize,
         (a, b): (&WVertex, &WVertex),
-        cut: (bool, bool),
         segments: usize,
         cot_twice: f32,
     ) -> Result<(), Status> {
-        let Some(part) = wedge.part(a, b, cut) else {
+        let Some((lo, hi)) = wedge.part(a, b) else {
             return Ok(());
         };
-        let (lo, hi) = (part.lo, part.hi);
         if self.next == j {
             self.lo = fmin(self.lo, lo);
             self.hi = fmax(self.hi, hi);
@@ -420,12 +476,11 @@ impl WedgeWalk {
             self.lo = lo;
             self.hi = hi;
             if j == 0 {
-                // The first vertex is in the wedge when no edge cut it off.
-                self.open |= end_inside(part.whole.0, a.lam, wedge.lam_lo);
+                self.open |= end_inside((a.x, a.y, a.tx), wedge.x_min);
             }
         }
         if j + 1 == segments {
-            self.open |= end_inside(part.whole.1, b.lam, wedge.lam_lo);
+            self.open |= end_inside((b.x, b.y, b.tx), wedge.x_min);
         }
         self.next = j + 1;
         if wedge.grazing(self.lo, self.hi, cot_twice) {
@@ -435,7 +490,7 @@ impl WedgeWalk {
         Ok(())
     }
 
-    /// The outcome once the segments are through (`λ` in pixels).
+    /// The outcome once the segments are through (in `X`, [`Wedge::vertex`]).
     #[inline(always)]
     pub(crate) fn outcome(&self) -> Outcome {
         if self.open {
@@ -452,13 +507,13 @@ impl WedgeWalk {
     }
 }
 
-/// Whether an end vertex of the polyline lies in the wedge: no edge cut
-/// it off (`whole`) and its `λ` is at least `lam_lo`. (Out of line: the
-/// walk's usual segment is no end.)
+/// Whether an end vertex `a` of the polyline lies in the wedge
+/// (both edge values at least 0, `X ≥ X_min`). (Out of line, its arguments by value: the walk's
+/// usual segment is no end, and its values stay in registers.)
 #[cold]
 #[inline(never)]
-fn end_inside(whole: bool, lam: f32, lam_lo: f32) -> bool {
-    whole && lam >= lam_lo
+fn end_inside((x, y, tx): (f32, f32, f32), x_min: f32) -> bool {
+    y.abs() <= tx && x >= x_min
 }
 
 /// A wedge walk as an index [`Visitor`] (the loose index, and the
@@ -580,7 +635,13 @@ mod tests {
                 continue;
             }
             let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
-            let Ok(wedge) = Wedge::new(p, (foe, side), (r1, e2), key_scale, orient) else {
+            // p's own key (step 1's), or none (the exact edge keys).
+            let key = if rng.next() < 0.2 {
+                crate::pencil::NO_KEY
+            } else {
+                crate::pencil::half_key(p, (foe, side, 4.0), key_scale).0
+            };
+            let Ok(wedge) = Wedge::new(p, (foe, side), (r1, e2), (key, key_scale, orient)) else {
                 continue;
             };
             let i = 1.0 / (dq[0].abs() + t);

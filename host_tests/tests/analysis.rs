@@ -76,9 +76,10 @@ fn motion_factor_tends_to_n_for_small_motion() {
 fn common_field_motion_stereo_vs_ordinary_stereo() {
     let (h, tilt, f, rows, cols) = (1.0f32, 23f32.to_radians(), 800.0f32, 480.0f32, 512.0f32);
     let half_fov = (rows / 2.0 / f).atan();
-    let (near, far) = ground_interval(h, tilt, half_fov)
+    let r = ground_interval(h, tilt, half_fov)
         .unwrap()
         .expect("ground in view");
+    let (near, far) = (r.lo, r.hi);
     println!("ground in view: {near:.2} to {far:.2} (paper: 1.4 to 8.7)");
     // Independent: the lowest ray is tilt + half field below the horizon.
     assert!((f64::from(near) - 1.0 / (f64::from(tilt + half_fov)).tan()).abs() < 1e-4);

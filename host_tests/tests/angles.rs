@@ -240,7 +240,9 @@ fn ground_in_view_reduces_the_tilt() {
             };
             (h / lower.tan(), far)
         });
-        let got = ground_interval(h as f32, x, half_fov as f32).unwrap();
+        let got = ground_interval(h as f32, x, half_fov as f32)
+            .unwrap()
+            .map(|r| (r.lo, r.hi));
         match (got, want) {
             (None, None) => {}
             (Some((gn, gf)), Some((wn, wf))) => {

@@ -436,7 +436,7 @@ fn check_map(d: &Drive, input: &host_tests::drives::Input, policy: FusionConfig)
                     .position(|px| cam.normalise(*px) == p.ray)
                     .expect("the map point's ray is a key-frame pixel's");
                 let z = d.z_true(key, b, i);
-                let ray = [f64::from(p.ray.0) * z, f64::from(p.ray.1) * z, z];
+                let ray = [f64::from(p.ray[0]) * z, f64::from(p.ray[1]) * z, z];
                 let kp = &d.frames[key].pose;
                 let world = synth::add(kp.centre, synth::mv(&kp.rot, ray));
                 let truth = d.in_vehicle(j, world);
@@ -687,7 +687,7 @@ fn range_constraints_narrow_or_flag() {
                 continue;
             };
             tried += 1;
-            let (x, y) = cam.normalise(input.frames[0][b][i]);
+            let [x, y] = cam.normalise(input.frames[0][b][i]);
             let z = d.z_true(0, b, i);
             let r = z * (1.0 + f64::from(x * x + y * y)).sqrt();
             let q = if i % 10 == 0 {
@@ -771,7 +771,7 @@ fn road_geometry_from_the_fused_map() {
                             .filter(|(_, p)| p.status == FusedStatus::Consistent)
                             .filter_map(|(i, p)| {
                                 let iv = p.interval?;
-                                let (x, y) = cam.normalise(input.frames[kid][b][i]);
+                                let [x, y] = cam.normalise(input.frames[kid][b][i]);
                                 Some(Sample {
                                     x,
                                     y,

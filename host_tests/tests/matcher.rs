@@ -86,3 +86,69 @@ fn indexed_search_equals_reference_on_random_scenarios() {
         both(&s, true);
     }
 }
+
+/// The same on every frame pair of the firmware's embedded data
+/// (`src/bin/data/`): the benchmark and stress pairs, the demo drive, and
+/// the adversarial inputs (spurious points in either frame, folds, radial
+/// stairs, zig-zags, a FOE on or near a boundary), whose frame-2 indexes
+/// set segments aside or come out loose.
+#[test]
+fn indexed_search_equals_reference_on_embedded_data() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../src/bin/data");
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .expect("data dir")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "bin"))
+        .collect();
+    files.sort();
+    let mut pairs = 0;
+    for path in &files {
+        let bytes = std::fs::read(path).expect("read");
+        let Some((cam, frames)) = host_tests::drive::decode(&bytes) else {
+            continue;
+        };
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
+        let mk = |f: &host_tests::drive::DriveFrame| {
+            let mut fr = roadstereo::Frame::<N, B>::new(cam);
+            for b in f.boundaries.iter().take(B) {
+                let pts: Vec<_> = b
+                    .iter()
+                    .take(N)
+                    .map(|q| roadstereo::Pixel::new(q[0], q[1]))
+                    .collect();
+                fr.push_boundary(&pts).expect("boundary");
+            }
+            fr
+        };
+        for w in frames.windows(2).take(6) {
+            let (f1, f2) = (mk(&w[0]), mk(&w[1]));
+            let m = roadstereo::Motion::new(w[1].translation, w[1].rotation).expect("motion");
+            let unlimited = Config::DEFAULT
+                .with_work_budget(Config::MAX_WORK_PER_POINT)
+                .expect("valid");
+            let mut p = Box::new(Processor::<N, B>::new(unlimited));
+            let _ = p.process(&f1, None);
+            let fast = p.process_against_kept(&f2, &m).expect("structure").clone();
+            let slow = p
+                .reference_against_kept(&f2, &m)
+                .expect("structure")
+                .clone();
+            if let Some((k, i, a, b)) = first_difference(&fast, &slow) {
+                panic!("{name:?}: boundary {k} point {i}: indexed {a:?}, reference {b:?}");
+            }
+            let mut d = Box::new(Processor::<N, B>::new(Config::DEFAULT));
+            let _ = d.process(&f1, None);
+            let budgeted = d.process_against_kept(&f2, &m).expect("structure");
+            for (x, y) in budgeted.boundaries().iter().zip(slow.boundaries()) {
+                for (p, q) in x.points().iter().zip(y.points()) {
+                    assert!(
+                        p == q || p.status() == Status::OverBudget,
+                        "{name:?}: with the default budget {p:?}, reference {q:?}"
+                    );
+                }
+            }
+            pairs += 1;
+        }
+    }
+    assert!(pairs >= 60, "{pairs}");
+}

@@ -208,11 +208,7 @@ fn rotation_error_bound_holds() {
                 let Some(c0) = g0.compensate(p1) else {
                     continue;
                 };
-                let bound = rotation_shift_bound(
-                    c0.pixel,
-                    (cam.fx(), cam.fy(), cam.cx(), cam.cy()),
-                    [eps; 3],
-                );
+                let bound = rotation_shift_bound(c0.pixel(), &cam, [eps; 3]);
                 for corner in 0..8 {
                     let a = m.angles();
                     let da = [0, 1, 2].map(|i| if corner >> i & 1 == 1 { eps } else { -eps });
@@ -220,7 +216,7 @@ fn rotation_error_bound_holds() {
                         Motion::new(m.translation(), [a[0] + da[0], a[1] + da[1], a[2] + da[2]])
                             .unwrap();
                     let c1 = PairGeometry::new(&cam, &cam, &mk).compensate(p1).unwrap();
-                    let shift = (c1.pixel[0] - c0.pixel[0]).hypot(c1.pixel[1] - c0.pixel[1]);
+                    let shift = (c1.pixel().u - c0.pixel().u).hypot(c1.pixel().v - c0.pixel().v);
                     assert!(shift <= bound, "seed {seed}: shift {shift} > bound {bound}");
                     worst_use = worst_use.max(shift / bound);
                 }
@@ -347,7 +343,6 @@ fn rotation_shift_bound_at_and_beyond_its_range() {
     use roadstereo::motion_error::rotation_shift_bound;
     use roadstereo::{Camera, PairGeometry, Pixel};
     let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).unwrap();
-    let intr = (cam.fx(), cam.fy(), cam.cx(), cam.cy());
     let m = Motion::new([0.0, -0.15, 0.37], [-0.001, 0.08, 0.03]).unwrap();
     let g0 = PairGeometry::new(&cam, &cam, &m);
     // Σ |ε| = 0.0999: the end of the range (0.1 / 3 rounds up in f32).
@@ -365,7 +360,7 @@ fn rotation_shift_bound_at_and_beyond_its_range() {
             let Some(c0) = g0.compensate(p1) else {
                 continue;
             };
-            let bound = rotation_shift_bound(c0.pixel, intr, eps);
+            let bound = rotation_shift_bound(c0.pixel(), &cam, eps);
             assert!(bound.is_finite(), "{eps:?}");
             for corner in 0..8 {
                 let a = m.angles();
@@ -373,7 +368,7 @@ fn rotation_shift_bound_at_and_beyond_its_range() {
                 let mk = Motion::new(m.translation(), [a[0] + da[0], a[1] + da[1], a[2] + da[2]])
                     .unwrap();
                 let c1 = PairGeometry::new(&cam, &cam, &mk).compensate(p1).unwrap();
-                let shift = (c1.pixel[0] - c0.pixel[0]).hypot(c1.pixel[1] - c0.pixel[1]);
+                let shift = (c1.pixel().u - c0.pixel().u).hypot(c1.pixel().v - c0.pixel().v);
                 assert!(shift <= bound, "({u}, {v}): shift {shift} > bound {bound}");
                 checked += 1;
             }
@@ -388,7 +383,7 @@ fn rotation_shift_bound_at_and_beyond_its_range() {
         [0.0, f32::INFINITY, 0.0],
     ] {
         assert_eq!(
-            rotation_shift_bound([255.5, 239.5], intr, eps),
+            rotation_shift_bound(Pixel::new(255.5, 239.5), &cam, eps),
             f32::INFINITY,
             "{eps:?}"
         );

@@ -113,6 +113,7 @@ pub struct FusionConfig {
 /// Why a [`FusionConfig`] was rejected.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum FusionConfigError {
     /// `max_partners` is not in `1..=MAX_PARTNERS`.
     Partners,
@@ -235,6 +236,7 @@ pub struct ChainedMotion {
 /// Why a frame or a constraint was rejected. Nothing changes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum FusionError {
     /// A previous frame exists but no motion was given.
     MissingMotion,
@@ -584,7 +586,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             .and_then(|b| b.points().get(index))
             .copied()
             .ok_or(FusionError::NoSuchPoint)?;
-        let (x, y) = kept.camera().normalise(p);
+        let [x, y] = kept.camera().normalise(p);
         let n = sqrt(1.0 + x * x + y * y);
         // (sqrt is within 2e-7 of the truth; 1e-6 covers it and the division.)
         let (zn, zf) = (near / n * (1.0 - 1.0e-6), far / n * (1.0 + 1.0e-6));

@@ -17,6 +17,7 @@ use core::fmt;
 /// framing found before any byte reached the decoder.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum Error<E, P = core::convert::Infallible> {
     /// The bus (SPI or UART) failed; the packet in progress is ended (the
     /// receiver reports it truncated) and the next one decodes as usual.

@@ -12,6 +12,7 @@ use crate::{BoundaryError, CameraError, ConfigError, MotionError};
 /// would have given had the bad one never come.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum WireError {
     /// The frame delimiter came early: inside a COBS run, or before a
     /// whole header and CRC (`len` bytes decoded).
@@ -138,6 +139,7 @@ pub enum WireError {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[repr(u8)]
 #[allow(missing_docs)]
+#[non_exhaustive]
 pub enum ErrorKind {
     Truncated = 1,
     BadCrc,

@@ -48,29 +48,31 @@ use crc::{Crc, Table};
 pub const VERSION: u8 = 1;
 /// The first two bytes of every packet.
 pub const MAGIC: [u8; 2] = *b"RS";
-/// Bytes before the payload.
-pub const HEADER_LEN: usize = 10;
+/// Bytes before the payload. (The layout lengths are the format's,
+/// `docs/wire.md`; a caller sizes its buffers with [`frame_packet_max`],
+/// [`result_packet_max`] and [`cobs_max`].)
+pub(crate) const HEADER_LEN: usize = 10;
 /// Bytes of the CRC after the payload.
-pub const CRC_LEN: usize = 4;
+pub(crate) const CRC_LEN: usize = 4;
 /// A frame payload's fixed part: timestamp, frame id, image size,
 /// boundary count and a reserved byte.
-pub const FRAME_HEAD_LEN: usize = 18;
+pub(crate) const FRAME_HEAD_LEN: usize = 18;
 /// A boundary's fixed part: index, quality, error radius, point count.
-pub const BOUNDARY_HEAD_LEN: usize = 6;
+pub(crate) const BOUNDARY_HEAD_LEN: usize = 6;
 /// One point: `u`, `v` as `u16` in 1/16 px ([`raw_to_px`]).
-pub const POINT_LEN: usize = 4;
+pub(crate) const POINT_LEN: usize = 4;
 /// A motion payload (fixed size).
-pub const MOTION_LEN: usize = 52;
+pub(crate) const MOTION_LEN: usize = 52;
 /// A camera payload (fixed size).
-pub const CAMERA_LEN: usize = 20;
+pub(crate) const CAMERA_LEN: usize = 20;
 /// A report payload (fixed size).
-pub const REPORT_LEN: usize = 20;
+pub(crate) const REPORT_LEN: usize = 20;
 /// A result payload's fixed part.
-pub const RESULT_HEAD_LEN: usize = 56;
+pub(crate) const RESULT_HEAD_LEN: usize = 56;
 /// A result boundary's fixed part.
-pub const RESULT_BOUNDARY_LEN: usize = 4;
+pub(crate) const RESULT_BOUNDARY_LEN: usize = 4;
 /// A result point with a depth: status and five `f32`.
-pub const RESULT_POINT_MAX: usize = 21;
+pub(crate) const RESULT_POINT_MAX: usize = 21;
 /// The largest localisation-error radius a boundary may carry, pixels
 /// (the limit of [`crate::Config`]).
 pub const MAX_RADIUS_PX: f32 = 100.0;
@@ -189,11 +191,11 @@ impl Default for DataIds {
 /// The CRC's implementation: one 256-entry table (1 KiB of flash), about
 /// five instructions a byte on the Cortex-M4F; README ("The link") gives
 /// the measured trade-off against no table and 16 tables.
-pub type CrcTable = Table<1>;
+pub(crate) type CrcTable = Table<1>;
 
 /// CRC-32/AUTOSAR (polynomial `0xF4ACFB13`, reflected, init and xorout
 /// `0xFFFFFFFF`).
-pub static CRC: Crc<u32, CrcTable> = Crc::<u32, CrcTable>::new(&crc::CRC_32_AUTOSAR);
+pub(crate) static CRC: Crc<u32, CrcTable> = Crc::<u32, CrcTable>::new(&crc::CRC_32_AUTOSAR);
 
 /// What the CRC register gives over a packet *including* its CRC (low
 /// byte first) when the packet is intact: the decoder checks that instead
@@ -212,7 +214,7 @@ pub(crate) const RESIDUE: u32 = {
 /// are what row-scanning detectors report: in COBS a zero byte ends a run,
 /// and each run costs the decoder a fixed overhead, so point data without
 /// zeros is decoded in long runs.
-pub const RAW_MINUS_ONE_PX: u16 = 0x0101;
+pub(crate) const RAW_MINUS_ONE_PX: u16 = 0x0101;
 
 /// A point coordinate on the wire → pixels: `raw / 16 − 17.0625`, i.e.
 /// `(raw − 0x0101) / 16 − 1` (exact in `f32`).

@@ -322,7 +322,9 @@ fn fig3(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
             .draw_series(LineSeries::new(curve, col.stroke_width(2)))?
             .label(format!("tilt {deg}°"))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col));
-        if let Some((near, far)) = ground_interval(1.0, t, half_fov)? {
+        if let Some(roadstereo::geometry::Range { lo: near, hi: far }) =
+            ground_interval(1.0, t, half_fov)?
+        {
             let y = -1.5 - 1.5 * k as f64;
             chart.draw_series(std::iter::once(PathElement::new(
                 vec![(f64::from(near), y), (f64::from(far.min(12.0)), y)],
@@ -559,7 +561,7 @@ fn fig_fusion(dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
     let policy = FusionConfig::DEFAULT.with_tilt(tilt as f32)?;
     // Stick (or fused interval) of key-frame point i as world segment.
     let seg = |key: usize, b: usize, i: usize, near: f32, far: f32| -> (V3, V3) {
-        let (x, y) = cam.normalise(input.frames[key][b][i]);
+        let [x, y] = cam.normalise(input.frames[key][b][i]);
         let pose = &d.frames[key].pose;
         (
             world(pose, [x * near, y * near, near]),

@@ -51,9 +51,10 @@ use crate::wedge::{WVertex, Wedge, WedgeWalk, WedgeWalker};
 /// `N` points. No heap: everything lives inside this value, so it can be a
 /// `static`.
 ///
-/// Size (bytes, 32-bit target): about `8·B·N` (previous frame) + `16·N`
-/// (search index) + `32·B·N` (output) + ~200; for `N = 256, B = 2` about
-/// 24.6 KiB, checked by a test.
+/// Size (bytes, 32-bit target): `8·B·N` (previous frame) + about
+/// `24.75·N` (search index) + `32·B·N` (output) + a few dozen; for `N =
+/// 256, B = 2` exactly 26 888 B, asserted at compile time below (issue 11
+/// allows up to 28 KiB; README, "Memory", says what the index's bytes buy).
 ///
 /// ```
 /// use roadstereo::{Camera, Config, Frame, Motion, Pixel, Processor, Step};
@@ -1270,3 +1271,9 @@ fn segment_distance2(p: [f32; 2], a: [f32; 2], b: [f32; 2]) -> f32 {
     let d = [ap[0] - t * ab[0], ap[1] - t * ab[1]];
     crate::math::dot(d, d)
 }
+
+// `Processor<256, 2>` is 26 888 B on the vehicle controller (README,
+// "Memory"): a change that grows it fails the build, one that shrinks it
+// lowers this figure.
+#[cfg(target_pointer_width = "32")]
+const _: () = assert!(core::mem::size_of::<Processor<256, 2>>() <= 26_888);

@@ -1,9 +1,10 @@
-//! State + output of the per-frame processor fit the 24 KiB budget.
+//! State + output of the per-frame processor fit their budget: exactly
+//! what they need (README, "Memory"; issue 11 allows up to 28 KiB).
 
 use roadstereo::{Frame, Processor, Structure};
 
 #[test]
-fn processor_for_two_boundaries_of_256_points_fits_24_kib() {
+fn processor_for_two_boundaries_of_256_points_fits_its_budget() {
     let processor = core::mem::size_of::<Processor<256, 2>>();
     let frame = core::mem::size_of::<Frame<256, 2>>();
     let output = core::mem::size_of::<Structure<256, 2>>();
@@ -13,7 +14,9 @@ fn processor_for_two_boundaries_of_256_points_fits_24_kib() {
         processor - frame - output
     );
     // Everything the processor keeps (state + output + scratch) is inside it.
-    assert!(processor <= 28 * 1024, "{processor} B");
+    // 26 888 B on the 32-bit target (asserted at compile time there); the
+    // host's `usize` fields make it 56 B more.
+    assert!(processor <= 26_944, "{processor} B");
 }
 
 /// The key-frame fusion's state and the road map beside the processor fit

@@ -19,7 +19,7 @@ mod fw;
 
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
-use roadstereo::fusion::{ChainedMotion, FusedStatus, Fusion, FusionConfig};
+use roadstereo::fusion::{ChainedMotion, FusedStatus, Fusion, FusionConfig, FusionStep, KeyFrame};
 use roadstereo::{Config, Frame, Status};
 use static_cell::ConstStaticCell;
 
@@ -82,74 +82,108 @@ fn main() -> ! {
             defmt::error!("frame {=u32}: rejected", i);
             fw::exit(false)
         };
-        let s = fusion.structure();
         if i == 0 {
             defmt::info!("frame=0 first instr={=u32}", instr);
             continue;
         }
-        let Some(key) = fusion.key() else {
-            defmt::error!("frame {=u32}: no key frame", i);
-            fw::exit(false)
-        };
-        let counts = key.counts();
-        // Median relative width (z_far − z_near)/z_mid of the fused points.
-        let mut n = 0;
-        for b in 0..2 {
-            for p in key.points(b) {
-                if let (FusedStatus::Consistent, Some(iv), Some(slot)) =
-                    (p.status, p.interval, widths.get_mut(n))
-                {
-                    *slot = (iv.z_far - iv.z_near) / (0.5 * (iv.z_far + iv.z_near));
-                    n += 1;
-                }
-            }
-        }
-        let fused_widths = widths.get_mut(..n).unwrap_or(&mut []);
-        fused_widths.sort_unstable_by(f32::total_cmp);
-        let median = fused_widths.get(n / 2).copied().unwrap_or(0.0);
-        let map = fusion.map();
-        let paired = step.paired.unwrap_or_default();
-        let c = s.status_counts();
-        let points: usize = c.iter().sum();
-        let g = |st: Status| c.get(st as usize).copied().unwrap_or(0) as u32;
+        let points = log_frame(i, fusion, &step, instr, &mut widths);
         total_instr += u64::from(instr);
         total_points += points as u64;
         worst = worst.max(instr);
-        defmt::info!(
-            "frame={=u32} points={=u32} ok={=u32} ambiguous={=u32} at_foe={=u32} behind={=u32} no_intersection={=u32} grazing={=u32} nonpositive={=u32} beyond={=u32} unbounded={=u32} folded={=u32} out_of_view={=u32} boundary_end={=u32} over_budget={=u32} instr={=u32} budget_permille={=u32} digest={=u32:08x} key={=u32} partner={=u16} retired={=bool} fused={=u32} single={=u32} inconsistent={=u32} conflicts={=u32} width_permille={=u32} map={=u32} map_behind={=u32} map_room={=u32} fusion_digest={=u32:08x}",
-            i,
-            points as u32,
-            g(Status::Ok),
-            g(Status::Ambiguous),
-            g(Status::AtFoe),
-            g(Status::BehindCamera),
-            g(Status::NoIntersection),
-            g(Status::Grazing),
-            g(Status::NonPositiveDepth),
-            g(Status::BeyondMaxDepth),
-            g(Status::Unbounded),
-            g(Status::Folded),
-            g(Status::OutOfView),
-                g(Status::BoundaryEnd),
-            g(Status::OverBudget),
-            instr,
-            (u64::from(instr) * 1000 / u64::from(BUDGET_INSTRUCTIONS)) as u32,
-            s.digest(),
-            key.id(),
-            step.partner,
-            step.retired.is_some(),
-            counts.consistent,
-            counts.single,
-            counts.inconsistent,
-            paired.conflicts,
-            (median * 1000.0) as u32,
-            (map.points(0).count() + map.points(1).count()) as u32,
-            map.drops().behind,
-            map.drops().capacity,
-            fusion.digest()
-        );
     }
-    // A sample of the last structure: every 24th point with a depth.
+    log_samples(fusion);
+    let per_point = total_instr.checked_div(total_points).unwrap_or(0) as u32;
+    defmt::info!(
+        "done frames={=u32} points={=u64} instr={=u64} per_point={=u32} worst_frame={=u32}",
+        drive.frames,
+        total_points,
+        total_instr,
+        per_point,
+        worst
+    );
+    fw::exit(true)
+}
+
+/// The frame's log line (the host's `cargo xtask demo --check` compares
+/// it): the statuses, the instructions, the digests and the fusion's
+/// state after pair `i`. Returns the points processed.
+fn log_frame(
+    i: u32,
+    fusion: &Fusion<256, 2, 512>,
+    step: &FusionStep,
+    instr: u32,
+    widths: &mut [f32; 512],
+) -> usize {
+    let Some(key) = fusion.key() else {
+        defmt::error!("frame {=u32}: no key frame", i);
+        fw::exit(false)
+    };
+    let s = fusion.structure();
+    let counts = key.counts();
+    let median = median_fused_width(key, widths);
+    let map = fusion.map();
+    let paired = step.paired.unwrap_or_default();
+    let c = s.status_counts();
+    let points: usize = c.iter().sum();
+    let g = |st: Status| c.get(st as usize).copied().unwrap_or(0) as u32;
+    defmt::info!(
+        "frame={=u32} points={=u32} ok={=u32} ambiguous={=u32} at_foe={=u32} behind={=u32} no_intersection={=u32} grazing={=u32} nonpositive={=u32} beyond={=u32} unbounded={=u32} folded={=u32} out_of_view={=u32} boundary_end={=u32} over_budget={=u32} instr={=u32} budget_permille={=u32} digest={=u32:08x} key={=u32} partner={=u16} retired={=bool} fused={=u32} single={=u32} inconsistent={=u32} conflicts={=u32} width_permille={=u32} map={=u32} map_behind={=u32} map_room={=u32} fusion_digest={=u32:08x}",
+        i,
+        points as u32,
+        g(Status::Ok),
+        g(Status::Ambiguous),
+        g(Status::AtFoe),
+        g(Status::BehindCamera),
+        g(Status::NoIntersection),
+        g(Status::Grazing),
+        g(Status::NonPositiveDepth),
+        g(Status::BeyondMaxDepth),
+        g(Status::Unbounded),
+        g(Status::Folded),
+        g(Status::OutOfView),
+        g(Status::BoundaryEnd),
+        g(Status::OverBudget),
+        instr,
+        (u64::from(instr) * 1000 / u64::from(BUDGET_INSTRUCTIONS)) as u32,
+        s.digest(),
+        key.id(),
+        step.partner,
+        step.retired.is_some(),
+        counts.consistent,
+        counts.single,
+        counts.inconsistent,
+        paired.conflicts,
+        (median * 1000.0) as u32,
+        (map.points(0).count() + map.points(1).count()) as u32,
+        map.drops().behind,
+        map.drops().capacity,
+        fusion.digest()
+    );
+    points
+}
+
+/// The median relative width `(z_far − z_near)/z_mid` of the key frame's
+/// consistently fused points (0 without any), sorted in `widths`.
+fn median_fused_width(key: &KeyFrame<256, 2>, widths: &mut [f32; 512]) -> f32 {
+    let mut n = 0;
+    for b in 0..2 {
+        for p in key.points(b) {
+            if let (FusedStatus::Consistent, Some(iv), Some(slot)) =
+                (p.status, p.interval, widths.get_mut(n))
+            {
+                *slot = (iv.z_far - iv.z_near) / (0.5 * (iv.z_far + iv.z_near));
+                n += 1;
+            }
+        }
+    }
+    let fused = widths.get_mut(..n).unwrap_or(&mut []);
+    fused.sort_unstable_by(f32::total_cmp);
+    fused.get(n / 2).copied().unwrap_or(0.0)
+}
+
+/// A sample of the last structure (every 24th point with a depth) and of
+/// the road map (every 24th point, vehicle frame).
+fn log_samples(fusion: &Fusion<256, 2, 512>) {
     let s = fusion.structure();
     for (k, b) in s.boundaries().iter().enumerate() {
         for r in b.points().iter().step_by(24) {
@@ -168,7 +202,6 @@ fn main() -> ! {
             }
         }
     }
-    // A sample of the road map: every 24th point, vehicle frame.
     for k in 0..2 {
         for p in fusion.map().points(k).step_by(24) {
             defmt::info!(
@@ -184,14 +217,4 @@ fn main() -> ! {
             );
         }
     }
-    let per_point = total_instr.checked_div(total_points).unwrap_or(0) as u32;
-    defmt::info!(
-        "done frames={=u32} points={=u64} instr={=u64} per_point={=u32} worst_frame={=u32}",
-        drive.frames,
-        total_points,
-        total_instr,
-        per_point,
-        worst
-    );
-    fw::exit(true)
 }

@@ -180,6 +180,23 @@ pub struct Retired {
     pub unfit: u32,
 }
 
+/// A retiring batch's forward extent (key frame's vehicle frame) and
+/// reach, over its points' ends, before the coding's widening.
+#[derive(Debug, Clone, Copy)]
+struct Extent {
+    lo: f32,
+    hi: f32,
+    reach: f32,
+}
+
+impl Extent {
+    const EMPTY: Self = Self {
+        lo: f32::INFINITY,
+        hi: f32::NEG_INFINITY,
+        reach: 0.0,
+    };
+}
+
 /// The forward axis of the vehicle frame in camera coordinates.
 fn forward_axis(tilt: (f32, f32)) -> [f32; 3] {
     [0.0, -tilt.0, tilt.1]
@@ -651,7 +668,6 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         s: &Structure<N, B>,
         chain: &Chain,
     ) -> Retired {
-        let min_pairs = key.min_pairs();
         let mut out = Retired {
             key: key.id(),
             ..Retired::default()
@@ -669,6 +685,50 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             return out;
         }
         // 2. Room: a batch slot, then ring slots, oldest first.
+        self.make_room(&mut want, &mut out);
+        // 3. The batch: its pose, each boundary's points, the forward
+        // extent and reach of all of them.
+        let (a, b, rho, phi) = chain.pose();
+        let mut batch = Batch::<B> {
+            a,
+            b,
+            rho,
+            phi,
+            key: key.id(),
+            ..Batch::EMPTY
+        };
+        let mut extent = Extent::EMPTY;
+        for (k, &w) in want.iter().enumerate() {
+            let n = self.enter(k, w, key, s, &mut extent);
+            let n16 = n as u16;
+            if let (Some(l), Some(lv), Some(u)) = (
+                batch.len.get_mut(k),
+                batch.live.get_mut(k),
+                self.used.get_mut(k),
+            ) {
+                *l = n16;
+                *lv = n16;
+                *u = u.saturating_add(n16);
+            }
+            out.entered += n as u32;
+        }
+        // The coded ends are up to 2⁻¹² beyond the fused ones, and the
+        // products round: widened by 2⁻¹⁰ of the reach.
+        let reach = extent.reach * (1.0 + 1.0 / 1024.0);
+        batch.forward = (extent.lo - reach / 1024.0, extent.hi + reach / 1024.0);
+        batch.reach = reach;
+        let slot = self.slot(usize::from(self.count));
+        if let Some(b) = self.batches.get_mut(slot) {
+            *b = batch;
+            self.count += 1;
+        }
+        out
+    }
+
+    /// [`Self::retire`]'s room: a batch slot (the oldest batch goes when
+    /// all are taken), then on each boundary the ring slots for its
+    /// `want` points (at most `M`; the rest counted unfit), oldest first.
+    fn make_room(&mut self, want: &mut [usize; B], out: &mut Retired) {
         if usize::from(self.count) >= MAP_BATCHES {
             if let Some(b) = self.batches.get(usize::from(self.first)).copied() {
                 out.dropped += b.live_total();
@@ -688,80 +748,58 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         }
         self.pop_dead();
         self.drops.capacity = self.drops.capacity.saturating_add(out.dropped);
-        // 3. The batch.
-        let (a, b, rho, phi) = chain.pose();
-        let mut batch = Batch::<B> {
-            a,
-            b,
-            rho,
-            phi,
-            key: key.id(),
-            ..Batch::EMPTY
-        };
+    }
+
+    /// [`Self::retire`]'s entries on boundary `k`: the first `w` admitted
+    /// points of the key frame, written into the ring after its used
+    /// slots, their forward coordinates and reach taken into `extent`.
+    /// Returns how many entered.
+    fn enter<const N: usize>(
+        &mut self,
+        k: usize,
+        w: usize,
+        key: &KeyFrame<N, B>,
+        s: &Structure<N, B>,
+        extent: &mut Extent,
+    ) -> usize {
+        let min_pairs = key.min_pairs();
         let (ts, tc) = self.tilt;
-        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-        let mut reach = 0.0f32;
-        let cam = s.camera1();
-        let scale = self.scale;
-        for (k, &w) in want.iter().enumerate() {
-            let start = self.tail.get(k).map_or(0, |&t| usize::from(t))
-                + self.used.get(k).map_or(0, |&u| usize::from(u));
-            let (Some(ring), Some(results)) = (self.entries.get_mut(k), s.boundaries().get(k))
-            else {
+        let (cam, scale) = (s.camera1(), self.scale);
+        let start = self.tail.get(k).map_or(0, |&t| usize::from(t))
+            + self.used.get(k).map_or(0, |&u| usize::from(u));
+        let (Some(ring), Some(results)) = (self.entries.get_mut(k), s.boundaries().get(k)) else {
+            return 0;
+        };
+        let mut n = 0usize;
+        for (c, r) in key.cells(k).iter().zip(results.points()) {
+            if n >= w {
+                break;
+            }
+            if c.admit(min_pairs) != Admit::Yes {
                 continue;
+            }
+            let [x, y] = cam.normalise(r.pixel1());
+            let (z_near, z_far) = c.ends();
+            let e = Entry {
+                x,
+                y,
+                near: scale.down(z_near),
+                far: scale.up(z_far).max(1),
             };
-            let mut n = 0usize;
-            for (c, r) in key.cells(k).iter().zip(results.points()) {
-                if n >= w {
-                    break;
-                }
-                if c.admit(min_pairs) != Admit::Yes {
-                    continue;
-                }
-                let [x, y] = cam.normalise(r.pixel1());
-                let (z_near, z_far) = c.ends();
-                let e = Entry {
-                    x,
-                    y,
-                    near: scale.down(z_near),
-                    far: scale.up(z_far).max(1),
-                };
-                // Forward coordinate (key frame's vehicle frame) of both
-                // ends; the coded ends are within 2⁻¹² of these (widened
-                // below).
-                let dir = tc - ts * y;
-                let (a, b) = (z_near * dir, z_far * dir);
-                lo = fmin(lo, fmin(a, b));
-                hi = fmax(hi, fmax(a, b));
-                reach = fmax(reach, z_far * (1.0 + 0.5 * (x * x + y * y)));
-                if let Some(slot) = ring.get_mut((start + n) % M) {
-                    *slot = e;
-                }
-                n += 1;
+            // Forward coordinate (key frame's vehicle frame) of both
+            // ends; the coded ends are within 2⁻¹² of these (widened by
+            // the caller).
+            let dir = tc - ts * y;
+            let (a, b) = (z_near * dir, z_far * dir);
+            extent.lo = fmin(extent.lo, fmin(a, b));
+            extent.hi = fmax(extent.hi, fmax(a, b));
+            extent.reach = fmax(extent.reach, z_far * (1.0 + 0.5 * (x * x + y * y)));
+            if let Some(slot) = ring.get_mut((start + n) % M) {
+                *slot = e;
             }
-            let n16 = n as u16;
-            if let (Some(l), Some(lv), Some(u)) = (
-                batch.len.get_mut(k),
-                batch.live.get_mut(k),
-                self.used.get_mut(k),
-            ) {
-                *l = n16;
-                *lv = n16;
-                *u = u.saturating_add(n16);
-            }
-            out.entered += n as u32;
+            n += 1;
         }
-        // The coded ends are up to 2⁻¹² beyond the fused ones, and the
-        // products round: widened by 2⁻¹⁰ of the reach.
-        let reach = reach * (1.0 + 1.0 / 1024.0);
-        batch.forward = (lo - reach / 1024.0, hi + reach / 1024.0);
-        batch.reach = reach;
-        let slot = self.slot(usize::from(self.count));
-        if let Some(b) = self.batches.get_mut(slot) {
-            *b = batch;
-            self.count += 1;
-        }
-        out
+        n
     }
 
     pub(crate) fn digest_into(&self, eat: &mut impl FnMut(u32)) {

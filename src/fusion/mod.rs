@@ -422,16 +422,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             out.new_key = self.start_key(id, frame, KeyReason::First, false);
             return Ok(out);
         };
-        let m = motion.ok_or(FusionError::MissingMotion)?;
-        if m.from != last {
-            return Err(FusionError::BrokenChain {
-                expected: last,
-                given: m.from,
-            });
-        }
-        if id == last {
-            return Err(FusionError::RepeatedFrame(id));
-        }
+        let m = chained_from(last, id, motion)?;
         self.last = Some(id);
         let bounds = StepBounds::of(&self.base);
         self.settle();
@@ -467,18 +458,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         if bounds.any() {
             self.processor.set_config(cfg);
         }
-        let fused = if last_partner {
-            match self.processor.process(frame, Some(&motion)) {
-                Ok(Step::Structure(s)) => self.key.fuse(s),
-                // (A kept frame exists and a motion is given: not reached.)
-                _ => PairFused::default(),
-            }
-        } else {
-            match self.processor.process_against_kept(frame, &motion) {
-                Ok(s) => self.key.fuse(s),
-                Err(_) => PairFused::default(),
-            }
-        };
+        let fused = self.fuse_pair(frame, &motion, last_partner);
         // 4. The pair fused; a last partner retires the key frame.
         out.paired = Some(fused);
         out.partner = self.key.partners();
@@ -506,6 +486,25 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             || (best == 0 && p >= 2);
         self.due = p.saturating_add(1) >= self.config.max_partners || few;
         Ok(out)
+    }
+
+    /// The pair of the key frame and `frame` through the processor, fused
+    /// into the key frame: a last partner is processed against the kept
+    /// frame and replaces it (it becomes the next key frame), any other is
+    /// processed against the kept frame, which stays.
+    fn fuse_pair(&mut self, frame: &Frame<N, B>, motion: &Motion, last_partner: bool) -> PairFused {
+        if last_partner {
+            match self.processor.process(frame, Some(motion)) {
+                Ok(Step::Structure(s)) => self.key.fuse(s),
+                // (A kept frame exists and a motion is given: not reached.)
+                _ => PairFused::default(),
+            }
+        } else {
+            match self.processor.process_against_kept(frame, motion) {
+                Ok(s) => self.key.fuse(s),
+                Err(_) => PairFused::default(),
+            }
+        }
     }
 
     /// Make frame `id` the key frame (if it has points): the processor
@@ -645,6 +644,26 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         self.map.digest_into(&mut eat);
         h
     }
+}
+
+/// Step 1 of [`Fusion::step`] after the first frame: frame `id`'s motion
+/// must be given and chain from the `last` frame, and `id` must be new.
+fn chained_from(
+    last: u32,
+    id: u32,
+    motion: Option<&ChainedMotion>,
+) -> Result<&ChainedMotion, FusionError> {
+    let m = motion.ok_or(FusionError::MissingMotion)?;
+    if m.from != last {
+        return Err(FusionError::BrokenChain {
+            expected: last,
+            given: m.from,
+        });
+    }
+    if id == last {
+        return Err(FusionError::RepeatedFrame(id));
+    }
+    Ok(m)
 }
 
 fn has_points<const N: usize, const B: usize>(frame: &Frame<N, B>) -> bool {

@@ -475,7 +475,9 @@ fn compensate_point(
 /// Step 1 for every point of `b1` when the pair certifies the whole image
 /// ([`Pair::certified_r1`]): [`compensate_point`] without its checks (they
 /// pass), `r₁` the frame's, the keys from `key`; each point's key margin in
-/// `margins`, the key order in `order`.
+/// `margins`, the key order in `order` (followed only until it cannot be
+/// strict any more, [`KeyOrder::settled`]: the rest of the points leave
+/// [`KeyOrder::strict`] as it is).
 #[inline(always)]
 fn compensate_all_certified(
     pair: &Pair,
@@ -485,7 +487,7 @@ fn compensate_all_certified(
     key: impl Fn([f32; 2]) -> (f32, f32),
 ) {
     let stretch = pair.geom.frame_stretch().unwrap_or(0.0);
-    for ((slot, &p1), m) in slots.iter_mut().zip(b1).zip(margins.iter_mut()) {
+    let one = |((slot, &p1), m): ((&mut PointResult, &Pixel), &mut f32)| {
         let c = pair.geom.compensate_certified(p1, stretch);
         let (k, e) = key(c.pixel);
         *slot = PointResult {
@@ -497,7 +499,18 @@ fn compensate_all_certified(
             status: Status::NoIntersection,
         };
         *m = e;
+        (k, e)
+    };
+    let mut points = slots.iter_mut().zip(b1).zip(margins.iter_mut());
+    for p in &mut points {
+        let (k, e) = one(p);
         order.push(k, e);
+        if order.settled() {
+            break;
+        }
+    }
+    for p in points {
+        one(p);
     }
 }
 

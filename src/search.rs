@@ -1125,6 +1125,14 @@ impl KeyOrder {
         Some(((plo, phi), (vlo, vhi)))
     }
 
+    /// Whether [`Self::strict`] is false whatever vertices come next (one
+    /// was unkeyed, or the keys went both ways): only pushes clear `up`
+    /// and `down` and set `odd`.
+    #[inline(always)]
+    pub(crate) fn settled(&self) -> bool {
+        self.odd || !(self.up || self.down)
+    }
+
     /// Every vertex keyed and the widened keys strictly ordered one way,
     /// for keys without a period (`period` 0).
     pub(crate) fn strict(&self, period: f32) -> bool {

@@ -837,7 +837,10 @@ fn wedge_run(
     let mut cached = usize::MAX;
     let mut va = WVertex::NONE;
     let mut stop = None;
-    for j in a..segs.len().min(b2.len().saturating_sub(1)) {
+    let end = segs.len().min(b2.len().saturating_sub(1));
+    // The vertices up to the run's last end.
+    let b2 = b2.get(..end + 1).unwrap_or(&[]);
+    for j in a..end {
         let (Some(g), Some(v1)) = (segs.get(j), b2.get(j + 1)) else {
             break;
         };
@@ -920,8 +923,12 @@ fn wedge_run_aside(
     let mut rest = aside.iter();
     let mut next = rest.next();
     let cx = (segments, cot_twice);
-    'walk: for j in a..segs.len().min(b2.len().saturating_sub(1)) {
-        let (Some(g), Some(v1)) = (segs.get(j), b2.get(j + 1)) else {
+    let end = segs.len().min(b2.len().saturating_sub(1));
+    // The vertices up to the run's last end (the aside entries take theirs
+    // from `b2`).
+    let run = b2.get(..end + 1).unwrap_or(&[]);
+    'walk: for j in a..end {
+        let (Some(g), Some(v1)) = (segs.get(j), run.get(j + 1)) else {
             break;
         };
         // The aside entries before segment `j` come first.
@@ -973,7 +980,7 @@ fn wedge_run_aside(
         }
         c -= CLIP_UNITS;
         if cached != j {
-            if let Some(v0) = b2.get(j) {
+            if let Some(v0) = run.get(j) {
                 va = wedge.vertex(v0.arr());
             }
         }

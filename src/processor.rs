@@ -476,7 +476,9 @@ fn compensate_point(
 /// Step 1 for every point of `b1` when the pair certifies the whole image
 /// ([`Pair::certified_r1`]): [`compensate_point`] without its checks (they
 /// pass), `r₁` the frame's, the keys from `key`; each point's key margin in
-/// `margins`, the key order in `order`.
+/// `margins`, the key order in `order` (followed only until it cannot be
+/// strict any more, [`KeyOrder::settled`]: the rest of the points leave
+/// [`KeyOrder::strict`] as it is).
 #[inline(always)]
 fn compensate_all_certified(
     pair: &Pair,
@@ -486,7 +488,7 @@ fn compensate_all_certified(
     key: impl Fn([f32; 2]) -> (f32, f32),
 ) {
     let stretch = pair.geom.frame_stretch().unwrap_or(0.0);
-    for ((slot, &p1), m) in slots.iter_mut().zip(b1).zip(margins.iter_mut()) {
+    let one = |((slot, &p1), m): ((&mut PointResult, &Pixel), &mut f32)| {
         let c = pair.geom.compensate_certified(p1, stretch);
         let (k, e) = key(c.pixel);
         *slot = PointResult {
@@ -498,7 +500,18 @@ fn compensate_all_certified(
             status: Status::NoIntersection,
         };
         *m = e;
+        (k, e)
+    };
+    let mut points = slots.iter_mut().zip(b1).zip(margins.iter_mut());
+    for p in &mut points {
+        let (k, e) = one(p);
         order.push(k, e);
+        if order.settled() {
+            break;
+        }
+    }
+    for p in points {
+        one(p);
     }
 }
 
@@ -825,7 +838,10 @@ fn wedge_run(
     let mut cached = usize::MAX;
     let mut va = WVertex::NONE;
     let mut stop = None;
-    for j in a..segs.len().min(b2.len().saturating_sub(1)) {
+    let end = segs.len().min(b2.len().saturating_sub(1));
+    // The vertices up to the run's last end.
+    let b2 = b2.get(..end + 1).unwrap_or(&[]);
+    for j in a..end {
         let (Some(g), Some(v1)) = (segs.get(j), b2.get(j + 1)) else {
             break;
         };
@@ -908,8 +924,12 @@ fn wedge_run_aside(
     let mut rest = aside.iter();
     let mut next = rest.next();
     let cx = (segments, cot_twice);
-    'walk: for j in a..segs.len().min(b2.len().saturating_sub(1)) {
-        let (Some(g), Some(v1)) = (segs.get(j), b2.get(j + 1)) else {
+    let end = segs.len().min(b2.len().saturating_sub(1));
+    // The vertices up to the run's last end (the aside entries take theirs
+    // from `b2`).
+    let run = b2.get(..end + 1).unwrap_or(&[]);
+    'walk: for j in a..end {
+        let (Some(g), Some(v1)) = (segs.get(j), run.get(j + 1)) else {
             break;
         };
         // The aside entries before segment `j` come first.
@@ -961,7 +981,7 @@ fn wedge_run_aside(
         }
         c -= CLIP_UNITS;
         if cached != j {
-            if let Some(v0) = b2.get(j) {
+            if let Some(v0) = run.get(j) {
                 va = wedge.vertex(v0.arr());
             }
         }

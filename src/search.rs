@@ -512,30 +512,46 @@ impl<const N: usize> Index<N> {
         mut flag: impl FnMut(&mut T, Result<bool, OutOfWork>),
     ) {
         let lean = self.period <= 0.0 && self.aside.is_empty();
+        if !lean {
+            for (i, it) in items.iter_mut().enumerate() {
+                work.grant(allowance);
+                let Some(k) = key(it) else {
+                    continue;
+                };
+                let r = self.folds(i, k, w, work);
+                flag(it, r);
+            }
+            return;
+        }
         let (s, o) = (self.segments.min(N), self.orient);
+        // The allowances of the items since the last grant: given before
+        // the next query and at the end (saturating sums, so the credit
+        // each query sees is the one granting item by item gives).
+        let mut owed = 0u32;
         for (i, it) in items.iter_mut().enumerate() {
-            work.grant(allowance);
+            owed = owed.saturating_add(allowance);
             let Some(k) = key(it) else {
                 continue;
             };
-            if lean {
-                let (ko, e) = (o * k, self.margin.get(i).copied().unwrap_or(0.0));
-                let before = i
-                    .checked_sub(w + 1)
-                    .and_then(|j| self.seg.get(j))
-                    .is_some_and(|g| ko - e <= g.pm);
-                let after = i + w < s && self.seg.get(i + w).is_some_and(|g| ko + e >= g.sm);
-                if !(before || after) {
-                    continue;
-                }
+            let (ko, e) = (o * k, self.margin.get(i).copied().unwrap_or(0.0));
+            let before = i
+                .checked_sub(w + 1)
+                .and_then(|j| self.seg.get(j))
+                .is_some_and(|g| ko - e <= g.pm);
+            let after = i + w < s && self.seg.get(i + w).is_some_and(|g| ko + e >= g.sm);
+            if !(before || after) {
+                continue;
             }
-            let r = if lean && !self.strict {
-                self.folds_query(i, k, w, work)
-            } else {
+            work.grant(owed);
+            owed = 0;
+            let r = if self.strict {
                 self.folds(i, k, w, work)
+            } else {
+                self.folds_query(i, k, w, work)
             };
             flag(it, r);
         }
+        work.grant(owed);
     }
 
     /// Whether no vertex's key meets a segment other than its own two (so
@@ -1123,6 +1139,14 @@ impl KeyOrder {
         self.up &= vlo > phi;
         self.down &= vhi < plo;
         Some(((plo, phi), (vlo, vhi)))
+    }
+
+    /// Whether [`Self::strict`] is false whatever vertices come next (one
+    /// was unkeyed, or the keys went both ways): only pushes clear `up`
+    /// and `down` and set `odd`.
+    #[inline(always)]
+    pub(crate) fn settled(&self) -> bool {
+        self.odd || !(self.up || self.down)
     }
 
     /// Every vertex keyed and the widened keys strictly ordered one way,

@@ -373,11 +373,12 @@ fn main() -> ! {
     fw::exit(true)
 }
 
-/// Budgets of the work sweep, units per point: the smallest accepted, the
-/// default and up to 16 times it.
-const SWEEP: [u32; 5] = [
+/// Budgets of the work sweep, units per point: the smallest accepted, two
+/// between, the default and up to 8 times it.
+const SWEEP: [u32; 6] = [
     Config::MIN_WORK_PER_POINT,
     16,
+    40,
     Config::DEFAULT_WORK_PER_POINT,
     160,
     640,

@@ -579,11 +579,22 @@ fn memory_table(
     );
     println!("|     `RoadMap<2, 512>` | {} |", num(&fusion, "map_2_512"));
     println!("| worst-case stack of one per-frame call (painted) | {stack} |");
-    // The fusion (with its processor) is a static, in .bss; the frame is on
-    // main's stack.
-    let needed = ram + num(&sizes, "frame_256_2") + stack;
+    // The fusion (with its processor) is a static in .data (not zero: its
+    // initial image is in flash); on main's stack the input frame, the
+    // median's scratch (`widths`, 512 f32) and one fusion step, the
+    // deepest call the demo makes (it includes the per-frame call).
+    const DEMO_WIDTHS: u64 = 512 * 4;
+    let step_stack = records(log, "fusion_stack ")
+        .iter()
+        .map(|r| num(r, "bytes"))
+        .max()
+        .unwrap_or(u64::MAX);
+    let needed = ram
+        .saturating_add(num(&sizes, "frame_256_2"))
+        .saturating_add(DEMO_WIDTHS)
+        .saturating_add(step_stack.max(stack));
     println!(
-        "| RAM the demo needs: .data + .bss (the fusion with its processor, a static) + one frame (on main's stack) + one call's stack | {needed} |"
+        "| RAM the demo needs: .data + .bss (the fusion with its processor, a static) + one frame and the median's scratch (on main's stack) + one fusion step's stack | {needed} |"
     );
     // The smaller board's RAM (src/bin/fw/boards/stm32f405.x).
     const F405_RAM: u64 = 128 * 1024;

@@ -71,7 +71,7 @@ impl Config {
     /// Work units each point brings to the frame's budget by default (see
     /// [`Config::with_work_budget`]): sized for yield, so that the inputs
     /// of the project's realistic and adversarial sets are not flagged
-    /// [`crate::Status::OverBudget`] (one point of the demo drive's 7 000
+    /// [`crate::Status::OverBudget`] (one point of the demo drive's 7 400
     /// is): a straight road with its edges
     /// rounded to the pixel grid needs 34 per point at 2 × 256, and
     /// backward motion on boundaries rounded to the pixel grid up to 80

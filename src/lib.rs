@@ -72,7 +72,9 @@ pub use epipolar::PairGeometry;
 pub use math::{AngleError, MAX_ANGLE_RAD};
 pub use motion::{Motion, MotionError};
 pub use processor::Processor;
-pub use structure::{BoundaryStructure, PointResult, ProcessError, Status, Step, Structure};
+pub use structure::{
+    BoundaryStructure, PointResult, ProcessError, Status, StatusCounts, Step, Structure,
+};
 
 // The README's Rust examples are compiled and run as doc tests.
 #[cfg(doctest)]

@@ -100,8 +100,10 @@ impl Status {
             Status::OverBudget => "over_budget",
         }
     }
-    /// Every status, in declaration order.
-    pub const ALL: [Status; 13] = [
+    /// Every status, in declaration order (the wire format's status codes,
+    /// `crate::wire`). A slice: a status added in a minor release makes it
+    /// longer without changing a public type.
+    pub const ALL: &'static [Status] = &[
         Status::Ok,
         Status::Ambiguous,
         Status::AtFoe,
@@ -116,6 +118,42 @@ impl Status {
         Status::BoundaryEnd,
         Status::OverBudget,
     ];
+}
+
+/// How many statuses there are (the length of [`Status::ALL`]).
+pub(crate) const STATUS_COUNT: usize = Status::ALL.len();
+
+/// How many points of a [`Structure`] have each status
+/// ([`Structure::status_counts`]).
+///
+/// ```
+/// # use roadstereo::{Status, Structure};
+/// fn report<const N: usize, const B: usize>(s: &Structure<N, B>) {
+///     let c = s.status_counts();
+///     let share = c.get(Status::Ok) as f32 / c.total().max(1) as f32;
+///     for (status, n) in c.iter().filter(|&(_, n)| n > 0) {
+///         // log `status` and `n`
+///     }
+/// }
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct StatusCounts {
+    counts: [usize; STATUS_COUNT],
+}
+
+impl StatusCounts {
+    /// The points with status `s`.
+    pub fn get(&self, s: Status) -> usize {
+        self.counts.get(s as usize).copied().unwrap_or(0)
+    }
+    /// Every status with its count, in the order of [`Status::ALL`].
+    pub fn iter(&self) -> impl Iterator<Item = (Status, usize)> + '_ {
+        Status::ALL.iter().copied().zip(self.counts.iter().copied())
+    }
+    /// All points.
+    pub fn total(&self) -> usize {
+        self.counts.iter().sum()
+    }
 }
 
 impl fmt::Display for Status {
@@ -311,11 +349,11 @@ impl<const N: usize, const B: usize> Structure<N, B> {
         h
     }
 
-    /// How many points have each status, indexed like [`Status::ALL`].
-    pub fn status_counts(&self) -> [usize; Status::ALL.len()] {
-        let mut c = [0usize; Status::ALL.len()];
+    /// How many points have each status.
+    pub fn status_counts(&self) -> StatusCounts {
+        let mut c = StatusCounts::default();
         for r in self.boundaries().iter().flat_map(|b| b.points()) {
-            if let Some(slot) = c.get_mut(r.status as usize) {
+            if let Some(slot) = c.counts.get_mut(r.status as usize) {
                 *slot += 1;
             }
         }

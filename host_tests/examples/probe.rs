@@ -35,8 +35,8 @@ fn main() {
     );
     let st = point_stats(&r, &k, &p);
     let counts = p.structure().status_counts();
-    for (c, s) in counts.iter().zip(roadstereo::Status::ALL) {
-        if *c > 0 {
+    for (s, c) in counts.iter() {
+        if c > 0 {
             print!("{}={} ", s.name(), c);
         }
     }

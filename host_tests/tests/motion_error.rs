@@ -166,7 +166,7 @@ fn combined_interval_holds_under_translation_error() {
         // with the largest budget.
         let config = Config::default().with_translation_error(delta).unwrap();
         let budgeted = run(&r, cam, &mu, config);
-        over += budgeted.structure().status_counts()[Status::OverBudget as usize];
+        over += budgeted.structure().status_counts().get(Status::OverBudget);
         let config = config.with_work_budget(Config::MAX_WORK_PER_POINT).unwrap();
         let p = run(&r, cam, &mu, config);
         for z in contained_sticks(&r, &k, &p, seed) {
@@ -231,7 +231,7 @@ fn rotation_error_bound_holds() {
         // default budget's over_budget count.
         let config = Config::default().with_rotation_error([eps; 3]).unwrap();
         let budgeted = run(&r, cam, &mu, config);
-        over += budgeted.structure().status_counts()[Status::OverBudget as usize];
+        over += budgeted.structure().status_counts().get(Status::OverBudget);
         let config = config.with_work_budget(Config::MAX_WORK_PER_POINT).unwrap();
         let p = run(&r, cam, &mu, config);
         ok += contained_sticks(&r, &k, &p, seed).len();

@@ -153,9 +153,8 @@ fn fusion_bench() -> bool {
 fn status_fields(s: &Structure<CAP, 2>) -> heapless::String<400> {
     let mut out = heapless::String::new();
     let counts = s.status_counts();
-    for (i, st) in Status::ALL.iter().enumerate() {
-        let c = counts.get(i).copied().unwrap_or(0);
-        if c == 0 && *st != Status::Ok {
+    for (st, c) in counts.iter() {
+        if c == 0 && st != Status::Ok {
             continue;
         }
         // Decimal digits of c, most significant first.
@@ -255,12 +254,7 @@ fn measure_pair(
         .iter()
         .map(|b| b.points().len())
         .sum();
-    let ok = processor
-        .structure()
-        .status_counts()
-        .first()
-        .copied()
-        .unwrap_or(0);
+    let ok = processor.structure().status_counts().get(Status::Ok);
     Measured {
         processed,
         instr,
@@ -398,10 +392,6 @@ fn worst_case_sweep(
         "work default_per_point={=u32}",
         Config::DEFAULT_WORK_PER_POINT
     );
-    let over = Status::ALL
-        .iter()
-        .position(|s| *s == Status::OverBudget)
-        .unwrap_or(0);
     if let Some((_, data)) = BENCH.first() {
         if let Some(m) = load(data, f1, f2) {
             for b in 1..=2usize {
@@ -448,7 +438,7 @@ fn worst_case_sweep(
                 r.instr,
                 r.processed,
                 s.work_units().0,
-                s.status_counts().get(over).copied().unwrap_or(0)
+                s.status_counts().get(Status::OverBudget)
             );
         }
     }

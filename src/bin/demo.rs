@@ -124,8 +124,8 @@ fn log_frame(
     let map = fusion.map();
     let paired = step.paired.unwrap_or_default();
     let c = s.status_counts();
-    let points: usize = c.iter().sum();
-    let g = |st: Status| c.get(st as usize).copied().unwrap_or(0) as u32;
+    let points = c.total();
+    let g = |st: Status| c.get(st) as u32;
     defmt::info!(
         "frame={=u32} points={=u32} ok={=u32} ambiguous={=u32} at_foe={=u32} behind={=u32} no_intersection={=u32} grazing={=u32} nonpositive={=u32} beyond={=u32} unbounded={=u32} folded={=u32} out_of_view={=u32} boundary_end={=u32} over_budget={=u32} instr={=u32} budget_permille={=u32} digest={=u32:08x} key={=u32} partner={=u16} retired={=bool} fused={=u32} single={=u32} inconsistent={=u32} conflicts={=u32} width_permille={=u32} map={=u32} map_behind={=u32} map_room={=u32} fusion_digest={=u32:08x}",
         i,

@@ -154,8 +154,8 @@ fn main() -> ! {
                         "frame={=u32} kept={=u32} points={=u32} ok={=u32} instr={=u32} budget_permille={=u32} digest={=u32:08x}",
                         job.info.frame_id,
                         job.kept_id,
-                        c.iter().sum::<usize>() as u32,
-                        c.get(Status::Ok as usize).copied().unwrap_or(0) as u32,
+                        c.total() as u32,
+                        c.get(Status::Ok) as u32,
                         instr,
                         (u64::from(instr) * 1000 / u64::from(BUDGET_INSTRUCTIONS)) as u32,
                         s.digest()

@@ -347,9 +347,9 @@ pub fn result<const N: usize, const B: usize>(
     w.u16(0)?;
     w.u32(head.instructions)?;
     w.u32(s.map_or(0, |s| s.digest()))?;
-    let counts = s.map_or([0; Status::ALL.len()], |s| s.status_counts());
-    for c in counts {
-        w.u16(u16::try_from(c).unwrap_or(u16::MAX))?;
+    let counts = s.map(|s| s.status_counts()).unwrap_or_default();
+    for &st in Status::ALL {
+        w.u16(u16::try_from(counts.get(st)).unwrap_or(u16::MAX))?;
     }
     w.u16(0)?;
     if let Some(s) = s {

@@ -69,6 +69,9 @@ pub(crate) const CAMERA_LEN: usize = 20;
 pub(crate) const REPORT_LEN: usize = 20;
 /// A result payload's fixed part.
 pub(crate) const RESULT_HEAD_LEN: usize = 56;
+// The result head holds one u16 count per status (offset 28, then a u16
+// of padding): a new status is a new format version.
+const _: () = assert!(RESULT_HEAD_LEN == 28 + 2 * crate::structure::STATUS_COUNT + 2);
 /// A result boundary's fixed part.
 pub(crate) const RESULT_BOUNDARY_LEN: usize = 4;
 /// A result point with a depth: status and five `f32`.

@@ -6,6 +6,7 @@ use super::{
     ErrorKind, PacketType, WireError, CRC, CRC_LEN, HEADER_LEN, MAGIC, REPORT_LEN,
     RESULT_BOUNDARY_LEN, RESULT_HEAD_LEN, VERSION,
 };
+use crate::structure::STATUS_COUNT;
 use crate::Status;
 
 fn le16(b: &[u8], at: usize) -> u16 {
@@ -151,8 +152,8 @@ pub struct ResultView<'a> {
     pub instructions: u32,
     /// [`crate::Structure::digest`].
     pub digest: u32,
-    /// Points per status, indexed like [`Status::ALL`].
-    pub counts: [u16; Status::ALL.len()],
+    /// Points per status, indexed like [`Status::ALL`] ([`Self::count`]).
+    counts: [u16; STATUS_COUNT],
     boundaries: u8,
     body: &'a [u8],
 }
@@ -166,7 +167,7 @@ impl<'a> ResultView<'a> {
     /// is checked to be in the payload.
     pub fn parse(payload: &'a [u8]) -> Result<Self, BadResult> {
         let head = payload.get(..RESULT_HEAD_LEN).ok_or(BadResult)?;
-        let mut counts = [0u16; Status::ALL.len()];
+        let mut counts = [0u16; STATUS_COUNT];
         for (i, c) in counts.iter_mut().enumerate() {
             *c = le16(head, 28 + 2 * i);
         }
@@ -196,6 +197,17 @@ impl<'a> ResultView<'a> {
             return Err(BadResult);
         }
         Ok(v)
+    }
+
+    /// The points with status `s`, as the packet gives it (saturated at
+    /// `u16::MAX`).
+    pub fn count(&self, s: Status) -> u16 {
+        self.counts.get(s as usize).copied().unwrap_or(0)
+    }
+
+    /// All points the packet counts.
+    pub fn total(&self) -> u64 {
+        self.counts.iter().map(|&c| u64::from(c)).sum()
     }
 
     /// The boundaries.

@@ -69,11 +69,11 @@ fn main() -> std::process::ExitCode {
         let median = widths.get(widths.len() / 2).copied().unwrap_or(0.0);
         let map = fusion.map();
         let c = s.status_counts();
-        let g = |st: Status| c[st as usize];
+        let g = |st: Status| c.get(st);
         println!(
             "frame={} points={} ok={} ambiguous={} at_foe={} behind={} no_intersection={} grazing={} nonpositive={} beyond={} unbounded={} folded={} out_of_view={} boundary_end={} over_budget={} digest={:08x} key={} partner={} retired={} fused={} single={} inconsistent={} conflicts={} width_permille={} map={} map_behind={} map_room={} fusion_digest={:08x}",
             i,
-            c.iter().sum::<usize>(),
+            c.total(),
             g(Status::Ok),
             g(Status::Ambiguous),
             g(Status::AtFoe),

@@ -778,13 +778,9 @@ pub fn host_cost(
         best = best.min(dt);
     }
     let counts = p.structure().status_counts();
-    let named = Status::ALL
+    let named = counts
         .iter()
-        .enumerate()
-        .filter_map(|(i, s)| {
-            let c = counts.get(i).copied().unwrap_or(0);
-            (c > 0 || *s == Status::Ok).then(|| (s.name().to_string(), c))
-        })
+        .filter_map(|(s, c)| (c > 0 || s == Status::Ok).then(|| (s.name().to_string(), c)))
         .collect();
     (best, named)
 }

@@ -832,7 +832,7 @@ fn check_structure<const N: usize, const B: usize>(
             kb.points().len(),
             "boundary {k}: one result per point"
         );
-        let mut counts = [0usize; Status::ALL.len()];
+        let mut counts = vec![0usize; Status::ALL.len()];
         let mut ok = 0;
         for (i, (r, p)) in b.points().iter().zip(kb.points()).enumerate() {
             let at = || format!("boundary {k} point {i}: {r:?}");

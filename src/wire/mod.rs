@@ -190,7 +190,9 @@ impl Default for DataIds {
 
 /// The CRC's implementation: one 256-entry table (1 KiB of flash), about
 /// five instructions a byte on the Cortex-M4F; README ("The link") gives
-/// the measured trade-off against no table and 16 tables.
+/// the measured trade-off against no table and 16 tables. (The decoder
+/// runs its own register over this table, a word at a time, inside its
+/// pass over the points: see `decode`.)
 pub(crate) type CrcTable = Table<1>;
 
 /// CRC-32/AUTOSAR (polynomial `0xF4ACFB13`, reflected, init and xorout

@@ -284,10 +284,13 @@ fn lean<const UP: bool>(
         } else {
             pv.wrapping_sub(v)
         } as i32;
+        // A zero high byte puts `u` or `v` below 0x0101, outside: only
+        // the low bytes need the zero test here.
         if u.wrapping_sub(base) > umax
             || v.wrapping_sub(base) > vmax
             || step <= 0
-            || zero_bytes(w) != 0
+            || w & 0xFF == 0
+            || w & 0xFF_0000 == 0
         {
             break;
         }

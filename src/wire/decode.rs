@@ -262,8 +262,10 @@ fn pixel(w: u32) -> Pixel {
 /// which excludes duplicates), no zero byte (a delimiter) and the CRC,
 /// each point stored as its pixel. `pv` is the previous point's raw `v`.
 /// Stops before the first point that fails any test; gives how many it
-/// took and the register.
-#[inline(always)]
+/// took and the register. (Not inlined: inside the decoder's dispatch
+/// its loop lacked registers, rematerialising the table's address and
+/// reloading the limits each point.)
+#[inline(never)]
 fn lean<const UP: bool>(
     words: &[[u8; POINT_LEN]],
     dst: &mut [Pixel],

@@ -2,10 +2,12 @@
 //!
 //! COBS framing is the `cobs` crate's [`DecoderState`] state machine: it
 //! reads every code byte and delimiter, and its run counter says how many
-//! data bytes follow, which are then taken as one slice (the CRC and the
-//! points are computed over whole runs, not byte by byte). The decoded
-//! bytes go through the CRC register and a small parser; a frame's points
-//! are written straight into the decoder's [`Frame`] and validated there.
+//! data bytes follow, which are then taken as one slice. A run's bytes
+//! are the decoded bytes, and none may be zero (a zero is the delimiter):
+//! one pass over the run tests for a zero, updates the CRC register (the
+//! `crc` crate's CRC-32/AUTOSAR table, a word at a time) and parses. A
+//! frame's points are checked in that same pass, a word each, and written
+//! straight into the decoder's [`Frame`]; nothing is copied in between.
 //!
 //! # Bounds
 //! [`Decoder::feed`] does constant work per input byte and returns after
@@ -13,12 +15,10 @@
 //! fixed-size sections (at most [`MOTION_LEN`] bytes) and a partial point.
 
 use cobs::{DecodeResult, DecoderState};
-use crc::Digest;
 
 use super::{
-    raw_to_px, raw_to_radius, CrcTable, DataIds, PacketType, WireError, BOUNDARY_HEAD_LEN,
-    CAMERA_LEN, CRC, CRC_LEN, FRAME_HEAD_LEN, HEADER_LEN, MAGIC, MOTION_LEN, POINT_LEN, RESIDUE,
-    VERSION,
+    raw_to_px, raw_to_radius, DataIds, PacketType, WireError, BOUNDARY_HEAD_LEN, CAMERA_LEN, CRC,
+    CRC_LEN, FRAME_HEAD_LEN, HEADER_LEN, MAGIC, MOTION_LEN, POINT_LEN, RESIDUE, VERSION,
 };
 use crate::{Camera, Config, Frame, Motion, Pixel};
 
@@ -185,69 +185,123 @@ impl PointRun {
         self.index = index + 1;
         Ok(())
     }
-
-    /// Check and convert `chunks` into `dst` (same length); stops at the
-    /// first bad point. The usual case, once the row direction is known,
-    /// in a lean loop; a point it does not pass gets the careful check,
-    /// which names the error.
-    #[inline(never)]
-    fn store(&mut self, chunks: &[[u8; 4]], dst: &mut [Pixel]) -> Result<(), crate::BoundaryError> {
-        let mut pairs = dst.iter_mut().zip(chunks);
-        while self.index < 2 {
-            let Some((d, c)) = pairs.next() else {
-                return Ok(());
-            };
-            let w = u32::from_le_bytes(*c);
-            self.check(w)?;
-            *d = Pixel::new(raw_to_px(w as u16), raw_to_px((w >> 16) as u16));
-        }
-        let base = u32::from(super::RAW_MINUS_ONE_PX);
-        let (umax, vmax) = self.limits;
-        let (mut prev, mut step) = (self.prev, self.step);
-        let mut taken = 0usize;
-        let mut failed = None;
-        for (d, c) in pairs {
-            let w = u32::from_le_bytes(*c);
-            let (u, v) = (w & 0xFFFF, w >> 16);
-            let dv = v as i32 - (prev >> 16) as i32;
-            // (A duplicate has dv = 0 too: the careful check tells which.)
-            if u.wrapping_sub(base) > umax
-                || v.wrapping_sub(base) > vmax
-                || dv == 0
-                || (dv ^ step) < 0
-            {
-                failed = Some(w);
-                break;
-            }
-            step = dv;
-            prev = w;
-            *d = Pixel::new(raw_to_px(u as u16), raw_to_px(v as u16));
-            taken += 1;
-        }
-        self.index += taken;
-        self.step = step;
-        self.prev = prev;
-        match failed {
-            Some(w) => self.check(w),
-            None => Ok(()),
-        }
-    }
 }
 
-/// The first zero byte of `s`: four bytes at a time (a word has a zero
-/// byte iff `(w − 0x0101_0101) & !w & 0x8080_8080 ≠ 0`), then byte by byte.
+/// The CRC register's value at the start of a packet. CRC-32/AUTOSAR is
+/// reflected: the register holds the reflected remainder, shifts right,
+/// and takes each byte at its low end (the `crc` crate's table).
+const CRC_INIT: u32 = crc::CRC_32_AUTOSAR.init.reverse_bits();
+const _: () = assert!(
+    crc::CRC_32_AUTOSAR.refin && crc::CRC_32_AUTOSAR.refout && crc::CRC_32_AUTOSAR.width == 32
+);
+
+/// The `crc` crate's table for [`CRC`] (one 256-entry lane).
 #[inline(always)]
-fn zero_at(s: &[u8]) -> Option<usize> {
-    let (words, _) = s.as_chunks::<4>();
-    let mut at = 0;
-    for w in words {
-        let x = u32::from_le_bytes(*w);
-        if x.wrapping_sub(0x0101_0101) & !x & 0x8080_8080 != 0 {
+fn crc_table() -> &'static [u32; 256] {
+    let [t] = CRC.table();
+    t
+}
+
+/// The register after one more byte entered its low end.
+#[inline(always)]
+fn crc_shift(t: &[u32; 256], c: u32) -> u32 {
+    t.get((c & 0xFF) as usize).copied().unwrap_or(0) ^ (c >> 8)
+}
+
+/// The register after byte `b`.
+#[inline(always)]
+fn crc_byte(t: &[u32; 256], c: u32, b: u8) -> u32 {
+    crc_shift(t, c ^ u32::from(b))
+}
+
+/// The register after the four bytes of `w` (little endian).
+#[inline(always)]
+fn crc_word(t: &[u32; 256], c: u32, w: u32) -> u32 {
+    crc_shift(t, crc_shift(t, crc_shift(t, crc_shift(t, c ^ w))))
+}
+
+/// Non-zero iff one of the four bytes of `w` is zero; then its lowest set
+/// bit is bit 7 of the first zero byte (the bits above it may be wrong).
+#[inline(always)]
+fn zero_bytes(w: u32) -> u32 {
+    w.wrapping_sub(0x0101_0101) & !w & 0x8080_8080
+}
+
+/// The register after `s`, bytes of a COBS run; `Err(z)`: a zero byte (a
+/// delimiter) at `z`, where the run ends.
+#[inline(always)]
+fn crc_run(mut c: u32, s: &[u8]) -> Result<u32, usize> {
+    let t = crc_table();
+    let (words, tail) = s.as_chunks::<4>();
+    for (i, w) in words.iter().enumerate() {
+        let w = u32::from_le_bytes(*w);
+        let z = zero_bytes(w);
+        if z != 0 {
+            return Err(4 * i + (z.trailing_zeros() / 8) as usize);
+        }
+        c = crc_word(t, c, w);
+    }
+    for (i, &b) in tail.iter().enumerate() {
+        if b == 0 {
+            return Err(4 * words.len() + i);
+        }
+        c = crc_byte(t, c, b);
+    }
+    Ok(c)
+}
+
+/// A point's pixel from its raw word (`u` low, `v` high).
+#[inline(always)]
+fn pixel(w: u32) -> Pixel {
+    Pixel::new(raw_to_px(w as u16), raw_to_px((w >> 16) as u16))
+}
+
+/// The lean loop over whole points once the row direction is known
+/// (`UP`: `v` grows): every check of [`PointRun::check`] on the raw word
+/// (inside the image with its margin, a row step of the boundary's sign,
+/// which excludes duplicates), no zero byte (a delimiter) and the CRC,
+/// each point stored as its pixel. `pv` is the previous point's raw `v`.
+/// Stops before the first point that fails any test; gives how many it
+/// took and the register. (Not inlined: inside the decoder's dispatch
+/// its loop lacked registers, rematerialising the table's address and
+/// reloading the limits each point.)
+#[inline(never)]
+fn lean<const UP: bool>(
+    words: &[[u8; POINT_LEN]],
+    dst: &mut [Pixel],
+    limits: (u32, u32),
+    mut crc: u32,
+    mut pv: u32,
+) -> (usize, u32) {
+    let t = crc_table();
+    let base = u32::from(super::RAW_MINUS_ONE_PX);
+    let (umax, vmax) = limits;
+    let mut taken = 0usize;
+    for (d, c) in dst.iter_mut().zip(words) {
+        let w = u32::from_le_bytes(*c);
+        let (u, v) = (w & 0xFFFF, w >> 16);
+        // (|v − pv| < 2^16: the difference as i32 is exact.)
+        let step = if UP {
+            v.wrapping_sub(pv)
+        } else {
+            pv.wrapping_sub(v)
+        } as i32;
+        // A zero high byte puts `u` or `v` below 0x0101, outside: only
+        // the low bytes need the zero test here.
+        if u.wrapping_sub(base) > umax
+            || v.wrapping_sub(base) > vmax
+            || step <= 0
+            || w & 0xFF == 0
+            || w & 0xFF_0000 == 0
+        {
             break;
         }
-        at += 4;
+        crc = crc_word(t, crc, w);
+        *d = pixel(w);
+        pv = v;
+        taken += 1;
     }
-    s.get(at..)?.iter().position(|&b| b == 0).map(|i| at + i)
+    (taken, crc)
 }
 
 fn le16(b: &[u8], at: usize) -> u16 {
@@ -286,7 +340,8 @@ fn lef32(b: &[u8], at: usize) -> f32 {
 pub struct Decoder<const N: usize, const B: usize> {
     ids: DataIds,
     cobs: DecoderState,
-    crc: Digest<'static, u32, CrcTable>,
+    /// The CRC register ([`CRC_INIT`] at a packet's start).
+    crc: u32,
     /// Bytes decoded in the current packet (saturating).
     pos: u32,
     state: State,
@@ -329,7 +384,7 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
         Self {
             ids,
             cobs: DecoderState::Idle,
-            crc: CRC.digest(),
+            crc: CRC_INIT,
             pos: 0,
             state: State::Skip,
             ptype: None,
@@ -381,14 +436,14 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
                 let Some((chunk, after_chunk)) = rest.split_at_checked(take) else {
                     break;
                 };
-                if let Some(z) = zero_at(chunk) {
+                let at = self.pos;
+                if let Some(z) = self.run(chunk) {
                     // A delimiter inside a run: the packet was cut short.
                     used += z + 1;
                     self.cobs = DecoderState::Idle;
-                    let len = self.pos.saturating_add(z as u32);
+                    let len = at.saturating_add(z as u32);
                     return (used, Some(self.fail(WireError::Truncated { len })));
                 }
-                self.data(chunk);
                 let left = run - take as u8;
                 self.cobs = match self.cobs {
                     DecoderState::GrabChain(_) => DecoderState::GrabChain(left),
@@ -403,7 +458,7 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
             match self.cobs.feed(byte) {
                 Ok(DecodeResult::NoData) => {}
                 Ok(DecodeResult::DataStart) => self.start(),
-                Ok(DecodeResult::DataContinue(b)) => self.data(&[b]),
+                Ok(DecodeResult::DataContinue(b)) => self.decoded(b),
                 Ok(DecodeResult::DataComplete) => return (used, Some(self.finish())),
                 Err(_) => {
                     let len = self.pos;
@@ -424,7 +479,7 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
 
     /// A packet begins.
     fn start(&mut self) {
-        self.crc = CRC.digest();
+        self.crc = CRC_INIT;
         self.pos = 0;
         self.state = State::Small(Section::Header);
         self.small_len = 0;
@@ -436,20 +491,58 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
         self.carry_len = 0;
     }
 
-    /// Decoded bytes of the current packet.
-    fn data(&mut self, bytes: &[u8]) {
-        self.crc.update(bytes);
-        let mut s = bytes;
-        // Each pass consumes at least one byte.
+    /// The bytes of a COBS run (as sent: they are the decoded bytes, and a
+    /// zero among them is a delimiter) through the zero test, the CRC
+    /// register and the parser, each state taking what it can in one
+    /// pass. `Some(z)`: a zero at `z` (the run, and the packet, end there;
+    /// the bytes before it were taken).
+    fn run(&mut self, chunk: &[u8]) -> Option<usize> {
+        let mut s = chunk;
         while !s.is_empty() {
-            s = match self.state {
+            let at = chunk.len() - s.len();
+            let taken = match self.state {
                 State::Small(section) => self.small(section, s),
                 State::Points => self.points(s),
-                State::Trailer | State::Skip => {
-                    self.advance(s.len());
-                    &[]
-                }
+                State::Trailer | State::Skip => match crc_run(self.crc, s) {
+                    Ok(c) => {
+                        self.crc = c;
+                        self.advance(s.len());
+                        Ok(&[][..])
+                    }
+                    Err(z) => Err(z),
+                },
             };
+            let rest = match taken {
+                Ok(rest) => rest,
+                Err(z) => return Some(at + z),
+            };
+            // (Every pass takes at least one byte.)
+            if rest.len() >= s.len() {
+                break;
+            }
+            s = rest;
+        }
+        None
+    }
+
+    /// The zero byte COBS decodes at the end of a run (a code byte).
+    fn decoded(&mut self, b: u8) {
+        self.crc = crc_byte(crc_table(), self.crc, b);
+        match self.state {
+            State::Small(section) => {
+                if let Some(d) = self.small.get_mut(self.small_len) {
+                    *d = b;
+                }
+                self.small_len += 1;
+                self.advance(1);
+                if self.small_len >= section.len() {
+                    self.section_done(section);
+                }
+            }
+            State::Points => {
+                self.carry(b);
+            }
+            State::Trailer | State::Skip => self.advance(1),
         }
     }
 
@@ -499,10 +592,12 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
         }
     }
 
-    fn small<'s>(&mut self, section: Section, s: &'s [u8]) -> &'s [u8] {
+    /// Bytes of a run into a fixed-size section.
+    fn small<'s>(&mut self, section: Section, s: &'s [u8]) -> Result<&'s [u8], usize> {
         let need = section.len();
         let take = need.saturating_sub(self.small_len).min(s.len());
         let (head, tail) = s.split_at_checked(take).unwrap_or((s, &[]));
+        self.crc = crc_run(self.crc, head)?;
         if let Some(dst) = self.small.get_mut(self.small_len..self.small_len + take) {
             for (d, b) in dst.iter_mut().zip(head) {
                 *d = *b;
@@ -513,7 +608,7 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
         if self.small_len >= need {
             self.section_done(section);
         }
-        tail
+        Ok(tail)
     }
 
     fn section_done(&mut self, section: Section) {
@@ -654,49 +749,50 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
         self.state = State::Points;
     }
 
-    /// Points of the current boundary: whole points straight into the
-    /// frame's slot, a partial one carried to the next slice.
-    fn points<'s>(&mut self, s: &'s [u8]) -> &'s [u8] {
+    /// Points of the current boundary from a run: whole points straight
+    /// into the frame's slot (once the row direction is known, in the lean
+    /// loop), the first two of a boundary and a point split between runs
+    /// or feeds byte by byte through the carry.
+    fn points<'s>(&mut self, s: &'s [u8]) -> Result<&'s [u8], usize> {
+        if self.carry_len == 0 && self.done >= 2 && s.len() >= POINT_LEN {
+            return self.whole_points(s);
+        }
+        // At most one point's bytes.
         let mut s = s;
-        if self.carry_len > 0 || s.len() < POINT_LEN {
-            while self.carry_len < POINT_LEN {
-                let Some((&b, rest)) = s.split_first() else {
-                    return s;
-                };
-                if let Some(c) = self.carry.get_mut(self.carry_len) {
-                    *c = b;
-                }
-                self.carry_len += 1;
-                self.advance(1);
-                s = rest;
+        let mut at = 0;
+        while let Some((&b, rest)) = s.split_first() {
+            if b == 0 {
+                return Err(at);
             }
-            self.carry_len = 0;
-            let c = self.carry;
-            self.store(&c);
-        } else {
-            let left = (self.points - self.done) * POINT_LEN;
-            let whole = left.min(s.len() - s.len() % POINT_LEN);
-            let (body, rest) = s.split_at_checked(whole).unwrap_or((&[], s));
-            self.advance(whole);
-            self.store(body);
+            self.crc = crc_byte(crc_table(), self.crc, b);
             s = rest;
+            at += 1;
+            if self.carry(b) {
+                break;
+            }
         }
-        if self.state == State::Points && self.done >= self.points {
-            self.boundary_done();
-        }
-        s
+        Ok(s)
     }
 
-    /// Validate whole points and convert them into the next slot's
-    /// storage. The checks are [`crate::Frame::push_boundary`]'s, done on
-    /// the raw values, in the same order, with the same errors: every
-    /// point is finite by construction; `u` is inside `[−1, width]` iff
-    /// `raw − 0x0101` is in `[0, 16 (width + 1)]` (the conversion is exact);
-    /// equal raw points are equal pixels; a row step's sign is the raw
-    /// step's.
-    #[inline(always)]
-    fn store(&mut self, body: &[u8]) {
-        let (chunks, _) = body.as_chunks::<POINT_LEN>();
+    /// One byte of a point (already through the CRC); `true` when it
+    /// completed the point.
+    fn carry(&mut self, b: u8) -> bool {
+        if let Some(c) = self.carry.get_mut(self.carry_len) {
+            *c = b;
+        }
+        self.carry_len += 1;
+        self.advance(1);
+        if self.carry_len < POINT_LEN {
+            return false;
+        }
+        self.carry_len = 0;
+        self.point(u32::from_le_bytes(self.carry));
+        true
+    }
+
+    /// One point (already through the CRC) with the careful check, which
+    /// names the error.
+    fn point(&mut self, w: u32) {
         let done = self.done;
         let mut run = PointRun {
             limits: self.limits,
@@ -704,23 +800,83 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
             step: self.step,
             index: done,
         };
-        let mut bad = None;
-        if let Some(dst) = self
-            .frame
-            .next_storage()
-            .and_then(|s| s.get_mut(done..done + chunks.len()))
-        {
-            bad = run.store(chunks, dst).err();
-        }
+        let checked = run.check(w);
         self.prev = run.prev;
         self.step = run.step;
-        self.done = done + chunks.len();
-        if let Some(error) = bad {
-            self.fault(WireError::Boundary {
+        self.done = done + 1;
+        match checked {
+            Ok(()) => {
+                if let Some(d) = self.frame.next_storage().and_then(|p| p.get_mut(done)) {
+                    *d = pixel(w);
+                }
+                if self.done >= self.points {
+                    self.boundary_done();
+                }
+            }
+            Err(error) => self.fault(WireError::Boundary {
                 boundary: u8::try_from(self.boundary).unwrap_or(u8::MAX),
                 error,
-            });
+            }),
         }
+    }
+
+    /// Whole points of a run (at least one; the row direction known):
+    /// the lean loop, then the careful check of a point it did not take.
+    /// The checks are [`crate::Frame::push_boundary`]'s, done on the raw
+    /// values, in the same order, with the same errors: every point is
+    /// finite by construction; `u` is inside `[−1, width]` iff
+    /// `raw − 0x0101` is in `[0, 16 (width + 1)]` (the conversion is
+    /// exact); equal raw points are equal pixels; a row step's sign is the
+    /// raw step's.
+    fn whole_points<'s>(&mut self, s: &'s [u8]) -> Result<&'s [u8], usize> {
+        let done = self.done;
+        let n = self.points.saturating_sub(done).min(s.len() / POINT_LEN);
+        let (words, _) = s.as_chunks::<POINT_LEN>();
+        let words = words.get(..n).unwrap_or(&[]);
+        let Some(dst) = self
+            .frame
+            .next_storage()
+            .and_then(|p| p.get_mut(done..done + words.len()))
+        else {
+            // (Not reached: the frame head admits at most `B` boundaries.)
+            // Taken unstored; `boundary_done` reports the full frame.
+            let len = words.len() * POINT_LEN;
+            let (body, rest) = s.split_at_checked(len).unwrap_or((s, &[]));
+            self.crc = crc_run(self.crc, body)?;
+            self.advance(len);
+            self.done = done + words.len();
+            if self.done >= self.points {
+                self.boundary_done();
+            }
+            return Ok(rest);
+        };
+        let pv = self.prev >> 16;
+        let (taken, crc) = if self.step > 0 {
+            lean::<true>(words, dst, self.limits, self.crc, pv)
+        } else {
+            lean::<false>(words, dst, self.limits, self.crc, pv)
+        };
+        self.crc = crc;
+        if let Some(c) = taken.checked_sub(1).and_then(|i| words.get(i)) {
+            self.prev = u32::from_le_bytes(*c);
+        }
+        self.done = done + taken;
+        self.advance(taken * POINT_LEN);
+        let mut end = taken;
+        if let Some(c) = words.get(taken) {
+            let w = u32::from_le_bytes(*c);
+            let z = zero_bytes(w);
+            if z != 0 {
+                return Err(taken * POINT_LEN + (z.trailing_zeros() / 8) as usize);
+            }
+            self.crc = crc_word(crc_table(), self.crc, w);
+            self.advance(POINT_LEN);
+            self.point(w);
+            end += 1;
+        } else if self.done >= self.points {
+            self.boundary_done();
+        }
+        Ok(s.get(end * POINT_LEN..).unwrap_or(&[]))
     }
 
     fn boundary_done(&mut self) {
@@ -792,7 +948,7 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
         if len < (HEADER_LEN + CRC_LEN) as u32 {
             return err(WireError::Truncated { len });
         }
-        if self.crc.clone().finalize() != RESIDUE {
+        if self.crc ^ crc::CRC_32_AUTOSAR.xorout != RESIDUE {
             return err(WireError::BadCrc);
         }
         if let Some(e) = self.header_fault {
@@ -851,5 +1007,45 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
             (None, _) => Err(WireError::Truncated { len }),
         };
         Decoded { missed, packet }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The decoder's register over the crate's table is the crate's
+    /// CRC-32/AUTOSAR, at every length and split; a zero stops it at its
+    /// index.
+    #[test]
+    fn crc_register_is_the_crates() {
+        let mut rng = crate::test_rng::Rng(0x2026_0012);
+        let bytes: [u8; 300] = core::array::from_fn(|_| 1 + (rng.next() * 255.0) as u8);
+        for len in 0..bytes.len() {
+            let b = &bytes[..len];
+            for cut in [0, len / 3, len / 2, len] {
+                let c = crc_run(CRC_INIT, &b[..cut]).unwrap();
+                let c = crc_run(c, &b[cut..]).unwrap();
+                assert_eq!(
+                    c ^ crc::CRC_32_AUTOSAR.xorout,
+                    CRC.checksum(b),
+                    "{len} {cut}"
+                );
+            }
+            let mut c = CRC_INIT;
+            for (i, &x) in b.iter().enumerate() {
+                c = if i % 3 == 0 {
+                    crc_byte(crc_table(), c, x)
+                } else {
+                    crc_run(c, &[x]).unwrap()
+                };
+            }
+            assert_eq!(c ^ crc::CRC_32_AUTOSAR.xorout, CRC.checksum(b));
+            for z in 0..len {
+                let mut with_zero = b.to_vec();
+                with_zero[z] = 0;
+                assert_eq!(crc_run(CRC_INIT, &with_zero), Err(z));
+            }
+        }
     }
 }

@@ -193,7 +193,9 @@ impl Default for DataIds {
 
 /// The CRC's implementation: one 256-entry table (1 KiB of flash), about
 /// five instructions a byte on the Cortex-M4F; README ("The link") gives
-/// the measured trade-off against no table and 16 tables.
+/// the measured trade-off against no table and 16 tables. (The decoder
+/// runs its own register over this table, a word at a time, inside its
+/// pass over the points: see `decode`.)
 pub(crate) type CrcTable = Table<1>;
 
 /// CRC-32/AUTOSAR (polynomial `0xF4ACFB13`, reflected, init and xorout
@@ -221,9 +223,18 @@ pub(crate) const RAW_MINUS_ONE_PX: u16 = 0x0101;
 
 /// A point coordinate on the wire → pixels: `raw / 16 − 17.0625`, i.e.
 /// `(raw − 0x0101) / 16 − 1` (exact in `f32`).
+///
+/// Computed without a conversion instruction: the `f32` with the bits
+/// `0x4900_0000 | raw` is `2^19 + raw / 16` (the numbers of `[2^19, 2^20)`
+/// step by 1/16 and `raw` fills the low 16 of the 23 fraction bits), and
+/// subtracting `2^19 + 17.0625` is exact (the operands are within a factor
+/// of two of each other), so the result is the same as
+/// `f32::from(raw) * 0.0625 - 17.0625`, bit for bit.
 #[inline(always)]
 pub fn raw_to_px(raw: u16) -> f32 {
-    f32::from(raw) * 0.0625 - 17.0625
+    // 2^19 + 17.0625 (exact in `f32`).
+    const BIAS: f32 = 524_288.0 + 17.0625;
+    f32::from_bits(0x4900_0000 | u32::from(raw)) - BIAS
 }
 
 /// Pixels → a point coordinate on the wire, rounded to the nearest

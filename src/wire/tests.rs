@@ -131,6 +131,11 @@ fn fixed_point_conversions_are_exact() {
     for raw in [257u16, 258, 272, 273, 8000, 65535] {
         assert_eq!(px_to_raw(raw_to_px(raw)), Some(raw));
     }
+    // Bit for bit the plain formula, at every raw value.
+    for raw in 0..=u16::MAX {
+        let plain = f32::from(raw) * 0.0625 - 17.0625;
+        assert_eq!(raw_to_px(raw).to_bits(), plain.to_bits(), "{raw}");
+    }
     assert_eq!(raw_to_px(RAW_MINUS_ONE_PX), -1.0);
     assert_eq!(raw_to_px(65535), 4078.875);
     assert_eq!(px_to_raw(-1.04), None);

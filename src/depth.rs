@@ -71,7 +71,7 @@
 //! `s_far = W' + σ_w + A₊/(L₋ − r₁)`,   `s_near = W' − σ_w + A₋/(L₊ + r₁)`
 //!
 //! and `Z = s/q_z` with `q_z` itself within `Δ` of ours when the point
-//! moves by `e₁` ([`crate::epipolar::PairGeometry::depth_scale_error`]).
+//! moves by `e₁` (`PairGeometry::depth_scale_error`).
 //! When `L₋ ≤ r₁` the disparity is not larger than its error and the far
 //! end is unbounded ([`crate::Status::Unbounded`], also when the near end
 //! reaches 0). This is the paper's interval with both errors as discs: for
@@ -84,7 +84,7 @@
 //!
 //! All of this is computed in `f32`. The band is widened by the rounding of
 //! the coordinates involved, `2⁻²⁰ S` pixels for coordinates below `S`
-//! ([`crate::epipolar::PairGeometry::coordinate_scale`], about 10⁻³ px for
+//! (`PairGeometry::coordinate_scale`, about 10⁻³ px for
 //! the paper's camera), and the estimate `s = W' + |a|²/λ` shares the form
 //! of the stick's ends with smaller numerators and larger denominators at
 //! `s_far` (the reverse at `s_near`): IEEE `+ − × ÷` are monotone in each

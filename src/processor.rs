@@ -5,17 +5,17 @@
 //!
 //! 1. **Compensate** every frame-1 point ([`crate::epipolar`]): `p₁'`, `1/q_z`,
 //!    its error radius `r₁`, and the key of its epipolar line
-//!    ([`crate::pencil`]); points behind the frame-2 camera or far out of
+//!    (`crate::pencil`); points behind the frame-2 camera or far out of
 //!    its view are flagged (checks a frame skips when its whole image
 //!    passes them, `PairGeometry::certifies_image`).
 //! 2. **Fold test**: index the compensated frame-1 polyline by key and flag
 //!    the points whose own epipolar line meets it again away from them
 //!    ([`Status::Folded`]); when the keys are strictly ordered along the
 //!    polyline nothing folds, and no index is built.
-//! 3. **Index** the corresponding frame-2 polyline ([`crate::search`]).
+//! 3. **Index** the corresponding frame-2 polyline (`crate::search`).
 //! 4. **Match** every remaining point: its error band ([`crate::depth`]),
 //!    the segments the index offers for the band's key interval, the walk
-//!    over them ([`crate::matching`]), and the depth and stick.
+//!    over them (`crate::matching`), and the depth and stick.
 //!
 //! Memory is fixed at compile time: a `Processor<N, B>` holds the previous
 //! frame (`B` boundaries of up to `N` points), one search index and the

@@ -303,7 +303,7 @@ pub struct FusedCounts {
     pub inconsistent: u32,
 }
 
-/// The fusion state of one key frame: a [`Cell`] per boundary point.
+/// The fusion state of one key frame: a `Cell` per boundary point.
 ///
 /// Size: `16·B·N` bytes and a few words (`8 KiB + 32 B` for `N = 256`,
 /// `B = 2`).

@@ -64,6 +64,8 @@ const CARGO_CHECKS: &[(&str, &[&str])] = &[
     ("host_tests", &["clippy", "--all-targets", "--", "-D", "warnings"]),
     // The firmware binaries.
     ("", &["clippy", "--release", "--target", THUMB, "--features", "firmware", "--bins", "--", "-D", "warnings"]),
+    // ... and for the second board (its own target dir, as `Board` builds it).
+    ("", &["clippy", "--release", "--target", THUMB, "--features", "board-f405", "--bins", "--target-dir", "target/f405", "--", "-D", "warnings"]),
 ];
 
 /// Everything CI runs: toolchain setup, the cargo checks above, the tests,

@@ -17,11 +17,19 @@ const FIRMWARE_ONLY: [&str; 2] = ["instr", "budget_permille"];
 /// `cargo xtask demo [--check] [--board mps2|f405|both]` (`both`: on each
 /// board, checked, and the boards compared).
 pub fn demo_args(args: &[String]) -> Result<(), String> {
-    let check = args.iter().any(|a| a == "--check");
-    let name = match args.iter().position(|a| a == "--board") {
-        None => "mps2",
-        Some(i) => args.get(i + 1).map(String::as_str).unwrap_or(""),
-    };
+    let (mut check, mut name) = (false, "mps2");
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--check" => check = true,
+            "--board" => name = it.next().map(String::as_str).unwrap_or(""),
+            other => {
+                return Err(format!(
+                    "unknown argument {other:?} (usage: cargo xtask demo [--check] [--board mps2|f405|both])"
+                ))
+            }
+        }
+    }
     if name == "both" {
         return demo_on_both_boards();
     }

@@ -5,14 +5,16 @@
 //! instruction counter) and the QEMU machine `cargo xtask` runs it on.
 //!
 //! To add a board: a feature in `Cargo.toml` (implying `firmware`), its
-//! memory map in `boards/` (beside `stm32f405.x`) and its arm in `build.rs`, its constants
-//! here, and its QEMU machine in `xtask/src/firmware.rs` (`Board`).
+//! memory map in `boards/` (beside `stm32f405.x`) and its arm in
+//! `build.rs`, its constants here (and its feature in the default's
+//! `not(any(...))`), and its QEMU machine in `xtask/src/firmware.rs`
+//! (`Board`; README, "Boards", lists every place).
 
 /// The board's name, as the firmware logs it.
-#[cfg(not(feature = "board-f405"))]
+#[cfg(not(any(feature = "board-f405")))]
 pub const NAME: &str = "mps2-an386";
 /// The core clock, hertz: SysTick counts it.
-#[cfg(not(feature = "board-f405"))]
+#[cfg(not(any(feature = "board-f405")))]
 pub const CORE_HZ: u64 = 25_000_000;
 
 /// The board's name, as the firmware logs it.

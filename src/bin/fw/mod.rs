@@ -61,7 +61,8 @@ pub fn ticks() -> u64 {
 /// Instructions executed in `ticks` core-clock ticks under `-icount shift=5`
 /// (32 ns each).
 pub fn instructions(ticks: u64) -> u32 {
-    let ns = ticks.saturating_mul(1_000_000_000) / board::CORE_HZ;
+    // In u128: ticks × 10⁹ passes u64 after 110 s at 168 MHz.
+    let ns = u128::from(ticks) * 1_000_000_000 / u128::from(board::CORE_HZ);
     u32::try_from(ns / 32).unwrap_or(u32::MAX)
 }
 

@@ -34,6 +34,9 @@ static WINDOWS: &[(&str, &[u8])] = &[
     // Spurious frame-2 detector points (N = 256): the wedge path's lean walk
     // with the index's aside entries merged in.
     ("spur_f2", include_bytes!("data/adv_spur_f2_256.bin")),
+    // The adversarial family's costliest member at 2 × 256 (a frame-1
+    // boundary across the FOE's row): the general band path.
+    ("foe_row", include_bytes!("data/adv_foe_row_256.bin")),
 ];
 
 /// Capacity: the bench's, so the per-frame code is the bench's too.

@@ -780,7 +780,8 @@ pub fn host_cost(
     let counts = p.structure().status_counts();
     let named = counts
         .iter()
-        .filter_map(|(s, c)| (c > 0 || s == Status::Ok).then(|| (s.name().to_string(), c)))
+        .filter(|&(s, c)| c > 0 || s == Status::Ok)
+        .map(|(s, c)| (s.name().to_string(), c))
         .collect();
     (best, named)
 }

@@ -176,9 +176,13 @@ impl Config {
 
     /// The same configuration with sticks that also hold when the rotation
     /// given to [`crate::Processor::process`] may be off by up to `eps`
-    /// radians about each axis (`x`, `y`, `z`; at most 0.1 rad in all): every
-    /// point's frame-1 localisation error grows by
-    /// [`crate::motion_error::rotation_shift_bound`].
+    /// radians about each of the frame-2 camera's axes (`x`, `y`, `z`: the
+    /// components of the error rotation `Rᵀ R_true` as a rotation vector;
+    /// at most 0.1 rad in all): every point's frame-1 localisation error
+    /// grows by [`crate::motion_error::rotation_shift_bound`]. Bounds on
+    /// the errors of the Euler angles of [`crate::Motion::new`] are not the
+    /// same thing away from zero rotation: convert them with
+    /// [`crate::motion_error::euler_error_box`].
     ///
     /// ```
     /// use roadstereo::Config;

@@ -20,10 +20,23 @@
 //! by the rotational flow at `(x, y)` (normalised frame-2 coordinates):
 //! `δx = f_x (x y ω_x − (1 + x²) ω_y + y ω_z)`,
 //! `δy = f_y ((1 + y²) ω_x − x y ω_y − x ω_z)` to first order. For
-//! `|ω_k| ≤ ε_k` its length is at most
-//! `Σ_k |flow column k| ε_k + f (1 + x² + y²) (Σ ε_k)²` (the last term covers
-//! the second order, generously, for `Σ ε_k ≤ 0.1` rad) —
-//! [`rotation_shift_bound`]. With [`crate::Config::with_rotation_error`] that
+//! `|ω_k| ≤ ε_k` the first-order flow `F` is at most `Σ_k |flow column
+//! k| ε_k` long.
+//!
+//! # The rotation's shift
+//! The rest is bounded exactly, not to first order (an earlier bound,
+//! `F + f (1 + x² + y²) (Σ ε_k)²`, fell 21 % short at the edge of a
+//! 150 px-focal image with a 0.1 rad error: the second order grows as
+//! `|x| (1 + x²)`). For the ray `r = (x, y, 1)` and an error rotation
+//! `ΔR` of angle `θ = |ω| ≤ Σ ε_k`, `ΔR − I − [ω]× = (1 − cos θ) [n]×² +
+//! (sin θ − θ) [n]×`, so `ΔR r = r + ω × r + η` with `|η| ≤ (θ²/2 +
+//! θ³/6) |r|`. The projection moves by `(δ_xy − p δ_z)/(1 + δ_z)` for `δ
+//! = ΔR r − r`, and `(ω × r)_xy − p (ω × r)_z` is the flow `F`, so the
+//! shift is `(F + η_xy − p η_z)/(1 + δ_z)`, at most `(|F| + f |η| (1 +
+//! |p|))/(1 − |δ_z|)` pixels with `|δ_z| ≤ ε_x |y| + ε_y |x| + |η|`
+//! (`f` the larger focal length; no claim where `|δ_z| ≥ 1/2`, far off
+//! the camera's axis) — [`rotation_shift_bound`], rounded up by `10⁻⁵`
+//! relative. With [`crate::Config::with_rotation_error`] that
 //! shift is added to the frame-1 localisation error of every point, so the
 //! stick holds for any rotation error in the box. At `f = 800` px a 1° error
 //! about `x` or `y` moves points by about 14 px at the image centre, about
@@ -154,6 +167,63 @@ pub fn rotation_shift_bound(p: Pixel, cam2: &Camera, eps: [f32; 3]) -> f32 {
     )
 }
 
+/// The box of rotation errors about the frame-2 camera's `x`, `y`, `z`
+/// axes (what [`rotation_shift_bound`] and
+/// [`crate::Config::with_rotation_error`] take) that holds every error of
+/// at most `eps` (radians) in the Euler angles `(α, β, γ)` of
+/// [`Motion::new`], at the angles `angles`.
+///
+/// The two are the same only near zero rotation. With `R = R_y(β) R_x(α)
+/// R_z(γ)` and each angle off by `δ`, the error rotation `Rᵀ R'` (the one
+/// that moves the compensated points) is `rot(u_β, δβ) rot(u_α, δα)
+/// rot(e_z, δγ)` with `u_α = R_z(γ)ᵀ e_x = (cos γ, −sin γ, 0)` and `u_β =
+/// (R_x(α) R_z(γ))ᵀ e_y = (cos α sin γ, cos α cos γ, −sin α)`: to first
+/// order the rotation vector `δα u_α + δβ u_β + δγ e_z`, whose components
+/// are bounded by the sums of `|δ_j| |u_j,k|`. The product's higher terms
+/// (Baker–Campbell–Hausdorff: a commutator of two rotation vectors is at
+/// most the product of their lengths) add at most `s²` to each component,
+/// `s = Σ |δ_j| ≤ 0.1` (generously; [`rotation_shift_bound`] claims nothing
+/// above it anyway). Each component is rounded up by `2⁻²⁰` relative. So at
+/// `γ = 5°` an error of `ε` in `α` alone gives `(0.996 ε, 0.087 ε, 0)`, not
+/// `(ε, 0, 0)`: a box of `ε` per axis would not hold it.
+///
+/// Angles as [`Motion::new`] takes them (`|angle| ≤`
+/// [`crate::motion::MAX_ROTATION_RAD`]), or an [`AngleError`].
+///
+/// ```
+/// use roadstereo::motion_error::euler_error_box;
+/// let e = 0.001;
+/// let b = euler_error_box([0.0, 0.3, 0.0], [e, e, e]).unwrap();
+/// // Without α and γ the axes are the angles' own (β is about y anyway).
+/// assert!(b.iter().all(|&k| k >= e && k < 1.01 * e));
+/// let b = euler_error_box([0.0, 0.0, 0.5], [e, 0.0, 0.0]).unwrap();
+/// assert!(b[1] > 0.47 * e); // an error in α reaches the y axis
+/// ```
+pub fn euler_error_box(
+    angles: [f32; 3],
+    eps: [f32; 3],
+) -> Result<[f32; 3], crate::math::AngleError> {
+    for a in angles {
+        if !a.is_finite() {
+            return Err(crate::math::AngleError::NotFinite);
+        }
+        if a.abs() > crate::motion::MAX_ROTATION_RAD {
+            return Err(crate::math::AngleError::TooLarge);
+        }
+    }
+    let (sa, ca) = crate::math::sin_cos_reduced(angles[0])?;
+    let (sg, cg) = crate::math::sin_cos_reduced(angles[2])?;
+    let [ea, eb, eg] = eps.map(f32::abs);
+    let s = ea + eb + eg;
+    let second = s * s;
+    let up = 1.0 + 9.536_743e-7;
+    Ok([
+        (ea * cg.abs() + eb * (ca * sg).abs() + second) * up,
+        (ea * sg.abs() + eb * (ca * cg).abs() + second) * up,
+        (eb * sa.abs() + eg + second) * up,
+    ])
+}
+
 /// [`rotation_shift_bound`] on the per-frame path: `p` as `[u, v]`, the
 /// intrinsics as `(f_x, f_y, c_x, c_y)`.
 #[inline]
@@ -173,8 +243,21 @@ pub(crate) fn shift_bound(p: [f32; 2], cam2: (f32, f32, f32, f32), eps: [f32; 3]
     for (c, e) in cols.iter().zip(eps.iter()) {
         b += crate::math::sqrt(dot(*c, *c)) * e.abs();
     }
+    // The rest, exactly bounded (module docs, "The rotation's shift"):
+    // `ΔR r = r + ω × r + η` with `|η| ≤ (θ²/2 + θ³/6) |r|`, `θ = |ω| ≤
+    // Σ ε`, and the shift `(F + η_xy − p η_z)/(1 + δ_z)` with `|δ_z| ≤
+    // ε_x |y| + ε_y |x| + |η|`.
     let f = if fx > fy { fx } else { fy };
-    b + f * (1.0 + x * x + y * y) * total * total
+    let rho2 = x * x + y * y;
+    let eta = total * total * (0.5 + total / 6.0) * crate::math::sqrt(1.0 + rho2);
+    let dz = eps[0].abs() * y.abs() + eps[1].abs() * x.abs() + eta;
+    // (A NaN fails.)
+    if !(dz < 0.5) {
+        return f32::INFINITY;
+    }
+    let rest = f * eta * (1.0 + crate::math::sqrt(rho2));
+    // Rounded up by a relative 1e-5 (a few dozen roundings of 2⁻²⁴).
+    (b + rest) / (1.0 - dz) * (1.0 + 1.0e-5)
 }
 
 /// Depth of the frame-1 pixel `p1` when its match is re-found, under

@@ -157,6 +157,15 @@ fn main() -> ! {
         if black_box(false) {
             fusion.reset();
         }
+        // The motion-error bounds an integrator configures with.
+        let angles = black_box([0.1f32, -0.2, 0.3]);
+        if let Ok(b) = roadstereo::motion_error::euler_error_box(angles, black_box([1e-3; 3])) {
+            black_box(roadstereo::motion_error::rotation_shift_bound(
+                roadstereo::Pixel::new(black_box(10.0), black_box(20.0)),
+                &camera,
+                b,
+            ));
+        }
         // The link: bytes from outside through the receiver (decoder,
         // pairing, per-pair config), the per-frame call, the result and
         // report packets, the UART driver, and the vehicle-side parsers.

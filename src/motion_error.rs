@@ -188,7 +188,7 @@ pub fn rotation_shift_bound(p: Pixel, cam2: &Camera, eps: [f32; 3]) -> f32 {
 /// `(ε, 0, 0)`: a box of `ε` per axis would not hold it.
 ///
 /// Angles as [`Motion::new`] takes them (`|angle| ≤`
-/// [`crate::motion::MAX_ROTATION_RAD`]), or an [`AngleError`].
+/// [`crate::motion::MAX_ROTATION_RAD`]), or an [`crate::AngleError`].
 ///
 /// ```
 /// use roadstereo::motion_error::euler_error_box;

@@ -11,6 +11,7 @@ pub mod jsonl;
 pub mod link;
 pub mod scenarios;
 pub mod synth;
+pub mod wire_ref;
 
 use roadstereo::{Frame, Pixel, Processor};
 

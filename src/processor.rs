@@ -448,13 +448,21 @@ fn compensate_point(
         let r1 = match pair.frame_r1 {
             Some(r1) => r1,
             None => {
-                config.e1 * c.stretch
+                let r1 = config.e1 * c.stretch
                     + crate::motion_error::shift_bound(
                         c.pixel,
                         pair.geom.camera2_intrinsics(),
                         config.rotation_error,
                     )
-                    + pair.slack
+                    + pair.slack;
+                // Far off the camera's axis the rotation error's shift has
+                // no bound (`rotation_shift_bound`): such a point is out of
+                // the view the stick can be certified in, and must not set
+                // the frame's largest error. (A NaN fails.)
+                if !(r1 < f32::INFINITY) {
+                    return Err(Status::OutOfView);
+                }
+                r1
             }
         };
         *r1_max = crate::math::fmax(*r1_max, r1);

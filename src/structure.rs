@@ -51,7 +51,10 @@ pub enum Status {
     Folded,
     /// After rotation compensation the point lies far outside the frame-2
     /// image (beyond one image size from its edges): no plausible
-    /// correspondence (see [`crate::epipolar::PairGeometry`]).
+    /// correspondence (see [`crate::epipolar::PairGeometry`]); or, with a
+    /// rotation error configured, so far off the camera's axis that the
+    /// error's shift has no bound
+    /// ([`crate::motion_error::rotation_shift_bound`] infinite).
     OutOfView,
     /// The band reaches past an end of the frame-2 boundary (its first or
     /// last point lies in the band): the true crossing may lie beyond what

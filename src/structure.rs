@@ -140,6 +140,7 @@ pub(crate) const STATUS_COUNT: usize = Status::ALL.len();
 /// }
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct StatusCounts {
     counts: [usize; STATUS_COUNT],
 }

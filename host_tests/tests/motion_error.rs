@@ -216,7 +216,7 @@ fn rotation_error_bound_holds() {
                         Motion::new(m.translation(), [a[0] + da[0], a[1] + da[1], a[2] + da[2]])
                             .unwrap();
                     let c1 = PairGeometry::new(&cam, &cam, &mk).compensate(p1).unwrap();
-                    let shift = (c1.pixel().u - c0.pixel().u).hypot(c1.pixel().v - c0.pixel().v);
+                    let shift = moved(c0.pixel(), c1.pixel());
                     assert!(shift <= bound, "seed {seed}: shift {shift} > bound {bound}");
                     worst_use = worst_use.max(shift / bound);
                 }
@@ -368,7 +368,7 @@ fn rotation_shift_bound_at_and_beyond_its_range() {
                 let mk = Motion::new(m.translation(), [a[0] + da[0], a[1] + da[1], a[2] + da[2]])
                     .unwrap();
                 let c1 = PairGeometry::new(&cam, &cam, &mk).compensate(p1).unwrap();
-                let shift = (c1.pixel().u - c0.pixel().u).hypot(c1.pixel().v - c0.pixel().v);
+                let shift = moved(c0.pixel(), c1.pixel());
                 assert!(shift <= bound, "({u}, {v}): shift {shift} > bound {bound}");
                 checked += 1;
             }
@@ -431,15 +431,7 @@ fn euler_angle_errors_are_held_by_the_converted_box() {
             let Some(c0) = g0.compensate(p1) else {
                 continue;
             };
-            // Only where the processor takes a compensated point: the
-            // frame-2 image grown by its larger side on every side.
-            let grow = f32::from(w.max(h));
-            let (u, v) = (c0.pixel().u, c0.pixel().v);
-            if !(u >= -grow
-                && u <= f32::from(w) - 1.0 + grow
-                && v >= -grow
-                && v <= f32::from(h) - 1.0 + grow)
-            {
+            if !in_accepted_view(c0.pixel(), w, h) {
                 continue;
             }
             let bound = rotation_shift_bound(c0.pixel(), &cam, abox);
@@ -461,7 +453,7 @@ fn euler_angle_errors_are_held_by_the_converted_box() {
                 let Some(c1) = PairGeometry::new(&cam, &cam, &mk).compensate(p1) else {
                     continue;
                 };
-                let shift = (c1.pixel().u - c0.pixel().u).hypot(c1.pixel().v - c0.pixel().v);
+                let shift = moved(c0.pixel(), c1.pixel());
                 assert!(
                     shift <= bound,
                     "case {case}: angles {angles:?} eps {eps:?} at {p1:?}: shift {shift} > bound {bound}"
@@ -495,7 +487,6 @@ fn rotation_shift_bound_holds_to_the_edge_of_its_range() {
     use roadstereo::motion_error::rotation_shift_bound;
     use roadstereo::{Camera, PairGeometry, Pixel};
     let (w, h) = (1024u16, 768u16);
-    let grow = f32::from(w.max(h));
     let (mut checked, mut worst) = (0usize, 0.0f32);
     for f in [150.0f32, 200.0, 400.0, 800.0] {
         let cam = Camera::new(f, f * 1.1, 511.5, 383.5, w, h).unwrap();
@@ -523,15 +514,10 @@ fn rotation_shift_bound_holds_to_the_edge_of_its_range() {
                             else {
                                 continue;
                             };
-                            let (u, v) = (c1.pixel().u, c1.pixel().v);
-                            if !(u >= -grow
-                                && u <= f32::from(w) - 1.0 + grow
-                                && v >= -grow
-                                && v <= f32::from(h) - 1.0 + grow)
-                            {
+                            if !in_accepted_view(c1.pixel(), w, h) {
                                 continue;
                             }
-                            let shift = (u - c0.pixel().u).hypot(v - c0.pixel().v);
+                            let shift = moved(c0.pixel(), c1.pixel());
                             let bound = rotation_shift_bound(c1.pixel(), &cam, eps);
                             assert!(
                                 shift <= bound,
@@ -551,4 +537,20 @@ fn rotation_shift_bound_holds_to_the_edge_of_its_range() {
         worst * 100.0
     );
     assert!(checked > 50_000);
+}
+
+/// How far a compensated point moved, pixels.
+fn moved(a: roadstereo::Pixel, b: roadstereo::Pixel) -> f32 {
+    (b.u - a.u).hypot(b.v - a.v)
+}
+
+/// Whether the processor takes a compensated point at `p` for a `w` × `h`
+/// frame-2 image: the image grown by its larger side on every side
+/// (`PairGeometry::in_view`).
+fn in_accepted_view(p: roadstereo::Pixel, w: u16, h: u16) -> bool {
+    let grow = f32::from(w.max(h));
+    p.u >= -grow
+        && p.u <= f32::from(w) - 1.0 + grow
+        && p.v >= -grow
+        && p.v <= f32::from(h) - 1.0 + grow
 }

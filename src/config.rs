@@ -10,7 +10,8 @@ pub struct Config {
     pub(crate) e1: f32,
     pub(crate) e2: f32,
     /// `2 cot(φ_min)`: a band piece longer than this times the band's width
-    /// is [`crate::Status::Grazing`].
+    /// plus `e₂ · 2/sin(φ_min)` is [`crate::Status::Grazing`] (see
+    /// [`crate::wedge`]; `2/sin φ = √(4 + (2 cot φ)²)`).
     pub(crate) cot_twice: f32,
     pub(crate) max_depth: f32,
     pub(crate) translation_error: f32,
@@ -93,7 +94,8 @@ impl Config {
     ///
     /// * `e1`, `e2`: largest localisation error of a boundary point in frame 1
     ///   and of the boundary in frame 2, pixels (the paper's `e = e₁ + e₂`).
-    /// * `min_angle_deg`: crossings flatter than this are [`crate::Status::Grazing`].
+    /// * `min_angle_deg`: crossings certainly flatter than this (for every
+    ///   boundary within `e₂` of the polyline) are [`crate::Status::Grazing`].
     /// * `max_depth`: depths beyond it are [`crate::Status::BeyondMaxDepth`].
     ///
     /// ```

@@ -110,6 +110,9 @@ pub(crate) struct PointErrors {
     pub(crate) r1: f32,
     /// `e₂`, with slack.
     pub(crate) e2: f32,
+    /// `e₂ · 2/sin φ_min`, the grazing test's allowance for the polyline's
+    /// own error ([`Band::grazing`]).
+    pub(crate) e2_csc: f32,
     /// `σ_a`: how far a translation error can move `a` at this point.
     pub(crate) spread_a: f32,
     /// `σ_w`: how far a translation error can move `W'`.
@@ -146,6 +149,8 @@ pub(crate) struct Band {
     /// and `1/(ρ₁ − r₁ − e₂)` (for `W' > 0`; see [`Band::key_half_width`]).
     half_angle: f32,
     foe_inv: f32,
+    /// `e₂ · 2/sin φ_min`, scaled by `|a|` ([`Band::grazing`]).
+    g0: f32,
 }
 
 /// How the band stands to the FOE, for the key interval.
@@ -177,7 +182,7 @@ impl Band {
         near_foe: f32,
     ) -> Result<Self, NoBand> {
         if w > 0.0 && err.spread_a == 0.0 && err.spread_w == 0.0 {
-            return Self::forward(p, a, w, err.r1, err.e2);
+            return Self::forward(p, a, w, err);
         }
         let a2 = dot(a, a);
         // `a2 > 1e-30` keeps the square root's input in its range (and
@@ -189,6 +194,7 @@ impl Band {
         let PointErrors {
             r1,
             e2,
+            e2_csc,
             spread_a,
             spread_w,
         } = *err;
@@ -234,6 +240,7 @@ impl Band {
             // (r₁ + e₂)/(ρ₁ − r₁ − e₂), or its slope h far out.
             half_angle: fmax(re * foe_inv, h),
             foe_inv,
+            g0: e2_csc * a_len,
         })
     }
 
@@ -245,9 +252,9 @@ impl Band {
         p: [f32; 2],
         a: [f32; 2],
         w: f32,
-        r1: f32,
-        e2: f32,
+        err: &PointErrors,
     ) -> Result<Self, NoBand> {
+        let (r1, e2) = (err.r1, err.e2);
         let a2 = dot(a, a);
         // `a2 > 1e-30` keeps the square root's input in its range (and
         // refuses NaN).
@@ -274,6 +281,7 @@ impl Band {
             w,
             half_angle: re * foe_inv,
             foe_inv,
+            g0: err.e2_csc * a_len,
         })
     }
 
@@ -413,11 +421,13 @@ impl Band {
     }
 
     /// Whether a piece of the band from `lo` to `hi` (`λ'`) is longer than
-    /// the band's width there times `cot_twice = 2 cot(φ_min)`: the
-    /// boundary crosses the line flatter than the minimum angle.
+    /// the band's width there times `cot_twice = 2 cot(φ_min)` plus `e₂ ·
+    /// 2/sin φ_min`: no boundary within `e₂` of the polyline crosses the
+    /// line at the minimum angle or steeper (the derivation is
+    /// [`crate::wedge`]'s, with the band's half-width for the wedge's).
     #[inline(always)]
     pub(crate) fn grazing(&self, lo: f32, hi: f32, cot_twice: f32) -> bool {
-        hi - lo > (self.k0 + self.h * hi) * cot_twice
+        hi - lo > (self.k0 + self.h * hi) * cot_twice + self.g0
     }
 
     /// The depth estimate and the stick in the compensated frame, `(s,
@@ -534,6 +544,7 @@ mod tests {
             let err = PointErrors {
                 r1: 0.1 + rng.next(),
                 e2: 0.1 + rng.next(),
+                e2_csc: 0.0,
                 spread_a: 0.0,
                 spread_w: 0.0,
             };

@@ -14,7 +14,8 @@
 //!   separate places) is [`Status::Ambiguous`]: either could hold the
 //!   correspondent, and no depth is given;
 //! * a piece longer than the band's width over `tan(φ_min)`, twice (both
-//!   edges of the band), is [`Status::Grazing`];
+//!   edges of the band), plus `e₂ · 2/sin φ_min` (the polyline's own
+//!   error, [`crate::wedge`]) is [`Status::Grazing`];
 //! * an end vertex of the polyline inside the band is
 //!   [`Status::BoundaryEnd`]: the boundary may go on, undetected, inside
 //!   the band;

@@ -333,6 +333,8 @@ struct Pair<'c> {
     /// compensated translation by a rotation error), and `σ_w`.
     translation: f32,
     spread_w: f32,
+    /// `2/sin φ_min = √(4 + (2 cot φ_min)²)`, for the grazing test.
+    csc_twice: f32,
 }
 
 impl<'c> Pair<'c> {
@@ -377,6 +379,7 @@ impl<'c> Pair<'c> {
             depth_scale_error,
             translation,
             spread_w,
+            csc_twice: crate::math::sqrt_pos(4.0 + config.cot_twice * config.cot_twice),
             geom,
         }
     }
@@ -406,6 +409,12 @@ impl<'c> Pair<'c> {
 
     fn e2(&self) -> f32 {
         self.config.e2 + self.slack
+    }
+
+    /// The grazing test's allowance for the polyline's error: `e₂ · 2/sin
+    /// φ_min` ([`crate::wedge`]).
+    fn e2_csc(&self) -> f32 {
+        self.e2() * self.csc_twice
     }
 
     /// Whether a band with `W' < 0` runs into an uncertain FOE (a
@@ -656,6 +665,7 @@ fn match_wedge_tight<const N: usize>(
         foe,
         side,
         e2: pair.e2(),
+        e2_csc: pair.e2_csc(),
         key_scale: keying.key_scale,
         orient,
         cot_twice: pair.config.cot_twice,
@@ -686,6 +696,7 @@ struct TightWalk<'a> {
     foe: [f32; 2],
     side: f32,
     e2: f32,
+    e2_csc: f32,
     key_scale: f32,
     orient: f32,
     cot_twice: f32,
@@ -703,7 +714,7 @@ impl TightWalk<'_> {
         let Ok(wedge) = Wedge::new(
             p,
             (self.foe, self.side),
-            (r1, self.e2),
+            (r1, self.e2, self.e2_csc),
             (key, self.key_scale, self.orient),
         ) else {
             *r = PointResult::flagged(p1, Status::AtFoe);
@@ -729,7 +740,7 @@ impl TightWalk<'_> {
         let Ok(wedge) = Wedge::new(
             p,
             (self.foe, self.side),
-            (r1, self.e2),
+            (r1, self.e2, self.e2_csc),
             (key, self.key_scale, self.orient),
         ) else {
             *r = PointResult::flagged(p1, Status::AtFoe);
@@ -765,7 +776,7 @@ fn match_wedge<const N: usize>(
         Matcher::Indexed => index.orient(),
         Matcher::Reference => 1.0,
     };
-    let (e2, cot_twice) = (pair.e2(), pair.config.cot_twice);
+    let (e2, e2_csc, cot_twice) = (pair.e2(), pair.e2_csc(), pair.config.cot_twice);
     let segments = b2.len().saturating_sub(1);
     for r in slots.iter_mut() {
         if r.status != Status::NoIntersection {
@@ -773,7 +784,7 @@ fn match_wedge<const N: usize>(
         }
         let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
         let key3 = (key, keying.key_scale, orient);
-        let Ok(wedge) = Wedge::new(p, (foe, side), (r1, e2), key3) else {
+        let Ok(wedge) = Wedge::new(p, (foe, side), (r1, e2, e2_csc), key3) else {
             *r = PointResult::flagged(p1, Status::AtFoe);
             continue;
         };
@@ -1127,6 +1138,7 @@ fn match_point<const N: usize>(
     let errors = PointErrors {
         r1,
         e2: pair.e2(),
+        e2_csc: pair.e2_csc(),
         spread_a,
         spread_w: pair.spread_w,
     };

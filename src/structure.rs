@@ -33,8 +33,9 @@ pub enum Status {
     #[default]
     NoIntersection,
     /// A piece of the boundary in the band is longer than the band's width
-    /// over the tangent of the minimum angle: the boundary crosses the
-    /// epipolar line flatter than the minimum angle (or runs along it).
+    /// over the tangent of the minimum angle plus `e₂ · 2/sin φ_min`: no
+    /// boundary within `e₂` of the polyline crosses the epipolar line at the
+    /// minimum angle or steeper (it runs flatter, or along it).
     Grazing,
     /// The triangulated depth is not positive (numerically degenerate).
     NonPositiveDepth,

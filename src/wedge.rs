@@ -73,11 +73,24 @@
 //! `(lo − R) − ρ₁ (r₁ + e₂) ≤ X − R ≤ (hi − R) + ρ₁ (r₁ + e₂)`, each
 //! computed in that order: IEEE operations keep the order, so the rounded
 //! stick holds the rounded estimate). A piece is grazing when it is longer
-//! than the wedge's width at its near end over `tan φ_min`, in `λ`
-//! `hi − lo > T (ρ₁ + lo) · 2 cot φ_min`, in `X` (times `ρ₁`) `hi − lo >
-//! T lo · 2 cot φ_min`: a test that only becomes true as the piece grows
-//! (`lo ≥ X_min > 0`), so the walk may stop at the first segment that makes
-//! it true and get the outcome a walk to the end would.
+//! than any piece a boundary crossing the line at `φ_min` or steeper could
+//! leave in the wedge, the polyline's own error included: a straight
+//! boundary at the angle `φ` crosses a strip of half-width `w` (the wedge's
+//! at the piece's near end, `T (ρ₁ + λ)`) over `2 w cot φ` along the line,
+//! and the points within `e₂` of it that lie in the strip span `2 w cot φ +
+//! 2 e₂/sin φ`; for `φ ≥ φ_min` that is at most `2 w cot φ_min + 2
+//! e₂/sin φ_min`. So the test is, in `λ`, `hi − lo > T (ρ₁ + lo) · 2 cot
+//! φ_min + e₂ · 2/sin φ_min`, in `X` (times `ρ₁`) `hi − lo > T lo · 2 cot
+//! φ_min + ρ₁ e₂ · 2/sin φ_min`: a point whose detected piece is flagged
+//! cannot have its true crossing at `φ_min` or steeper (up to the curvature
+//! of the boundary over the piece). The test is a cut for information, not
+//! part of the guarantee: the stick comes from the piece's range whatever
+//! its length. (Before the `e₂` term the test took the polyline's wobble
+//! within `e₂` for flatness: a boundary rounded to the pixel grid lost 1.8
+//! % of the two-view ideal points to it, at true angles of 10–15°.) It only
+//! becomes true as the piece grows (`lo ≥ X_min > 0`), so the walk may stop
+//! at the first segment that makes it true and get the outcome a walk to
+//! the end would.
 //!
 //! # Rounding
 //! `ρ₁` enters only through `X_min`, `T` and the stick's small terms
@@ -127,6 +140,9 @@ pub(crate) struct Wedge {
     pub(crate) kh: f32,
     /// `X_min = R − ρ₊ (r₁ + e₂)`: `λ ≥ −(r₁ + e₂)` is `X ≥ X_min`.
     pub(crate) x_min: f32,
+    /// The grazing test's allowance for the polyline's own error, in `X`:
+    /// `ρ₊ e₂ · 2/sin φ_min` (module docs).
+    g0: f32,
 }
 
 /// A point without a wedge: it lies within `3 (r₁ + e₂)` of the FOE
@@ -136,7 +152,8 @@ pub(crate) struct AtFoe;
 
 impl Wedge {
     /// The wedge of compensated point `p` for a FOE `foe`, the boundary on
-    /// the `side` of its row (+1 below), errors `r1`, `e2`, keys with
+    /// the `side` of its row (+1 below), errors `r1`, `e2` and the grazing
+    /// test's `e2_csc = e₂ · 2/sin φ_min`, keys with
     /// `key_scale` (`crate::pencil::Keying`) oriented by `orient`; `key` is
     /// `p`'s own raw half-plane key (step 1's; [`crate::pencil::NO_KEY`]
     /// where it has none).
@@ -144,7 +161,7 @@ impl Wedge {
     pub(crate) fn new(
         p: [f32; 2],
         (foe, side): ([f32; 2], f32),
-        (r1, e2): (f32, f32),
+        (r1, e2, e2_csc): (f32, f32, f32),
         (key, key_scale, orient): (f32, f32, f32),
     ) -> Result<Self, AtFoe> {
         let d = sub(p, foe);
@@ -190,6 +207,7 @@ impl Wedge {
             kl,
             kh,
             x_min: r2 - rho_re,
+            g0: rho * e2_csc,
         })
     }
 
@@ -249,7 +267,7 @@ impl Wedge {
     /// docs); it stays so as the piece grows.
     #[inline(always)]
     pub(crate) fn grazing(&self, lo: f32, hi: f32, cot_twice: f32) -> bool {
-        hi - lo > (self.t * cot_twice) * lo
+        hi - lo > (self.t * cot_twice) * lo + self.g0
     }
 
     /// `best` lowered to the exact line's crossing of segment `a → b`, if
@@ -641,7 +659,12 @@ mod tests {
             } else {
                 crate::pencil::half_key(p, (foe, side, 4.0), key_scale).0
             };
-            let Ok(wedge) = Wedge::new(p, (foe, side), (r1, e2), (key, key_scale, orient)) else {
+            let Ok(wedge) = Wedge::new(
+                p,
+                (foe, side),
+                (r1, e2, e2 * 11.52),
+                (key, key_scale, orient),
+            ) else {
                 continue;
             };
             let i = 1.0 / (dq[0].abs() + t);
@@ -667,6 +690,7 @@ mod tests {
                 &PointErrors {
                     r1,
                     e2,
+                    e2_csc: e2 * 11.52,
                     spread_a: 0.0,
                     spread_w: 0.0,
                 },

@@ -756,6 +756,17 @@ impl Tally {
     pub fn folded_loss(&self) -> f64 {
         ratio(self.folded_spurious, self.ideal)
     }
+
+    /// The share of the ideal points (true crossing at least
+    /// [`MIN_ANGLE_DEG`] steep) flagged `grazing`.
+    pub fn grazing_loss(&self) -> f64 {
+        let i = Status::ALL.iter().position(|&x| x == Status::Grazing);
+        ratio(
+            i.and_then(|i| self.ideal_by_status.get(i).copied())
+                .unwrap_or(0),
+            self.ideal,
+        )
+    }
 }
 
 fn ratio(a: usize, b: usize) -> f64 {

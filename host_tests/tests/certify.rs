@@ -35,6 +35,12 @@ const CONTAINMENT: f64 = 1.0;
 const ACTUAL_OVER_IDEAL_ALL: f64 = 0.90;
 const ACTUAL_OVER_IDEAL_FAMILY: f64 = 0.80;
 const FOLDED_LOSS_MAX: f64 = 0.05;
+/// The grazing test allows for the polyline's own error, so it should not
+/// flag a point whose true crossing is at the minimum angle or steeper; the
+/// allowance is for the boundary's curvature over the piece, which the test
+/// leaves out (measured: at most 0.0 % in every variant; 1.8 % of the
+/// rounded variant's ideal points before the allowance).
+const GRAZING_LOSS_MAX: f64 = 0.002;
 
 fn families_from_env() -> (Vec<Family>, u64, bool) {
     let fams = std::env::var("CERTIFY_FAMILIES").ok().map(|s| {
@@ -133,6 +139,14 @@ fn requirements(rep: &Report, full: bool) -> (Vec<String>, Vec<String>) {
                 t.contained,
                 t.ok_observed,
                 t.ok_observed - t.contained
+            ));
+        }
+        if t.grazing_loss() > GRAZING_LOSS_MAX {
+            guarantee.push(format!(
+                "{}: {:.2} % of the ideal points grazing > {:.1} %",
+                v.name(),
+                100.0 * t.grazing_loss(),
+                100.0 * GRAZING_LOSS_MAX
             ));
         }
         if t.ideal == 0 || t.actual_over_ideal() < ACTUAL_OVER_IDEAL_ALL {

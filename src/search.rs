@@ -499,9 +499,22 @@ impl<const N: usize> Index<N> {
     /// [`Self::folds`] for every item of `items` in order (vertex `i` the
     /// `i`-th, `key` its raw key where it is to be tested), each bringing
     /// `allowance` to `work` first; `flag` gets the answer of each tested
-    /// one. Without a period and with nothing aside, the envelopes' `O(1)`
-    /// answer ([`Self::may_fold`]) is taken in the loop itself, and only the
-    /// vertices it cannot clear go through [`Self::folds`].
+    /// one.
+    ///
+    /// Without a period and with nothing aside, the envelopes' `O(1)`
+    /// answer ([`Self::may_fold`]) is taken in the loop itself. A vertex it
+    /// cannot clear is decided exactly in `O(1)`, without work, when the
+    /// intervals form a connected path ([`Self::suffix_maxima`], asked
+    /// once): the union of the intervals of the segments before the
+    /// window, `0 ..= i − w − 1`, is then `[min lo, pm]` (the low end kept
+    /// in the loop), that of those after it, `i + w ..= s − 1`, is `[sm,
+    /// max hi]` (the high end from the suffix maxima), and the vertex's
+    /// widened key meets a segment of either run exactly when it meets
+    /// that run's union: a segment it meets lies in the union; and where
+    /// it meets the union, at some value `x`, `x` lies in one of the run's
+    /// intervals (the union of closed intervals that chain covers every
+    /// value between its ends), which therefore meets it. Otherwise (an
+    /// unkeyed vertex breaks the path) the vertex goes through the query.
     #[inline(always)]
     pub(crate) fn folds_all<T>(
         &mut self,
@@ -528,6 +541,10 @@ impl<const N: usize> Index<N> {
         // the next query and at the end (saturating sums, so the credit
         // each query sees is the one granting item by item gives).
         let mut owed = 0u32;
+        // Whether the intervals form a connected path, once asked; where
+        // they do, the item from which the exact loop takes over.
+        let mut connected = None;
+        let mut exact_from = None;
         for (i, it) in items.iter_mut().enumerate() {
             owed = owed.saturating_add(allowance);
             let Some(k) = key(it) else {
@@ -542,6 +559,10 @@ impl<const N: usize> Index<N> {
             if !(before || after) {
                 continue;
             }
+            if *connected.get_or_insert_with(|| self.suffix_maxima()) {
+                exact_from = Some(i);
+                break;
+            }
             work.grant(owed);
             owed = 0;
             let r = if self.strict {
@@ -551,7 +572,92 @@ impl<const N: usize> Index<N> {
             };
             flag(it, r);
         }
+        if let Some(i0) = exact_from {
+            let rest = u32::try_from(items.len().saturating_sub(i0 + 1)).unwrap_or(u32::MAX);
+            owed = owed.saturating_add(allowance.saturating_mul(rest));
+            self.folds_exact(items, i0, w, key, flag);
+        }
         work.grant(owed);
+    }
+
+    /// The loop of [`Self::folds_all`] from item `i0` on, on a connected
+    /// path whose suffix maxima are in `tree` ([`Self::suffix_maxima`]):
+    /// each vertex the envelopes cannot clear is decided by the two runs'
+    /// unions (see there). Without work; `O(1)` per item after one pass
+    /// over the segments before `i0`'s window.
+    #[inline(never)]
+    fn folds_exact<T>(
+        &self,
+        items: &mut [T],
+        i0: usize,
+        w: usize,
+        key: impl Fn(&T) -> Option<f32>,
+        mut flag: impl FnMut(&mut T, Result<bool, OutOfWork>),
+    ) {
+        let (s, o) = (self.segments.min(N), self.orient);
+        let seg = self.seg.get(..s).unwrap_or(&[]);
+        // The low end of the union of the intervals before the window
+        // (its high end is `pm`), up to segment `i0 − w − 2` here.
+        let mut before_lo = f32::INFINITY;
+        for g in seg.get(..i0.saturating_sub(w + 1)).unwrap_or(&[]) {
+            before_lo = fmin(before_lo, g.lo);
+        }
+        let rest = items.get_mut(i0..).unwrap_or(&mut []);
+        for (i, it) in (i0..).zip(rest) {
+            let gb = i.checked_sub(w + 1).and_then(|j| seg.get(j));
+            if let Some(g) = gb {
+                before_lo = fmin(before_lo, g.lo);
+            }
+            let Some(k) = key(it) else {
+                continue;
+            };
+            let (ko, e) = (o * k, self.margin.get(i).copied().unwrap_or(0.0));
+            let before = gb.is_some_and(|g| ko - e <= g.pm);
+            let ga = seg.get(i + w);
+            let after = ga.is_some_and(|g| ko + e >= g.sm);
+            if !(before || after) {
+                continue;
+            }
+            let after_hi = self.tree.get(i + w).copied().unwrap_or(f32::NEG_INFINITY);
+            let folds = (before && ko + e >= before_lo) || (after && ko - e <= after_hi);
+            flag(it, Ok(folds));
+        }
+    }
+
+    /// Whether the segments' intervals form a *connected path*: every one
+    /// non-empty and meeting the one before. Then the union of the
+    /// intervals of any run of consecutive segments is one interval,
+    /// `[min lo, max hi]` over the run (by induction: the union up to `j −
+    /// 1` is an interval holding segment `j − 1`'s, which meets segment
+    /// `j`'s). Built from vertex keys, consecutive segments share the
+    /// widened key of their common vertex, so a polyline whose vertices
+    /// are all keyed is connected; this checks it rather than trusting it.
+    /// When it is, `tree` gets the suffix maxima of the high ends (`tree[j]`
+    /// the largest over `j ..= s − 1`) and the block tree is dropped
+    /// (`levels` 0: queries stay correct, only without skips); otherwise
+    /// nothing changes. One pass, two when connected.
+    #[inline(never)]
+    fn suffix_maxima(&mut self) -> bool {
+        let s = self.segments.min(N);
+        let Some(seg) = self.seg.get(..s) else {
+            return false;
+        };
+        let (mut plo, mut phi) = (f32::NEG_INFINITY, f32::INFINITY);
+        for g in seg {
+            // (A NaN fails.)
+            if !(g.lo <= g.hi && g.lo <= phi && g.hi >= plo) {
+                return false;
+            }
+            (plo, phi) = (g.lo, g.hi);
+        }
+        self.levels = 0;
+        let mut run = f32::NEG_INFINITY;
+        let tree = self.tree.get_mut(..s).unwrap_or(&mut []);
+        for (t, g) in tree.iter_mut().zip(seg).rev() {
+            run = fmax(run, g.hi);
+            *t = run;
+        }
+        true
     }
 
     /// Whether no vertex's key meets a segment other than its own two (so
@@ -1588,6 +1694,68 @@ mod tests {
                 assert_eq!(count.0, n - 1, "case {case}: every segment for Everything");
             }
         }
+    }
+
+    /// The fold test of every vertex at once ([`Index::folds_all`]: the
+    /// connected path's exact unions, or the envelopes and the query)
+    /// equals the brute force, and flags through `flag` only what folds.
+    #[test]
+    fn folds_all_equals_brute_force() {
+        let mut rng = Rng(0xf01d_0003);
+        let mut index = Index::<CAP>::new();
+        let w = 4;
+        let mut connected = 0;
+        for case in 0..3000 {
+            let (shape, period) = (case % 5, case % 7 == 0);
+            let n = 2 + (rng.next() * (CAP - 2) as f32) as usize;
+            let mut ks = keys(&mut rng, shape, n, period);
+            // Most cases with every vertex keyed (a connected path).
+            if case % 4 != 0 {
+                for k in ks.iter_mut() {
+                    if !k.0.is_finite() {
+                        *k = (rng.next(), 1.0e-5);
+                    }
+                }
+            }
+            let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+            let mut b = index.builder((if period { 4.0 } else { 0.0 }, orient), Unkeyed::MeetNone);
+            b.push_all(ks.iter().copied());
+            b.finish(None);
+            let lean = !period && index.aside.is_empty();
+            connected += usize::from(lean && index.clone().suffix_maxima());
+            let ivs = intervals(&ks, period);
+            // (key, folded): items the way the processor's slots are.
+            let mut items: Vec<(f32, Option<bool>)> = ks.iter().map(|&(k, _)| (k, None)).collect();
+            let mut work = Work::new();
+            index.folds_all(
+                &mut items,
+                (w, u32::MAX / 4),
+                &mut work,
+                |it| it.0.is_finite().then_some(it.0),
+                |it, r| match r {
+                    Ok(f) => {
+                        assert!(it.1.is_none(), "case {case}: an item flagged twice");
+                        it.1 = Some(f);
+                    }
+                    Err(OutOfWork) => panic!("case {case}: out of work"),
+                },
+            );
+            for (i, (&(k, e), it)) in ks.iter().zip(&items).enumerate() {
+                if !k.is_finite() {
+                    continue;
+                }
+                let brute = ivs.iter().enumerate().any(|(j, iv)| {
+                    let outside = j + w < i || j > i + w - 1;
+                    outside && iv.is_some_and(|iv| meets(iv, (k - e, k + e), period))
+                });
+                assert_eq!(
+                    it.1 == Some(true),
+                    brute,
+                    "case {case} (shape {shape}, period {period}) vertex {i} key {k}"
+                );
+            }
+        }
+        assert!(connected > 800, "{connected} connected cases");
     }
 
     /// The fold test (the `strict` certificate, the envelopes' `O(1)`

@@ -260,10 +260,13 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                     }
                 }
             }
+            let n = u32::try_from(slots.len()).unwrap_or(u32::MAX);
             if order.strict(keying.period) {
                 // No key meets a segment but its own two: nothing folds,
                 // and the fold index is not needed.
-                let n = u32::try_from(slots.len()).unwrap_or(u32::MAX);
+                work.grant(config.work_per_point.saturating_mul(n));
+            } else if keying.period <= 0.0 && fold_by_hulls(slots, index.margins()) {
+                // Every point keyed: the fold test from the keys alone.
                 work.grant(config.work_per_point.saturating_mul(n));
             } else {
                 let mut fold_index = index.builder((keying.period, orient), Unkeyed::MeetNone);
@@ -560,6 +563,23 @@ fn fold<const N: usize>(
             Ok(false) => {}
         },
     );
+}
+
+/// Step 2 without the fold index, when every point of the boundary has a
+/// key without a period ([`crate::search::folds_by_hulls`]: the same
+/// answer as the index's query, in `O(1)` per point and without work);
+/// `false`, with nothing changed, otherwise.
+fn fold_by_hulls(slots: &mut [PointResult], margins: &[f32]) -> bool {
+    let valid = |r: &PointResult| r.status == Status::NoIntersection;
+    // Marked points keep their key (`z_far`) until both passes are done.
+    let mark = |r: &mut PointResult| r.status = Status::Folded;
+    if !crate::search::folds_by_hulls(slots, margins, FOLD_WINDOW, (valid, |r| r.z_far), mark) {
+        return false;
+    }
+    for r in slots.iter_mut().filter(|r| r.status == Status::Folded) {
+        *r = PointResult::flagged(r.pixel1, Status::Folded);
+    }
+    true
 }
 
 /// Step 3: index the frame-2 polyline; with `W' < 0` and the FOE near, the

@@ -366,9 +366,12 @@ impl<const N: usize> Index<N> {
             run = fmax(run, g.hi);
             g.pm = run;
         }
-        // The block tree for runs through the rebuilt envelopes.
+        // The block tree for runs through the rebuilt envelopes, when they
+        // are still loose (tight runs are short: no tree needed).
         self.loose = self.suffix_minima(wide);
-        self.build_tree();
+        if self.loose {
+            self.build_tree();
+        }
     }
 
     /// The block tree over the current intervals (module docs): as many
@@ -499,22 +502,9 @@ impl<const N: usize> Index<N> {
     /// [`Self::folds`] for every item of `items` in order (vertex `i` the
     /// `i`-th, `key` its raw key where it is to be tested), each bringing
     /// `allowance` to `work` first; `flag` gets the answer of each tested
-    /// one.
-    ///
-    /// Without a period and with nothing aside, the envelopes' `O(1)`
-    /// answer ([`Self::may_fold`]) is taken in the loop itself. A vertex it
-    /// cannot clear is decided exactly in `O(1)`, without work, when the
-    /// intervals form a connected path ([`Self::suffix_maxima`], asked
-    /// once): the union of the intervals of the segments before the
-    /// window, `0 ..= i − w − 1`, is then `[min lo, pm]` (the low end kept
-    /// in the loop), that of those after it, `i + w ..= s − 1`, is `[sm,
-    /// max hi]` (the high end from the suffix maxima), and the vertex's
-    /// widened key meets a segment of either run exactly when it meets
-    /// that run's union: a segment it meets lies in the union; and where
-    /// it meets the union, at some value `x`, `x` lies in one of the run's
-    /// intervals (the union of closed intervals that chain covers every
-    /// value between its ends), which therefore meets it. Otherwise (an
-    /// unkeyed vertex breaks the path) the vertex goes through the query.
+    /// one. Without a period and with nothing aside, the envelopes' `O(1)`
+    /// answer ([`Self::may_fold`]) is taken in the loop itself, and only the
+    /// vertices it cannot clear go through [`Self::folds`].
     #[inline(always)]
     pub(crate) fn folds_all<T>(
         &mut self,
@@ -541,10 +531,6 @@ impl<const N: usize> Index<N> {
         // the next query and at the end (saturating sums, so the credit
         // each query sees is the one granting item by item gives).
         let mut owed = 0u32;
-        // Whether the intervals form a connected path, once asked; where
-        // they do, the item from which the exact loop takes over.
-        let mut connected = None;
-        let mut exact_from = None;
         for (i, it) in items.iter_mut().enumerate() {
             owed = owed.saturating_add(allowance);
             let Some(k) = key(it) else {
@@ -559,10 +545,6 @@ impl<const N: usize> Index<N> {
             if !(before || after) {
                 continue;
             }
-            if *connected.get_or_insert_with(|| self.suffix_maxima()) {
-                exact_from = Some(i);
-                break;
-            }
             work.grant(owed);
             owed = 0;
             let r = if self.strict {
@@ -572,92 +554,7 @@ impl<const N: usize> Index<N> {
             };
             flag(it, r);
         }
-        if let Some(i0) = exact_from {
-            let rest = u32::try_from(items.len().saturating_sub(i0 + 1)).unwrap_or(u32::MAX);
-            owed = owed.saturating_add(allowance.saturating_mul(rest));
-            self.folds_exact(items, i0, w, key, flag);
-        }
         work.grant(owed);
-    }
-
-    /// The loop of [`Self::folds_all`] from item `i0` on, on a connected
-    /// path whose suffix maxima are in `tree` ([`Self::suffix_maxima`]):
-    /// each vertex the envelopes cannot clear is decided by the two runs'
-    /// unions (see there). Without work; `O(1)` per item after one pass
-    /// over the segments before `i0`'s window.
-    #[inline(never)]
-    fn folds_exact<T>(
-        &self,
-        items: &mut [T],
-        i0: usize,
-        w: usize,
-        key: impl Fn(&T) -> Option<f32>,
-        mut flag: impl FnMut(&mut T, Result<bool, OutOfWork>),
-    ) {
-        let (s, o) = (self.segments.min(N), self.orient);
-        let seg = self.seg.get(..s).unwrap_or(&[]);
-        // The low end of the union of the intervals before the window
-        // (its high end is `pm`), up to segment `i0 − w − 2` here.
-        let mut before_lo = f32::INFINITY;
-        for g in seg.get(..i0.saturating_sub(w + 1)).unwrap_or(&[]) {
-            before_lo = fmin(before_lo, g.lo);
-        }
-        let rest = items.get_mut(i0..).unwrap_or(&mut []);
-        for (i, it) in (i0..).zip(rest) {
-            let gb = i.checked_sub(w + 1).and_then(|j| seg.get(j));
-            if let Some(g) = gb {
-                before_lo = fmin(before_lo, g.lo);
-            }
-            let Some(k) = key(it) else {
-                continue;
-            };
-            let (ko, e) = (o * k, self.margin.get(i).copied().unwrap_or(0.0));
-            let before = gb.is_some_and(|g| ko - e <= g.pm);
-            let ga = seg.get(i + w);
-            let after = ga.is_some_and(|g| ko + e >= g.sm);
-            if !(before || after) {
-                continue;
-            }
-            let after_hi = self.tree.get(i + w).copied().unwrap_or(f32::NEG_INFINITY);
-            let folds = (before && ko + e >= before_lo) || (after && ko - e <= after_hi);
-            flag(it, Ok(folds));
-        }
-    }
-
-    /// Whether the segments' intervals form a *connected path*: every one
-    /// non-empty and meeting the one before. Then the union of the
-    /// intervals of any run of consecutive segments is one interval,
-    /// `[min lo, max hi]` over the run (by induction: the union up to `j −
-    /// 1` is an interval holding segment `j − 1`'s, which meets segment
-    /// `j`'s). Built from vertex keys, consecutive segments share the
-    /// widened key of their common vertex, so a polyline whose vertices
-    /// are all keyed is connected; this checks it rather than trusting it.
-    /// When it is, `tree` gets the suffix maxima of the high ends (`tree[j]`
-    /// the largest over `j ..= s − 1`) and the block tree is dropped
-    /// (`levels` 0: queries stay correct, only without skips); otherwise
-    /// nothing changes. One pass, two when connected.
-    #[inline(never)]
-    fn suffix_maxima(&mut self) -> bool {
-        let s = self.segments.min(N);
-        let Some(seg) = self.seg.get(..s) else {
-            return false;
-        };
-        let (mut plo, mut phi) = (f32::NEG_INFINITY, f32::INFINITY);
-        for g in seg {
-            // (A NaN fails.)
-            if !(g.lo <= g.hi && g.lo <= phi && g.hi >= plo) {
-                return false;
-            }
-            (plo, phi) = (g.lo, g.hi);
-        }
-        self.levels = 0;
-        let mut run = f32::NEG_INFINITY;
-        let tree = self.tree.get_mut(..s).unwrap_or(&mut []);
-        for (t, g) in tree.iter_mut().zip(seg).rev() {
-            run = fmax(run, g.hi);
-            *t = run;
-        }
-        true
     }
 
     /// Whether no vertex's key meets a segment other than its own two (so
@@ -771,6 +668,11 @@ impl<const N: usize> Index<N> {
     /// the build ([`Builder::push_all_stored`]).
     pub(crate) fn margins_mut(&mut self) -> &mut [f32; N] {
         &mut self.margin
+    }
+
+    /// The vertices' key margins as written ([`Self::margins_mut`]).
+    pub(crate) fn margins(&self) -> &[f32] {
+        &self.margin
     }
 
     /// The key margin of vertex `i` (0 when out of range).
@@ -1484,6 +1386,81 @@ impl<const N: usize> Builder<'_, N> {
     }
 }
 
+/// The fold test ([`Index::folds`]) of every vertex of a polyline whose
+/// vertices all have a key (no period), straight from the keys: no index,
+/// no work. Item `i` is vertex `i`; `valid` says whether it is to be
+/// tested (it has a key, and `mark` has not marked it), `key` gives its
+/// raw key (read whatever `mark` did to it), `margins[i]` its margin;
+/// `mark` gets every item that folds, once. Returns `false`, marking nothing, when an item is not valid or
+/// its key is not finite or its margin is not a number `≥ 0`: then the
+/// index decides ([`Index::folds_all`]).
+///
+/// Vertex `i` folds when its widened key `[k − e, k + e]` meets the
+/// interval of a segment `j ≤ i − w − 1` or `j ≥ i + w` (segment `j` from
+/// vertex `j` to `j + 1`, its interval the hull of its ends' widened keys,
+/// [`Builder`]). Consecutive segments share a vertex, so both intervals
+/// hold its (non-empty) widened key, and the union of the intervals of a
+/// run of consecutive segments is one interval: the hull of the widened
+/// keys of the run's vertices (by induction along the run). So the vertex
+/// folds exactly when its widened key meets the hull of vertices `0 ..= i
+/// − w` (for `i ≥ w + 1`: the run before the window has a segment) or of
+/// vertices `i + w ..= n − 1` (for `i + w ≤ n − 2`): a segment it meets
+/// lies in the hull; and where it meets the hull, at some value `x`, `x`
+/// lies in the interval of one of the run's segments (their union covers
+/// every value between its ends), which therefore meets it. A forward
+/// pass keeps the first hull, a backward pass the second: `O(1)` per
+/// vertex. Orientation does not matter (negating every key negates every
+/// interval exactly); `folds_by_hulls_equals_brute_force` compares it
+/// with the segments' brute force.
+pub(crate) fn folds_by_hulls<T>(
+    items: &mut [T],
+    margins: &[f32],
+    w: usize,
+    (valid, key): (impl Fn(&T) -> bool, impl Fn(&T) -> f32),
+    mut mark: impl FnMut(&mut T),
+) -> bool {
+    let n = items.len();
+    // (A NaN fails.)
+    let ok = |it: &T, e: f32| valid(it) && key(it).is_finite() && (0.0..f32::INFINITY).contains(&e);
+    if margins.len() < n || !items.iter().zip(margins).all(|(it, &e)| ok(it, e)) {
+        return false;
+    }
+    let widened = |items: &[T], i: usize| match (items.get(i), margins.get(i)) {
+        (Some(it), Some(&e)) => {
+            let k = key(it);
+            (k - e, k + e)
+        }
+        _ => (f32::INFINITY, f32::NEG_INFINITY),
+    };
+    let join = |(a, b): (f32, f32), (c, d): (f32, f32)| (fmin(a, c), fmax(b, d));
+    let meets = |(lo, hi): (f32, f32), (ulo, uhi): (f32, f32)| lo <= uhi && hi >= ulo;
+    // Forward: the hull of vertices 0 ..= i − w, from i = w + 1 on.
+    let mut hull = widened(items, 0);
+    for i in w.saturating_add(1)..n {
+        hull = join(hull, widened(items, i - w));
+        if meets(widened(items, i), hull) {
+            if let Some(it) = items.get_mut(i) {
+                mark(it);
+            }
+        }
+    }
+    // Backward: the hull of vertices i + w ..= n − 1, for i + w ≤ n − 2.
+    let Some(last) = n.checked_sub(1) else {
+        return true;
+    };
+    let mut hull = widened(items, last);
+    for i in (0..n.saturating_sub(w.saturating_add(1))).rev() {
+        hull = join(hull, widened(items, i + w));
+        // (An item the forward pass marked is no longer `valid`.)
+        if items.get(i).is_some_and(&valid) && meets(widened(items, i), hull) {
+            if let Some(it) = items.get_mut(i) {
+                mark(it);
+            }
+        }
+    }
+    true
+}
+
 /// First index in `[lo, hi)` with `v[j] ≥ t` (non-decreasing `v`), or `hi`;
 /// each step one unit of work.
 fn bisect(
@@ -1696,65 +1673,55 @@ mod tests {
         }
     }
 
-    /// The fold test of every vertex at once ([`Index::folds_all`]: the
-    /// connected path's exact unions, or the envelopes and the query)
-    /// equals the brute force, and flags through `flag` only what folds.
+    /// The fold test straight from the keys ([`folds_by_hulls`]) equals
+    /// the brute force over the segments on every key sequence with all
+    /// vertices keyed and no period, and declines the others.
     #[test]
-    fn folds_all_equals_brute_force() {
+    fn folds_by_hulls_equals_brute_force() {
         let mut rng = Rng(0xf01d_0003);
-        let mut index = Index::<CAP>::new();
-        let w = 4;
-        let mut connected = 0;
+        let (w, mut taken) = (4, 0);
         for case in 0..3000 {
-            let (shape, period) = (case % 5, case % 7 == 0);
-            let n = 2 + (rng.next() * (CAP - 2) as f32) as usize;
-            let mut ks = keys(&mut rng, shape, n, period);
-            // Most cases with every vertex keyed (a connected path).
+            let shape = case % 5;
+            let n = 1 + (rng.next() * (CAP - 1) as f32) as usize;
+            let mut ks = keys(&mut rng, shape, n, false);
+            // Most cases with every vertex keyed.
             if case % 4 != 0 {
-                for k in ks.iter_mut() {
-                    if !k.0.is_finite() {
-                        *k = (rng.next(), 1.0e-5);
-                    }
+                for k in ks.iter_mut().filter(|k| !k.0.is_finite()) {
+                    *k = (rng.next(), 1.0e-5);
                 }
             }
-            let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
-            let mut b = index.builder((if period { 4.0 } else { 0.0 }, orient), Unkeyed::MeetNone);
-            b.push_all(ks.iter().copied());
-            b.finish(None);
-            let lean = !period && index.aside.is_empty();
-            connected += usize::from(lean && index.clone().suffix_maxima());
-            let ivs = intervals(&ks, period);
-            // (key, folded): items the way the processor's slots are.
-            let mut items: Vec<(f32, Option<bool>)> = ks.iter().map(|&(k, _)| (k, None)).collect();
-            let mut work = Work::new();
-            let mut twice_or_out = false;
-            index.folds_all(
-                &mut items,
-                (w, u32::MAX / 4),
-                &mut work,
-                |it| it.0.is_finite().then_some(it.0),
-                |it, r| {
-                    twice_or_out |= it.1.is_some() || r.is_err();
-                    it.1 = Some(r == Ok(true));
-                },
+            let ivs = intervals(&ks, false);
+            let margins: Vec<f32> = ks.iter().map(|k| k.1).collect();
+            // (raw key, marks).
+            let mut items: Vec<(f32, u32)> = ks.iter().map(|k| (k.0, 0)).collect();
+            let valid = |it: &(f32, u32)| it.0.is_finite() && it.1 == 0;
+            let took = folds_by_hulls(&mut items, &margins, w, (valid, |it| it.0), |it| it.1 += 1);
+            let all_keyed = ks.iter().all(|k| k.0.is_finite());
+            assert_eq!(
+                took, all_keyed,
+                "case {case}: taken only with every vertex keyed"
             );
-            assert!(!twice_or_out, "case {case}: an item flagged twice, or out of work");
+            if !took {
+                assert!(
+                    items.iter().all(|it| it.1 == 0),
+                    "case {case}: marked when declined"
+                );
+                continue;
+            }
+            taken += 1;
             for (i, (&(k, e), it)) in ks.iter().zip(&items).enumerate() {
-                if !k.is_finite() {
-                    continue;
-                }
                 let brute = ivs.iter().enumerate().any(|(j, iv)| {
                     let outside = j + w < i || j > i + w - 1;
-                    outside && iv.is_some_and(|iv| meets(iv, (k - e, k + e), period))
+                    outside && iv.is_some_and(|iv| meets(iv, (k - e, k + e), false))
                 });
                 assert_eq!(
-                    it.1 == Some(true),
-                    brute,
-                    "case {case} (shape {shape}, period {period}) vertex {i} key {k}"
+                    it.1,
+                    u32::from(brute),
+                    "case {case} (shape {shape}) vertex {i} of {n}"
                 );
             }
         }
-        assert!(connected > 800, "{connected} connected cases");
+        assert!(taken > 2000, "{taken} cases taken");
     }
 
     /// The fold test (the `strict` certificate, the envelopes' `O(1)`

@@ -573,7 +573,9 @@ fn fold_by_hulls(slots: &mut [PointResult], margins: &[f32]) -> bool {
     let valid = |r: &PointResult| r.status == Status::NoIntersection;
     // Marked points keep their key (`z_far`) until both passes are done.
     let mark = |r: &mut PointResult| r.status = Status::Folded;
-    if !crate::search::folds_by_hulls(slots, margins, FOLD_WINDOW, (valid, |r| r.z_far), mark) {
+    let unmark = |r: &mut PointResult| r.status = Status::NoIntersection;
+    let marks = (mark, unmark);
+    if !crate::search::folds_by_hulls(slots, margins, FOLD_WINDOW, (valid, |r| r.z_far), marks) {
         return false;
     }
     for r in slots.iter_mut().filter(|r| r.status == Status::Folded) {

@@ -1391,9 +1391,10 @@ impl<const N: usize> Builder<'_, N> {
 /// no work. Item `i` is vertex `i`; `valid` says whether it is to be
 /// tested (it has a key, and `mark` has not marked it), `key` gives its
 /// raw key (read whatever `mark` did to it), `margins[i]` its margin;
-/// `mark` gets every item that folds, once. Returns `false`, marking nothing, when an item is not valid or
-/// its key is not finite or its margin is not a number `≥ 0`: then the
-/// index decides ([`Index::folds_all`]).
+/// `mark` gets every item that folds, once. Returns `false` when an item
+/// is not valid, or its key is not finite, or its margin is not a number
+/// `≥ 0`: then the items marked so far get `unmark` (which must make them
+/// valid again) and the index decides ([`Index::folds_all`]).
 ///
 /// Vertex `i` folds when its widened key `[k − e, k + e]` meets the
 /// interval of a segment `j ≤ i − w − 1` or `j ≥ i + w` (segment `j` from
@@ -1417,12 +1418,10 @@ pub(crate) fn folds_by_hulls<T>(
     margins: &[f32],
     w: usize,
     (valid, key): (impl Fn(&T) -> bool, impl Fn(&T) -> f32),
-    mut mark: impl FnMut(&mut T),
+    (mut mark, mut unmark): (impl FnMut(&mut T), impl FnMut(&mut T)),
 ) -> bool {
     let n = items.len();
-    // (A NaN fails.)
-    let ok = |it: &T, e: f32| valid(it) && key(it).is_finite() && (0.0..f32::INFINITY).contains(&e);
-    if margins.len() < n || !items.iter().zip(margins).all(|(it, &e)| ok(it, e)) {
+    if margins.len() < n {
         return false;
     }
     let widened = |items: &[T], i: usize| match (items.get(i), margins.get(i)) {
@@ -1434,25 +1433,41 @@ pub(crate) fn folds_by_hulls<T>(
     };
     let join = |(a, b): (f32, f32), (c, d): (f32, f32)| (fmin(a, c), fmax(b, d));
     let meets = |(lo, hi): (f32, f32), (ulo, uhi): (f32, f32)| lo <= uhi && hi >= ulo;
-    // Forward: the hull of vertices 0 ..= i − w, from i = w + 1 on.
-    let mut hull = widened(items, 0);
-    for i in w.saturating_add(1)..n {
-        hull = join(hull, widened(items, i - w));
-        if meets(widened(items, i), hull) {
+    // Forward: each item checked as it comes (valid, its key finite, its
+    // margin a number ≥ 0: then `k − e ≤ k + e`, both finite), the hull
+    // of vertices 0 ..= i − w, the test from i = w + 1 on.
+    let mut hull = (f32::INFINITY, f32::NEG_INFINITY);
+    for i in 0..n {
+        let e = margins.get(i).copied().unwrap_or(f32::NAN);
+        let checked = items.get(i).filter(|&it| valid(it)).map(&key);
+        // (A NaN fails.)
+        let Some(wi) = checked.filter(|k| k.is_finite() && (0.0..f32::INFINITY).contains(&e))
+        else {
+            // Undo: every item before `i` was valid, so those that are
+            // no longer are the ones marked here.
+            for it in items.iter_mut().take(i).filter(|it| !valid(it)) {
+                unmark(it);
+            }
+            return false;
+        };
+        let wi = (wi - e, wi + e);
+        if let Some(v) = i.checked_sub(w) {
+            hull = join(hull, widened(items, v));
+        }
+        if i > w && meets(wi, hull) {
             if let Some(it) = items.get_mut(i) {
                 mark(it);
             }
         }
     }
     // Backward: the hull of vertices i + w ..= n − 1, for i + w ≤ n − 2.
-    let Some(last) = n.checked_sub(1) else {
-        return true;
-    };
-    let mut hull = widened(items, last);
-    for i in (0..n.saturating_sub(w.saturating_add(1))).rev() {
-        hull = join(hull, widened(items, i + w));
+    let mut hull = (f32::INFINITY, f32::NEG_INFINITY);
+    for i in (0..n).rev() {
+        if let Some(v) = i.checked_add(w).filter(|&v| v < n) {
+            hull = join(hull, widened(items, v));
+        }
         // (An item the forward pass marked is no longer `valid`.)
-        if items.get(i).is_some_and(&valid) && meets(widened(items, i), hull) {
+        if i + w + 1 < n && items.get(i).is_some_and(&valid) && meets(widened(items, i), hull) {
             if let Some(it) = items.get_mut(i) {
                 mark(it);
             }
@@ -1695,7 +1710,11 @@ mod tests {
             // (raw key, marks).
             let mut items: Vec<(f32, u32)> = ks.iter().map(|k| (k.0, 0)).collect();
             let valid = |it: &(f32, u32)| it.0.is_finite() && it.1 == 0;
-            let took = folds_by_hulls(&mut items, &margins, w, (valid, |it| it.0), |it| it.1 += 1);
+            let marks = (
+                |it: &mut (f32, u32)| it.1 += 1,
+                |it: &mut (f32, u32)| it.1 -= 1,
+            );
+            let took = folds_by_hulls(&mut items, &margins, w, (valid, |it| it.0), marks);
             let all_keyed = ks.iter().all(|k| k.0.is_finite());
             assert_eq!(
                 took, all_keyed,

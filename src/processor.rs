@@ -42,7 +42,8 @@ use crate::matching::{Outcome, Radial, Walker};
 use crate::motion::Motion;
 use crate::pencil::{half_key, Keying, Pencil, NO_KEY};
 use crate::search::{
-    run_start_in, Flow, Index, KeyOrder, OutOfWork, Query, Unkeyed, Visitor, Work, CLIP_UNITS,
+    run_start_in, Blocks, Flow, Index, KeyOrder, Lean, OutOfWork, Query, Unkeyed, Visitor, Work,
+    CLIP_UNITS,
 };
 use crate::structure::{PointResult, ProcessError, Status, Step, Structure, FOLD_WINDOW};
 use crate::wedge::{WVertex, Wedge, WedgeWalk, WedgeWalker};
@@ -637,19 +638,12 @@ fn match_boundary<const N: usize>(
         keying.pencil,
         pair.geom.w() > 0.0 && pair.translation <= 0.0,
     ) {
-        if matcher == Matcher::Indexed && index.lean().is_some() {
-            match_wedge_tight(pair, keying, (foe, side), slots, b2, index, &mut credit);
-        } else {
-            match_wedge(
-                pair,
-                keying,
-                (foe, side),
-                slots,
-                b2,
-                index,
-                &mut credit,
-                matcher,
-            );
+        // (Half-plane keys have no period: the index always walks lean.)
+        match matcher {
+            Matcher::Indexed => {
+                match_wedge_tight(pair, keying, (foe, side), slots, b2, index, &mut credit)
+            }
+            Matcher::Reference => match_wedge_reference(pair, keying, (foe, side), slots, b2),
         }
         *work = credit;
         return;
@@ -676,13 +670,20 @@ fn match_wedge_tight<const N: usize>(
     work: &mut Work,
 ) {
     let mut hint = index.hint();
-    let Some((segs, orient, aside)) = index.lean() else {
+    let Some(Lean {
+        segs,
+        orient,
+        aside,
+        blocks,
+    }) = index.lean()
+    else {
         return;
     };
     let walk = TightWalk {
         pair,
         segs,
         aside,
+        blocks,
         b2,
         foe,
         side,
@@ -693,7 +694,14 @@ fn match_wedge_tight<const N: usize>(
         cot_twice: pair.config.cot_twice,
         segments: b2.len().saturating_sub(1),
     };
-    if aside.is_empty() {
+    if blocks.any() {
+        // A loose index (the keys fold somewhere): the tree's skips too.
+        for r in slots.iter_mut() {
+            if r.status == Status::NoIntersection {
+                hint = walk.point_loose(r, hint, work);
+            }
+        }
+    } else if aside.is_empty() {
         for r in slots.iter_mut() {
             if r.status == Status::NoIntersection {
                 hint = walk.point(r, hint, work);
@@ -714,6 +722,7 @@ struct TightWalk<'a> {
     pair: &'a Pair<'a>,
     segs: &'a [crate::search::Seg],
     aside: &'a [crate::search::Aside],
+    blocks: Blocks<'a>,
     b2: &'a [Pixel],
     foe: [f32; 2],
     side: f32,
@@ -768,10 +777,35 @@ impl TightWalk<'_> {
             *r = PointResult::flagged(p1, Status::AtFoe);
             return hint;
         };
-        let (outcome, a) = wedge_run_aside(
+        let (outcome, a) = wedge_run_aside::<false>(
             &wedge,
             (self.segs, self.b2, self.aside),
-            hint,
+            (hint, self.blocks),
+            (self.segments, self.cot_twice),
+            work,
+        );
+        *r = conclude_wedge(self.pair, p1, iz, r1, &wedge, outcome);
+        a
+    }
+
+    /// [`Self::point_aside`] through a loose index: the run's blocks that
+    /// miss the wedge's keys skipped by the tree ([`wedge_run_aside`]).
+    #[inline(never)]
+    fn point_loose(&self, r: &mut PointResult, hint: usize, work: &mut Work) -> usize {
+        let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
+        let Ok(wedge) = Wedge::new(
+            p,
+            (self.foe, self.side),
+            (r1, self.e2, self.e2_csc),
+            (key, self.key_scale, self.orient),
+        ) else {
+            *r = PointResult::flagged(p1, Status::AtFoe);
+            return hint;
+        };
+        let (outcome, a) = wedge_run_aside::<true>(
+            &wedge,
+            (self.segs, self.b2, self.aside),
+            (hint, self.blocks),
             (self.segments, self.cot_twice),
             work,
         );
@@ -780,24 +814,17 @@ impl TightWalk<'_> {
     }
 }
 
-/// The wedge path through a loose index (the general visit) or the
-/// reference (every segment, with the intervals the index would hold).
-#[allow(clippy::too_many_arguments)]
+/// The wedge path's reference: every segment offered to the walk, with
+/// the interval the index would hold ([`raw_interval`]), no work budget.
+#[cfg_attr(not(any(test, feature = "_reference")), allow(dead_code))]
 #[inline(never)]
-fn match_wedge<const N: usize>(
+fn match_wedge_reference(
     pair: &Pair,
     keying: &Keying,
     (foe, side): ([f32; 2], f32),
     slots: &mut [PointResult],
     b2: &[Pixel],
-    index: &mut Index<N>,
-    work: &mut Work,
-    matcher: Matcher,
 ) {
-    let orient = match matcher {
-        Matcher::Indexed => index.orient(),
-        Matcher::Reference => 1.0,
-    };
     let (e2, e2_csc, cot_twice) = (pair.e2(), pair.e2_csc(), pair.config.cot_twice);
     let segments = b2.len().saturating_sub(1);
     for r in slots.iter_mut() {
@@ -805,38 +832,22 @@ fn match_wedge<const N: usize>(
             continue;
         }
         let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
-        let key3 = (key, keying.key_scale, orient);
+        let key3 = (key, keying.key_scale, 1.0);
         let Ok(wedge) = Wedge::new(p, (foe, side), (r1, e2, e2_csc), key3) else {
             *r = PointResult::flagged(p1, Status::AtFoe);
             continue;
         };
         let mut walker = WedgeWalker::new(wedge, b2, cot_twice);
-        let outcome = match matcher {
-            Matcher::Indexed => {
-                let query = if orient < 0.0 {
-                    Query::Keys(-wedge.kh, -wedge.kl)
-                } else {
-                    Query::Keys(wedge.kl, wedge.kh)
-                };
-                match index.visit(query, false, None, work, &mut walker) {
-                    Err(OutOfWork) => Outcome::Flag(Status::OverBudget),
-                    Ok(()) => walker.outcome(),
-                }
+        for j in 0..segments {
+            let iv = match (b2.get(j), b2.get(j + 1)) {
+                (Some(a), Some(b)) => raw_interval(keying, a.arr(), b.arr()),
+                _ => (f32::INFINITY, f32::NEG_INFINITY),
+            };
+            if Visitor::segment(&mut walker, j, iv).0 == Flow::Stop {
+                break;
             }
-            Matcher::Reference => {
-                for j in 0..segments {
-                    let iv = match (b2.get(j), b2.get(j + 1)) {
-                        (Some(a), Some(b)) => raw_interval(keying, a.arr(), b.arr()),
-                        _ => (f32::INFINITY, f32::NEG_INFINITY),
-                    };
-                    if Visitor::segment(&mut walker, j, iv).0 == Flow::Stop {
-                        break;
-                    }
-                }
-                walker.outcome()
-            }
-        };
-        *r = conclude_wedge(pair, p1, iz, r1, &wedge, outcome);
+        }
+        *r = conclude_wedge(pair, p1, iz, r1, &wedge, walker.outcome());
     }
 }
 
@@ -938,15 +949,20 @@ fn wedge_run(
     (outcome, a)
 }
 
-/// [`wedge_run`] through a lean index with aside entries: each one offered
+/// [`wedge_run`] through an index with aside entries: each one offered
 /// in its place by index ([`offer`]: a look one unit, a met one
 /// [`CLIP_UNITS`] more), before the run's segments after it and, past the
-/// run, in order. Returns the outcome and where the run started.
+/// run, in order. With `SKIP` (a loose index, whose runs can be long where
+/// the keys fold), a segment that misses the wedge's keys also passes over
+/// the largest aligned block of the tree from it that misses them
+/// ([`Blocks::skip_at`]; a block holding a segment that meets them meets
+/// them too, so only a miss can start a skip), for the look's unit.
+/// Returns the outcome and where the run started.
 #[inline(always)]
-fn wedge_run_aside(
+fn wedge_run_aside<const SKIP: bool>(
     wedge: &Wedge,
     (segs, b2, aside): (&[crate::search::Seg], &[Pixel], &[crate::search::Aside]),
-    hint: usize,
+    (hint, blocks): (usize, Blocks),
     (segments, cot_twice): (usize, f32),
     work: &mut Work,
 ) -> (Outcome, usize) {
@@ -969,7 +985,12 @@ fn wedge_run_aside(
     // The vertices up to the run's last end (the aside entries take theirs
     // from `b2`).
     let run = b2.get(..end + 1).unwrap_or(&[]);
-    'walk: for j in a..end {
+    let meets = |l: f32, h: f32| l <= wedge.kh && h >= wedge.kl;
+    // The next segment to look at (bounded: every step moves it on).
+    let mut at = a;
+    'walk: while at < end {
+        let j = at;
+        at += 1;
         let (Some(g), Some(v1)) = (segs.get(j), run.get(j + 1)) else {
             break;
         };
@@ -1004,6 +1025,9 @@ fn wedge_run_aside(
                 break;
             }
             c -= 1;
+            if SKIP {
+                at = j.saturating_add(blocks.skip_at(j, meets).max(1));
+            }
             continue;
         }
         if c == 0 {
@@ -1013,6 +1037,9 @@ fn wedge_run_aside(
         c -= 1;
         let hi_meets = g.hi > kh || g.hi >= kl;
         if !hi_meets {
+            if SKIP {
+                at = j.saturating_add(blocks.skip_at(j, meets).max(1));
+            }
             continue;
         }
         if c < CLIP_UNITS {

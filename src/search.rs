@@ -158,6 +158,74 @@ pub(crate) trait Visitor {
     fn segment(&mut self, j: usize, interval: (f32, f32)) -> (Flow, u32);
 }
 
+/// An index's view for a caller that walks runs itself ([`Index::lean`]).
+#[derive(Clone, Copy)]
+pub(crate) struct Lean<'a> {
+    pub(crate) segs: &'a [Seg],
+    pub(crate) orient: f32,
+    pub(crate) aside: &'a [Aside],
+    pub(crate) blocks: Blocks<'a>,
+}
+
+/// A loose index's block tree (module docs): the `(min lo, max hi)` of
+/// every aligned block of `FAN^l` segments, level after level.
+#[derive(Clone, Copy)]
+pub(crate) struct Blocks<'a> {
+    tree: &'a [f32],
+    levels: usize,
+    segments: usize,
+}
+
+impl Blocks<'_> {
+    /// Whether there is a tree (a loose index).
+    #[inline(always)]
+    pub(crate) fn any(&self) -> bool {
+        self.levels > 0
+    }
+
+    /// At segment `j` of a loose index's run: how many segments from `j`
+    /// on a block skip passes over: the largest block aligned at `j` whose
+    /// key range `meets` does not accept (0: look at segment `j` itself).
+    /// At most [`LEVELS`] steps.
+    #[inline(always)]
+    pub(crate) fn skip_at(&self, j: usize, meets: impl Fn(f32, f32) -> bool) -> usize {
+        // Only a position aligned to a block starts one.
+        if j & (FAN - 1) != 0 {
+            return 0;
+        }
+        let (mut base, mut n, mut skip) = (0usize, self.segments, 0usize);
+        let mut shift = 0u32;
+        for _ in 0..self.levels.min(LEVELS) {
+            shift += FAN_BITS;
+            n = n.div_ceil(FAN);
+            // (`shift` ≤ 3 · LEVELS = 12.)
+            let size = 1usize << shift;
+            if j & (size - 1) != 0 {
+                break;
+            }
+            let b = j >> shift;
+            let (lo, hi) = (
+                self.tree
+                    .get(base + 2 * b)
+                    .copied()
+                    .unwrap_or(f32::NEG_INFINITY),
+                self.tree
+                    .get(base + 2 * b + 1)
+                    .copied()
+                    .unwrap_or(f32::INFINITY),
+            );
+            // A block that meets the query holds every larger block's
+            // range too: stop there.
+            if lo <= hi && meets(lo, hi) {
+                break;
+            }
+            skip = size;
+            base += 2 * n;
+        }
+        skip
+    }
+}
+
 /// How segments with an unkeyable end count.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Unkeyed {
@@ -422,46 +490,20 @@ impl<const N: usize> Index<N> {
         }
     }
 
-    /// At segment `j` of a loose index's run: how many segments from `j`
-    /// on a block skip passes over: the largest block aligned at `j` whose
-    /// key range `meets` does not accept (0: look at segment `j` itself).
-    /// At most [`LEVELS`] steps.
+    /// The block tree as [`Blocks`] (no levels when none is built).
+    #[inline(always)]
+    fn blocks(&self) -> Blocks<'_> {
+        Blocks {
+            tree: &self.tree,
+            levels: self.levels,
+            segments: self.segments,
+        }
+    }
+
+    /// [`Blocks::skip_at`] on this index's tree.
     #[inline(always)]
     fn skip_at(&self, j: usize, meets: impl Fn(f32, f32) -> bool) -> usize {
-        // Only a position aligned to a block starts one.
-        if j & (FAN - 1) != 0 {
-            return 0;
-        }
-        let (mut base, mut n, mut skip) = (0usize, self.segments, 0usize);
-        let mut shift = 0u32;
-        for _ in 0..self.levels.min(LEVELS) {
-            shift += FAN_BITS;
-            n = n.div_ceil(FAN);
-            // (`shift` ≤ 3 · LEVELS = 12.)
-            let size = 1usize << shift;
-            if j & (size - 1) != 0 {
-                break;
-            }
-            let b = j >> shift;
-            let (lo, hi) = (
-                self.tree
-                    .get(base + 2 * b)
-                    .copied()
-                    .unwrap_or(f32::NEG_INFINITY),
-                self.tree
-                    .get(base + 2 * b + 1)
-                    .copied()
-                    .unwrap_or(f32::INFINITY),
-            );
-            // A block that meets the query holds every larger block's
-            // range too: stop there.
-            if lo <= hi && meets(lo, hi) {
-                break;
-            }
-            skip = size;
-            base += 2 * n;
-        }
-        skip
+        self.blocks().skip_at(j, meets)
     }
 
     /// Whether vertex `i`, whose raw key is `key`, may lie on a ray that
@@ -628,20 +670,18 @@ impl<const N: usize> Index<N> {
         Ok(met.0)
     }
 
-    /// For a *lean* index (non-periodic keys, envelopes not loose once the
-    /// aside segments are left out): its segments, orientation and aside
-    /// list, for a caller that walks the run itself and merges the aside
-    /// entries into it by index ([`Self::run_start`], then `sm`, `lo`, `hi`
-    /// as [`Self::visit`] does; the block tree, if any, is not needed for
-    /// such short runs); `None` otherwise.
+    /// For an index without a period: its segments, orientation, aside
+    /// list and block tree, for a caller that walks the run itself and
+    /// merges the aside entries into it by index ([`run_start_in`], then
+    /// `sm`, `lo`, `hi` as [`Self::visit`] does, and, on a loose index, the
+    /// tree's skips at aligned positions); `None` otherwise.
     #[inline(always)]
-    pub(crate) fn lean(&self) -> Option<(&[Seg], f32, &[Aside])> {
-        (self.period <= 0.0 && !self.loose).then(|| {
-            (
-                self.seg.get(..self.segments.min(N)).unwrap_or(&[]),
-                self.orient,
-                self.aside.as_slice(),
-            )
+    pub(crate) fn lean(&self) -> Option<Lean<'_>> {
+        (self.period <= 0.0).then(|| Lean {
+            segs: self.seg.get(..self.segments.min(N)).unwrap_or(&[]),
+            orient: self.orient,
+            aside: self.aside.as_slice(),
+            blocks: self.blocks(),
         })
     }
 

@@ -8,14 +8,19 @@
 //!    (`crate::pencil`); points behind the frame-2 camera or far out of
 //!    its view are flagged (checks a frame skips when its whole image
 //!    passes them, `PairGeometry::certifies_image`).
-//! 2. **Fold test**: index the compensated frame-1 polyline by key and flag
-//!    the points whose own epipolar line meets it again away from them
-//!    ([`Status::Folded`]); when the keys are strictly ordered along the
-//!    polyline nothing folds, and no index is built.
+//! 2. **Fold test**: flag the points whose own epipolar line meets the
+//!    compensated frame-1 polyline again away from them
+//!    ([`Status::Folded`]). When the keys are strictly ordered along the
+//!    polyline nothing folds; when every point has a key without a period
+//!    the test is decided from the keys in `O(1)` per point
+//!    (`search::folds_by_hulls`); only otherwise (a point without a key, or
+//!    pseudo-angle keys) is the polyline indexed and queried.
 //! 3. **Index** the corresponding frame-2 polyline (`crate::search`).
 //! 4. **Match** every remaining point: its error band ([`crate::depth`]),
-//!    the segments the index offers for the band's key interval, the walk
-//!    over them (`crate::matching`), and the depth and stick.
+//!    or in the usual case the wedge that holds it (`crate::wedge`),
+//!    the segments the index offers for its key interval (the wedge path
+//!    walks the index's runs itself, skipping blocks on a loose index), the
+//!    walk over them (`crate::matching`), and the depth and stick.
 //!
 //! Memory is fixed at compile time: a `Processor<N, B>` holds the previous
 //! frame (`B` boundaries of up to `N` points), one search index and the

@@ -43,9 +43,15 @@
 //! range misses the query (at an aligned position, the largest such block),
 //! so a long run costs about one step per block it crosses and per segment
 //! it visits, not one per segment. A tight index never builds or reads the
-//! tree, and neither does a *lean* one (non-periodic keys, envelopes no
-//! longer loose once the outliers are aside: the wedge path walks its short
-//! runs itself and merges the aside entries in by index, `Index::lean`).
+//! tree. The wedge path walks the runs of every index without a period
+//! itself (`Index::lean`): it merges the aside entries in by index and, on
+//! a loose index, skips from a segment that misses the query over the
+//! largest aligned block that misses it too ([`Blocks::skip_at`]).
+//!
+//! The fold test of a polyline whose vertices all have keys (no period)
+//! needs no index at all: the union of the intervals of a run of
+//! consecutive segments is the hull of its vertices' widened keys
+//! ([`folds_by_hulls`]).
 //!
 //! Periodic keys (pseudo-angles) are searched at each copy `q + 4m` that
 //! can meet the keys' range (at most [`MAX_COPIES`], else every segment is

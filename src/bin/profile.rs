@@ -29,7 +29,9 @@ static WINDOWS: &[(&str, &[u8])] = &[
     ("representative", include_bytes!("data/bench_256.bin")),
     // The bench's N = 256 stress pair (up to 3.4 points per row).
     ("stress", include_bytes!("data/stress_256.bin")),
-    // The demo drive's costliest frame pair (frames 14 and 15).
+    // The demo drive's frames 14 and 15 as one consecutive pair (the
+    // costliest such pair when the demo matched consecutive frames; the
+    // fusion demo pairs frame 15 with key frame 12).
     ("demo_15", include_bytes!("data/demo_15.bin")),
     // Spurious frame-2 detector points (N = 256): the wedge path's lean walk
     // with the index's aside entries merged in.

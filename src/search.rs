@@ -1506,14 +1506,18 @@ pub(crate) fn folds_by_hulls<T>(
             }
         }
     }
-    // Backward: the hull of vertices i + w ..= n − 1, for i + w ≤ n − 2.
-    let mut hull = (f32::INFINITY, f32::NEG_INFINITY);
-    for i in (0..n).rev() {
-        if let Some(v) = i.checked_add(w).filter(|&v| v < n) {
-            hull = join(hull, widened(items, v));
-        }
+    // Backward: the hull of vertices i + w ..= n − 1, tested for
+    // i + w ≤ n − 2, that is i < n − w − 1: it starts as vertex n − 1 alone
+    // and takes vertex i + w (< n − 1) at each tested i.
+    let tested = n.saturating_sub(w.saturating_add(1));
+    if tested == 0 {
+        return true;
+    }
+    let mut hull = widened(items, n - 1);
+    for i in (0..tested).rev() {
+        hull = join(hull, widened(items, i + w));
         // (An item the forward pass marked is no longer `valid`.)
-        if i + w + 1 < n && items.get(i).is_some_and(&valid) && meets(widened(items, i), hull) {
+        if items.get(i).is_some_and(&valid) && meets(widened(items, i), hull) {
             if let Some(it) = items.get_mut(i) {
                 mark(it);
             }
@@ -1787,6 +1791,24 @@ mod tests {
             }
         }
         assert!(taken > 2000, "{taken} cases taken");
+        // A window past every vertex (no run on either side): nothing
+        // folds, and no index arithmetic overflows.
+        let mut items: Vec<(f32, u32)> = (0..5).map(|i| ((i % 2) as f32, 0)).collect();
+        for w in [usize::MAX, usize::MAX - 1, usize::MAX / 2] {
+            let marks = (
+                |it: &mut (f32, u32)| it.1 += 1,
+                |it: &mut (f32, u32)| it.1 -= 1,
+            );
+            let valid = |it: &(f32, u32)| it.1 == 0;
+            assert!(folds_by_hulls(
+                &mut items,
+                &[0.5; 5],
+                w,
+                (valid, |it| it.0),
+                marks
+            ));
+            assert!(items.iter().all(|it| it.1 == 0), "w = {w}: nothing folds");
+        }
     }
 
     /// The fold test (the `strict` certificate, the envelopes' `O(1)`

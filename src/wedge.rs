@@ -368,8 +368,14 @@ fn exact_keys(d: [f32; 2], t: f32, side: f32, key_scale: f32, orient: f32) -> (f
 /// `el`, `eh` (named as in [`Wedge::new`]), each widened by its margin; an
 /// edge outside the half-plane stands for the key limit where the wedge
 /// crosses the FOE's row, on the side of `d` (the wedge is narrower than
-/// 53°); the lower key is the low end, and the interval is empty when the
-/// whole wedge lies beyond the row.
+/// 53°); the lower key is the low end. When the whole wedge lies beyond
+/// the row no keyed point is in it, and the interval is `(−∞, −∞)`: it
+/// meets only the intervals of segments with an unkeyed end (frame 2's
+/// `(−∞, ∞)`, [`crate::search`]), and a walk's tests of a segment's low
+/// end against it (`lo < kl || lo ≤ kh`, `sm > kh`) reject every other
+/// segment and end the run at the first one past them. (As the empty
+/// `(∞, −∞)`, the same segments meet it, but those tests took every
+/// finite low end for one below the query.)
 #[inline(always)]
 fn edge_keys(
     d: [f32; 2],
@@ -393,7 +399,7 @@ fn edge_keys(
     let first_low = if s > 0.0 { k0 <= k1 } else { k0 < k1 };
     if !(side * d[1] > 0.0 || in0 || in1) {
         // The whole wedge lies beyond the FOE's row: no keyed point.
-        return (f32::INFINITY, f32::NEG_INFINITY);
+        return (f32::NEG_INFINITY, f32::NEG_INFINITY);
     }
     if first_low {
         (k0 - m0, k1 + m1)

@@ -1487,8 +1487,8 @@ pub(crate) fn folds_by_hulls<T>(
         let e = margins.get(i).copied().unwrap_or(f32::NAN);
         let checked = items.get(i).filter(|&it| valid(it)).map(&key);
         // (A NaN fails.)
-        let Some(wi) = checked.filter(|k| k.is_finite() && (0.0..f32::INFINITY).contains(&e))
-        else {
+        // (`k + e` finite with `e ≥ 0`: both finite, and no overflow.)
+        let Some(wi) = checked.filter(|k| e >= 0.0 && (k + e).is_finite()) else {
             // Undo: every item before `i` was valid, so those that are
             // no longer are the ones marked here.
             for it in items.iter_mut().take(i).filter(|it| !valid(it)) {

@@ -403,22 +403,24 @@ impl<const N: usize> Index<N> {
         // keys move one way, neither end of an interval passes both of
         // those). A heuristic for speed only: any choice gives the same
         // results.
+        // (An empty interval, `(∞, −∞)`, or a missing neighbour leaves the
+        // neighbours' hull as it is; with neither there is no hull, `hi =
+        // −∞`: intervals are never otherwise inverted, and a non-empty one
+        // has `hi > −∞`.)
         let mut aside = heapless::Vec::<(u16, f32, f32), MAX_ASIDE>::new();
-        for j in 0..s {
-            let at = |i: Option<usize>| i.and_then(|i| seg.get(i)).filter(|g| g.lo <= g.hi);
-            let (b, a) = (at(j.checked_sub(2)), at(j.checked_add(2)));
-            let Some(g) = seg.get(j).copied() else { break };
+        let ends = |i: usize| {
+            seg.get(i)
+                .map_or((f32::INFINITY, f32::NEG_INFINITY), |x| (x.lo, x.hi))
+        };
+        for (j, g) in seg.iter().enumerate() {
             let all = g.lo == f32::NEG_INFINITY;
-            let out = g.lo.is_finite() && g.hi.is_finite() && (b.is_some() || a.is_some()) && {
-                let hi = fmax(
-                    b.map_or(f32::NEG_INFINITY, |x| x.hi),
-                    a.map_or(f32::NEG_INFINITY, |x| x.hi),
-                );
-                let lo = fmin(
-                    b.map_or(f32::INFINITY, |x| x.lo),
-                    a.map_or(f32::INFINITY, |x| x.lo),
-                );
-                g.hi - hi > wide || lo - g.lo > wide
+            let out = g.lo.is_finite() && g.hi.is_finite() && {
+                let (bl, bh) = j
+                    .checked_sub(2)
+                    .map_or((f32::INFINITY, f32::NEG_INFINITY), ends);
+                let (al, ah) = ends(j + 2);
+                let (lo, hi) = (fmin(bl, al), fmax(bh, ah));
+                hi > f32::NEG_INFINITY && (g.hi - hi > wide || lo - g.lo > wide)
             };
             if (all || out) && !aside.is_full() {
                 if let Ok(jj) = u16::try_from(j) {

@@ -49,6 +49,7 @@ pub mod camera;
 mod config;
 pub mod depth;
 pub mod epipolar;
+mod fold;
 pub mod fusion;
 pub mod geometry;
 pub mod link;

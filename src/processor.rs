@@ -13,7 +13,7 @@
 //!    ([`Status::Folded`]). When the keys are strictly ordered along the
 //!    polyline nothing folds; when every point has a key without a period
 //!    the test is decided from the keys in `O(1)` per point
-//!    (`search::folds_by_hulls`); only otherwise (a point without a key, or
+//!    (`fold::folds_by_hulls`); only otherwise (a point without a key, or
 //!    pseudo-angle keys) is the polyline indexed and queried.
 //! 3. **Index** the corresponding frame-2 polyline (`crate::search`).
 //! 4. **Match** every remaining point: its error band ([`crate::depth`]),
@@ -50,7 +50,7 @@ use crate::search::{
     run_start_in, Blocks, Flow, Index, KeyOrder, Lean, OutOfWork, Query, Unkeyed, Visitor, Work,
     CLIP_UNITS,
 };
-use crate::structure::{PointResult, ProcessError, Status, Step, Structure, FOLD_WINDOW};
+use crate::structure::{PointResult, ProcessError, Status, Step, Structure};
 use crate::wedge::{WVertex, Wedge, WedgeWalk, WedgeWalker};
 
 /// The per-frame motion-stereo processor for up to `B` boundaries of up to
@@ -266,26 +266,13 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                     }
                 }
             }
-            let n = u32::try_from(slots.len()).unwrap_or(u32::MAX);
-            if order.strict(keying.period) {
-                // No key meets a segment but its own two: nothing folds,
-                // and the fold index is not needed.
-                work.grant(config.work_per_point.saturating_mul(n));
-            } else if keying.period <= 0.0 && fold_by_hulls(slots, index.margins()) {
-                // Every point keyed: the fold test from the keys alone.
-                work.grant(config.work_per_point.saturating_mul(n));
-            } else {
-                let mut fold_index = index.builder((keying.period, orient), Unkeyed::MeetNone);
-                fold_index.push_all_stored(slots.iter().map(|r| {
-                    if r.status == Status::NoIntersection {
-                        r.z_far
-                    } else {
-                        NO_KEY
-                    }
-                }));
-                fold_index.finish(None);
-                fold(index, slots, config.work_per_point, &mut work);
-            }
+            crate::fold::step(
+                index,
+                slots,
+                (&order, keying.period, orient),
+                config.work_per_point,
+                &mut work,
+            );
             let Some(b2) = b2 else {
                 for r in slots
                     .iter_mut()
@@ -539,55 +526,6 @@ fn compensate_all_certified(
     for p in points {
         one(p);
     }
-}
-
-/// Step 2, the fold test, on the index of the compensated frame-1
-/// polyline built from step 1's keys (points flagged there have none):
-/// flag every point whose own key meets a segment more than
-/// [`FOLD_WINDOW`] points away. Each point brings its allowance to the
-/// frame's work budget here.
-fn fold<const N: usize>(
-    index: &mut Index<N>,
-    slots: &mut [PointResult],
-    allowance: u32,
-    work: &mut Work,
-) {
-    if index.strict() {
-        // No key meets a segment but its own two: nothing folds.
-        let n = u32::try_from(slots.len()).unwrap_or(u32::MAX);
-        work.grant(allowance.saturating_mul(n));
-        return;
-    }
-    index.folds_all(
-        slots,
-        (FOLD_WINDOW, allowance),
-        work,
-        |r| (r.status == Status::NoIntersection && r.z_far.is_finite()).then_some(r.z_far),
-        |r, folds| match folds {
-            Err(OutOfWork) => *r = PointResult::flagged(r.pixel1, Status::OverBudget),
-            Ok(true) => *r = PointResult::flagged(r.pixel1, Status::Folded),
-            Ok(false) => {}
-        },
-    );
-}
-
-/// Step 2 without the fold index, when every point of the boundary has a
-/// key without a period ([`crate::search::folds_by_hulls`]: the same
-/// answer as the index's query, in `O(1)` per point and without work);
-/// `false`, with nothing changed, otherwise.
-fn fold_by_hulls(slots: &mut [PointResult], margins: &[f32]) -> bool {
-    let valid = |r: &PointResult| r.status == Status::NoIntersection;
-    // Marked points keep their key (`z_far`) until both passes are done.
-    let mark = |r: &mut PointResult| r.status = Status::Folded;
-    let unmark = |r: &mut PointResult| r.status = Status::NoIntersection;
-    let marks = (mark, unmark);
-    if !crate::search::folds_by_hulls(slots, margins, FOLD_WINDOW, (valid, |r| r.z_far), marks) {
-        return false;
-    }
-    for r in slots.iter_mut().filter(|r| r.status == Status::Folded) {
-        *r = PointResult::flagged(r.pixel1, Status::Folded);
-    }
-    true
 }
 
 /// Step 3: index the frame-2 polyline; with `W' < 0` and the FOE near, the

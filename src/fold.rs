@@ -1,0 +1,293 @@
+//! Step 2 of the per-frame call ([`crate::processor`]): the **fold test**.
+//!
+//! A compensated frame-1 point *folds* when its own epipolar line, the ray
+//! from the FOE through it, meets the compensated frame-1 polyline again
+//! away from it: then a frame-2 crossing on that line may belong to the
+//! other place, and the point is flagged [`Status::Folded`] (the paper's
+//! condition for a reliable match; the certification's "without a
+//! correspondent" column counts what slips past it). In keys
+//! ([`crate::pencil`]): vertex `i` folds when its widened key `[k − e, k +
+//! e]` meets the key interval of a segment `j ≤ i − w − 1` or `j ≥ i + w`
+//! (`w` = [`FOLD_WINDOW`]; segment `j` from vertex `j` to `j + 1`, its
+//! interval the hull of its ends' widened keys, as the search index builds
+//! it; a segment with an unkeyed end meets nothing here).
+//!
+//! One rule, decided the cheapest way the boundary allows, each giving the
+//! brute force's answer:
+//!
+//! 1. The keys are strictly ordered along the polyline (step 1 tracks the
+//!    order, [`KeyOrder`]): no key meets a segment but its own two, nothing
+//!    folds.
+//! 2. Every point has a key, without a period (half-plane keys): the test
+//!    from the keys alone, `O(1)` per point, no index, no work
+//!    ([`folds_by_hulls`]).
+//! 3. Otherwise (a point without a key breaks the polyline's chain of
+//!    intervals; pseudo-angle keys repeat every turn): the polyline is
+//!    indexed ([`crate::search`]) and each point the envelopes cannot clear
+//!    is queried, each segment looked at paid from the frame's work budget
+//!    ([`Status::OverBudget`] when it runs out).
+
+use crate::math::{fmax, fmin};
+use crate::pencil::NO_KEY;
+use crate::search::{Index, KeyOrder, OutOfWork, Unkeyed, Work};
+use crate::structure::{PointResult, Status, FOLD_WINDOW};
+
+/// Step 2 for one boundary's points in `slots` (step 1's results: a point
+/// still to be matched holds its raw key in `z_far`, its margin in the
+/// index's margins), whose key order step 1 tracked in `order`, keys of
+/// the given `period` and likely orientation `orient`; each point brings
+/// `allowance` units to `work`. Flags the points that fold.
+pub(crate) fn step<const N: usize>(
+    index: &mut Index<N>,
+    slots: &mut [PointResult],
+    (order, period, orient): (&KeyOrder, f32, f32),
+    allowance: u32,
+    work: &mut Work,
+) {
+    let n = u32::try_from(slots.len()).unwrap_or(u32::MAX);
+    if order.strict(period) {
+        // No key meets a segment but its own two: nothing folds.
+        work.grant(allowance.saturating_mul(n));
+        return;
+    }
+    if period <= 0.0 && by_hulls(slots, index.margins()) {
+        work.grant(allowance.saturating_mul(n));
+        return;
+    }
+    let mut fold_index = index.builder((period, orient), Unkeyed::MeetNone);
+    fold_index.push_all_stored(slots.iter().map(|r| {
+        if r.status == Status::NoIntersection {
+            r.z_far
+        } else {
+            NO_KEY
+        }
+    }));
+    fold_index.finish(None);
+    by_index(index, slots, allowance, work);
+}
+
+/// Rule 3: the query on the index of the compensated frame-1 polyline
+/// built from step 1's keys (points flagged there have none). Each point
+/// brings its allowance to the frame's work budget here.
+fn by_index<const N: usize>(
+    index: &mut Index<N>,
+    slots: &mut [PointResult],
+    allowance: u32,
+    work: &mut Work,
+) {
+    if index.strict() {
+        // No key meets a segment but its own two: nothing folds.
+        let n = u32::try_from(slots.len()).unwrap_or(u32::MAX);
+        work.grant(allowance.saturating_mul(n));
+        return;
+    }
+    index.folds_all(
+        slots,
+        (FOLD_WINDOW, allowance),
+        work,
+        |r| (r.status == Status::NoIntersection && r.z_far.is_finite()).then_some(r.z_far),
+        |r, folds| match folds {
+            Err(OutOfWork) => *r = PointResult::flagged(r.pixel1, Status::OverBudget),
+            Ok(true) => *r = PointResult::flagged(r.pixel1, Status::Folded),
+            Ok(false) => {}
+        },
+    );
+}
+
+/// Rule 2 on the processor's slots ([`folds_by_hulls`]); `false`, with
+/// nothing changed, when a point has no key.
+fn by_hulls(slots: &mut [PointResult], margins: &[f32]) -> bool {
+    let valid = |r: &PointResult| r.status == Status::NoIntersection;
+    // Marked points keep their key (`z_far`) until both passes are done.
+    let mark = |r: &mut PointResult| r.status = Status::Folded;
+    let unmark = |r: &mut PointResult| r.status = Status::NoIntersection;
+    if !folds_by_hulls(
+        slots,
+        margins,
+        FOLD_WINDOW,
+        (valid, |r| r.z_far),
+        (mark, unmark),
+    ) {
+        return false;
+    }
+    for r in slots.iter_mut().filter(|r| r.status == Status::Folded) {
+        *r = PointResult::flagged(r.pixel1, Status::Folded);
+    }
+    true
+}
+
+/// The fold test ([`Index::folds`]'s answer) of every vertex of a polyline whose
+/// vertices all have a key (no period), straight from the keys: no index,
+/// no work. Item `i` is vertex `i`; `valid` says whether it is to be
+/// tested (it has a key, and `mark` has not marked it), `key` gives its
+/// raw key (read whatever `mark` did to it), `margins[i]` its margin;
+/// `mark` gets every item that folds, once. Returns `false` when an item
+/// is not valid, or its key is not finite, or its margin is not a number
+/// `≥ 0`: then the items marked so far get `unmark` (which must make them
+/// valid again) and the index decides ([`Index::folds_all`]).
+///
+/// Vertex `i` folds when its widened key `[k − e, k + e]` meets the
+/// interval of a segment `j ≤ i − w − 1` or `j ≥ i + w` (segment `j` from
+/// vertex `j` to `j + 1`, its interval the hull of its ends' widened keys,
+/// `search::Builder`). Consecutive segments share a vertex, so both intervals
+/// hold its (non-empty) widened key, and the union of the intervals of a
+/// run of consecutive segments is one interval: the hull of the widened
+/// keys of the run's vertices (by induction along the run). So the vertex
+/// folds exactly when its widened key meets the hull of vertices `0 ..= i
+/// − w` (for `i ≥ w + 1`: the run before the window has a segment) or of
+/// vertices `i + w ..= n − 1` (for `i + w ≤ n − 2`): a segment it meets
+/// lies in the hull; and where it meets the hull, at some value `x`, `x`
+/// lies in the interval of one of the run's segments (their union covers
+/// every value between its ends), which therefore meets it. A forward
+/// pass keeps the first hull, a backward pass the second: `O(1)` per
+/// vertex. Orientation does not matter (negating every key negates every
+/// interval exactly); `folds_by_hulls_equals_brute_force` compares it
+/// with the segments' brute force.
+fn folds_by_hulls<T>(
+    items: &mut [T],
+    margins: &[f32],
+    w: usize,
+    (valid, key): (impl Fn(&T) -> bool, impl Fn(&T) -> f32),
+    (mut mark, mut unmark): (impl FnMut(&mut T), impl FnMut(&mut T)),
+) -> bool {
+    let n = items.len();
+    if margins.len() < n {
+        return false;
+    }
+    let widened = |items: &[T], i: usize| match (items.get(i), margins.get(i)) {
+        (Some(it), Some(&e)) => {
+            let k = key(it);
+            (k - e, k + e)
+        }
+        _ => (f32::INFINITY, f32::NEG_INFINITY),
+    };
+    let join = |(a, b): (f32, f32), (c, d): (f32, f32)| (fmin(a, c), fmax(b, d));
+    let meets = |(lo, hi): (f32, f32), (ulo, uhi): (f32, f32)| lo <= uhi && hi >= ulo;
+    // Forward: each item checked as it comes (valid, its key finite, its
+    // margin a number ≥ 0: then `k − e ≤ k + e`, both finite), the hull
+    // of vertices 0 ..= i − w, the test from i = w + 1 on.
+    let mut hull = (f32::INFINITY, f32::NEG_INFINITY);
+    for i in 0..n {
+        let e = margins.get(i).copied().unwrap_or(f32::NAN);
+        let checked = items.get(i).filter(|&it| valid(it)).map(&key);
+        // (A NaN fails.)
+        // (`k + e` finite with `e ≥ 0`: both finite, and no overflow.)
+        let Some(wi) = checked.filter(|k| e >= 0.0 && (k + e).is_finite()) else {
+            // Undo: every item before `i` was valid, so those that are
+            // no longer are the ones marked here.
+            for it in items.iter_mut().take(i).filter(|it| !valid(it)) {
+                unmark(it);
+            }
+            return false;
+        };
+        let wi = (wi - e, wi + e);
+        if let Some(v) = i.checked_sub(w) {
+            hull = join(hull, widened(items, v));
+        }
+        if i > w && meets(wi, hull) {
+            if let Some(it) = items.get_mut(i) {
+                mark(it);
+            }
+        }
+    }
+    // Backward: the hull of vertices i + w ..= n − 1, tested for
+    // i + w ≤ n − 2, that is i < n − w − 1: it starts as vertex n − 1 alone
+    // and takes vertex i + w (< n − 1) at each tested i.
+    let tested = n.saturating_sub(w.saturating_add(1));
+    if tested == 0 {
+        return true;
+    }
+    let mut hull = widened(items, n - 1);
+    for i in (0..tested).rev() {
+        hull = join(hull, widened(items, i + w));
+        // (An item the forward pass marked is no longer `valid`.)
+        if items.get(i).is_some_and(&valid) && meets(widened(items, i), hull) {
+            if let Some(it) = items.get_mut(i) {
+                mark(it);
+            }
+        }
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::search::tests::{intervals, keys, meets, CAP};
+    use crate::test_rng::Rng;
+    extern crate std;
+    use std::vec::Vec;
+
+    /// The fold test straight from the keys ([`folds_by_hulls`]) equals
+    /// the brute force over the segments on every key sequence with all
+    /// vertices keyed and no period, and declines the others.
+    #[test]
+    fn folds_by_hulls_equals_brute_force() {
+        let mut rng = Rng(0xf01d_0003);
+        let (w, mut taken) = (4, 0);
+        for case in 0..3000 {
+            let shape = case % 5;
+            let n = 1 + (rng.next() * (CAP - 1) as f32) as usize;
+            let mut ks = keys(&mut rng, shape, n, false);
+            // Most cases with every vertex keyed.
+            if case % 4 != 0 {
+                for k in ks.iter_mut().filter(|k| !k.0.is_finite()) {
+                    *k = (rng.next(), 1.0e-5);
+                }
+            }
+            let ivs = intervals(&ks, false);
+            let margins: Vec<f32> = ks.iter().map(|k| k.1).collect();
+            // (raw key, marks).
+            let mut items: Vec<(f32, u32)> = ks.iter().map(|k| (k.0, 0)).collect();
+            let valid = |it: &(f32, u32)| it.0.is_finite() && it.1 == 0;
+            let marks = (
+                |it: &mut (f32, u32)| it.1 += 1,
+                |it: &mut (f32, u32)| it.1 -= 1,
+            );
+            let took = folds_by_hulls(&mut items, &margins, w, (valid, |it| it.0), marks);
+            let all_keyed = ks.iter().all(|k| k.0.is_finite());
+            assert_eq!(
+                took, all_keyed,
+                "case {case}: taken only with every vertex keyed"
+            );
+            if !took {
+                assert!(
+                    items.iter().all(|it| it.1 == 0),
+                    "case {case}: marked when declined"
+                );
+                continue;
+            }
+            taken += 1;
+            for (i, (&(k, e), it)) in ks.iter().zip(&items).enumerate() {
+                let brute = ivs.iter().enumerate().any(|(j, iv)| {
+                    let outside = j + w < i || j > i + w - 1;
+                    outside && iv.is_some_and(|iv| meets(iv, (k - e, k + e), false))
+                });
+                assert_eq!(
+                    it.1,
+                    u32::from(brute),
+                    "case {case} (shape {shape}) vertex {i} of {n}"
+                );
+            }
+        }
+        assert!(taken > 2000, "{taken} cases taken");
+        // A window past every vertex (no run on either side): nothing
+        // folds, and no index arithmetic overflows.
+        let mut items: Vec<(f32, u32)> = (0..5).map(|i| ((i % 2) as f32, 0)).collect();
+        for w in [usize::MAX, usize::MAX - 1, usize::MAX / 2] {
+            let marks = (
+                |it: &mut (f32, u32)| it.1 += 1,
+                |it: &mut (f32, u32)| it.1 -= 1,
+            );
+            let valid = |it: &(f32, u32)| it.1 == 0;
+            assert!(folds_by_hulls(
+                &mut items,
+                &[0.5; 5],
+                w,
+                (valid, |it| it.0),
+                marks
+            ));
+            assert!(items.iter().all(|it| it.1 == 0), "w = {w}: nothing folds");
+        }
+    }
+}

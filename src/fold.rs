@@ -13,12 +13,14 @@
 //! it; a segment with an unkeyed end meets nothing here).
 //!
 //! One rule, decided the cheapest way the boundary allows, each giving the
-//! brute force's answer:
+//! brute force's answer (the third unless the work budget runs out first:
+//! then the point is [`Status::OverBudget`]):
 //!
 //! 1. The keys are strictly ordered along the polyline (step 1 tracks the
 //!    order, [`KeyOrder`]): no key meets a segment but its own two, nothing
 //!    folds.
-//! 2. Every point has a key, without a period (half-plane keys): the test
+//! 2. Every point has a key, without a period (half-plane or projective
+//!    keys): the test
 //!    from the keys alone, `O(1)` per point, no index, no work
 //!    ([`folds_by_hulls`]).
 //! 3. Otherwise (a point without a key breaks the polyline's chain of
@@ -121,10 +123,11 @@ fn by_hulls(slots: &mut [PointResult], margins: &[f32]) -> bool {
 /// no work. Item `i` is vertex `i`; `valid` says whether it is to be
 /// tested (it has a key, and `mark` has not marked it), `key` gives its
 /// raw key (read whatever `mark` did to it), `margins[i]` its margin;
-/// `mark` gets every item that folds, once. Returns `false` when an item
-/// is not valid, or its key is not finite, or its margin is not a number
-/// `≥ 0`: then the items marked so far get `unmark` (which must make them
-/// valid again) and the index decides ([`Index::folds_all`]).
+/// `mark` gets every item that folds, once. Returns `false` when there are
+/// fewer margins than items, or an item is not valid, or its margin is not
+/// a number `≥ 0`, or its `k + e` is not finite (its key is not, or the sum
+/// overflows): then the items marked so far get `unmark` (which must make
+/// them valid again) and the index decides ([`Index::folds_all`]).
 ///
 /// Vertex `i` folds when its widened key `[k − e, k + e]` meets the
 /// interval of a segment `j ≤ i − w − 1` or `j ≥ i + w` (segment `j` from
@@ -163,9 +166,10 @@ fn folds_by_hulls<T>(
     };
     let join = |(a, b): (f32, f32), (c, d): (f32, f32)| (fmin(a, c), fmax(b, d));
     let meets = |(lo, hi): (f32, f32), (ulo, uhi): (f32, f32)| lo <= uhi && hi >= ulo;
-    // Forward: each item checked as it comes (valid, its key finite, its
-    // margin a number ≥ 0: then `k − e ≤ k + e`, both finite), the hull
-    // of vertices 0 ..= i − w, the test from i = w + 1 on.
+    // Forward: each item checked as it comes (valid, its margin a number
+    // ≥ 0, `k + e` finite: then `k − e ≤ k + e`, the low end perhaps −∞,
+    // as the index computes it too), the hull of vertices 0 ..= i − w, the
+    // test from i = w + 1 on.
     let mut hull = (f32::INFINITY, f32::NEG_INFINITY);
     for i in 0..n {
         let e = margins.get(i).copied().unwrap_or(f32::NAN);

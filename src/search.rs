@@ -35,11 +35,11 @@
 //!
 //! The build is two linear passes (keys, intervals and `pm` forwards; `sm`
 //! backwards). Only when the envelopes come out loose (somewhere `pm[j] −
-//! sm[j]` exceeds [`WIDE`] average widths: a fold, an outlier, an unkeyed
-//! segment, or a wrong guess of the orientation) does a third pass look for
-//! outliers and the envelopes get rebuilt without them, and a **block
-//! tree** is built: the key range of every aligned block of [`FAN`],
-//! `FAN²`, … segments. A run through a loose index skips every block whose
+//! sm[j]` exceeds [`WIDE`] average widths: a fold, an outlier), a segment is
+//! unkeyed, or the orientation was guessed wrong does a third pass look
+//! for outliers and the envelopes get rebuilt without them; where they are
+//! still loose, a **block tree** is built: the key range of every aligned
+//! block of [`FAN`], `FAN²`, … segments. A run through a loose index skips every block whose
 //! range misses the query (at an aligned position, the largest such block),
 //! so a long run costs about one step per block it crosses and per segment
 //! it visits, not one per segment. A tight index never builds or reads the

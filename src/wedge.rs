@@ -540,9 +540,9 @@ fn end_inside((x, y, tx): (f32, f32, f32), x_min: f32) -> bool {
     y.abs() <= tx && x >= x_min
 }
 
-/// A wedge walk as an index [`Visitor`] (the loose index, and the
-/// reference): the wedge, the polyline, the last vertex (reused along a
-/// run) and the walk.
+/// A wedge walk as an index [`Visitor`], for the reference matcher (the
+/// indexed path walks the index's runs itself): the wedge, the polyline,
+/// the last vertex (reused along a run) and the walk.
 #[derive(Clone, Copy)]
 pub(crate) struct WedgeWalker<'a> {
     wedge: Wedge,

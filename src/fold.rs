@@ -3,9 +3,9 @@
 //! A compensated frame-1 point *folds* when its own epipolar line, the ray
 //! from the FOE through it, meets the compensated frame-1 polyline again
 //! away from it: then a frame-2 crossing on that line may belong to the
-//! other place, and the point is flagged [`Status::Folded`] (the paper's
-//! condition for a reliable match; the certification's "without a
-//! correspondent" column counts what slips past it). In keys
+//! other place (a wrong match no two-view test could tell from a right
+//! one), and the point is flagged [`Status::Folded`] (the certification's
+//! "without a correspondent" column counts what slips past it). In keys
 //! ([`crate::pencil`]): vertex `i` folds when its widened key `[k − e, k +
 //! e]` meets the key interval of a segment `j ≤ i − w − 1` or `j ≥ i + w`
 //! (`w` = [`FOLD_WINDOW`]; segment `j` from vertex `j` to `j + 1`, its
@@ -20,9 +20,8 @@
 //!    order, [`KeyOrder`]): no key meets a segment but its own two, nothing
 //!    folds.
 //! 2. Every point has a key, without a period (half-plane or projective
-//!    keys): the test
-//!    from the keys alone, `O(1)` per point, no index, no work
-//!    ([`folds_by_hulls`]).
+//!    keys): the test from the keys alone, `O(1)` per point, no index, no
+//!    work ([`folds_by_hulls`]).
 //! 3. Otherwise (a point without a key breaks the polyline's chain of
 //!    intervals; pseudo-angle keys repeat every turn): the polyline is
 //!    indexed ([`crate::search`]) and each point the envelopes cannot clear
@@ -118,9 +117,9 @@ fn by_hulls(slots: &mut [PointResult], margins: &[f32]) -> bool {
     true
 }
 
-/// The fold test ([`Index::folds`]'s answer) of every vertex of a polyline whose
-/// vertices all have a key (no period), straight from the keys: no index,
-/// no work. Item `i` is vertex `i`; `valid` says whether it is to be
+/// The fold test ([`Index::folds`]'s answer) of every vertex of a
+/// polyline whose vertices all have a key (no period), straight from the
+/// keys: no index, no work. Item `i` is vertex `i`; `valid` says whether it is to be
 /// tested (it has a key, and `mark` has not marked it), `key` gives its
 /// raw key (read whatever `mark` did to it), `margins[i]` its margin;
 /// `mark` gets every item that folds, once. Returns `false` when there are
@@ -132,8 +131,8 @@ fn by_hulls(slots: &mut [PointResult], margins: &[f32]) -> bool {
 /// Vertex `i` folds when its widened key `[k − e, k + e]` meets the
 /// interval of a segment `j ≤ i − w − 1` or `j ≥ i + w` (segment `j` from
 /// vertex `j` to `j + 1`, its interval the hull of its ends' widened keys,
-/// `search::Builder`). Consecutive segments share a vertex, so both intervals
-/// hold its (non-empty) widened key, and the union of the intervals of a
+/// `search::Builder`). Consecutive segments share a vertex, so both
+/// intervals hold its (non-empty) widened key, and the union of the intervals of a
 /// run of consecutive segments is one interval: the hull of the widened
 /// keys of the run's vertices (by induction along the run). So the vertex
 /// folds exactly when its widened key meets the hull of vertices `0 ..= i

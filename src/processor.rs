@@ -756,6 +756,27 @@ impl LeanWalk<'_> {
             *r = PointResult::flagged(p1, Status::AtFoe);
             return hint;
         };
+        // When no aside entry has a part in the wedge, offered in their
+        // places they would change nothing: the run is walked without
+        // them, their units paid first. (Not on a loose index: there the
+        // test measured dearer than the merge.)
+        if !SKIP {
+            if let Some(units) = aside_idle(&wedge, self.b2, self.aside) {
+                let (outcome, a) = match work.spend(units) {
+                    Ok(()) => wedge_run(
+                        &wedge,
+                        (self.segs, self.b2),
+                        hint,
+                        self.segments,
+                        self.cot_twice,
+                        work,
+                    ),
+                    Err(OutOfWork) => (Outcome::Flag(Status::OverBudget), hint),
+                };
+                *r = conclude_wedge(self.pair, p1, iz, r1, &wedge, outcome);
+                return a;
+            }
+        }
         let (outcome, a) = wedge_run_aside::<SKIP>(
             &wedge,
             (self.segs, self.b2, self.aside),
@@ -1091,6 +1112,40 @@ fn offer(
     };
     (*cached, *va) = (k + 1, vb);
     r
+}
+
+/// Whether no aside entry has a part in the wedge, tested as [`offer`]
+/// tests each (an interval that misses the wedge's keys, an end beyond
+/// the polyline, [`Wedge::before`], then [`Wedge::part`]); if so, the
+/// units offering them all would cost (one each, [`CLIP_UNITS`] more for
+/// each whose interval meets the keys).
+#[inline(always)]
+fn aside_idle(wedge: &Wedge, b2: &[Pixel], aside: &[crate::search::Aside]) -> Option<u32> {
+    let mut units = 0u32;
+    // The vertex that starts segment `cached`, when it is `va`.
+    let mut cached = usize::MAX;
+    let mut va = WVertex::NONE;
+    for &(k, l, h) in aside {
+        units = units.saturating_add(1);
+        // (A NaN fails.)
+        if !(l <= wedge.kh && h >= wedge.kl) {
+            continue;
+        }
+        units = units.saturating_add(CLIP_UNITS);
+        let k = usize::from(k);
+        let (Some(v0), Some(v1)) = (b2.get(k), b2.get(k + 1)) else {
+            continue;
+        };
+        if cached != k {
+            va = wedge.vertex(v0.arr());
+        }
+        let vb = wedge.vertex(v1.arr());
+        if !wedge.before(&va, &vb) && wedge.part(&va, &vb).is_some() {
+            return None;
+        }
+        (cached, va) = (k + 1, vb);
+    }
+    Some(units)
 }
 
 /// The point's result from a wedge walk's outcome: depth and stick

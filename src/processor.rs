@@ -17,10 +17,13 @@
 //!    pseudo-angle keys) is the polyline indexed and queried.
 //! 3. **Index** the corresponding frame-2 polyline (`crate::search`).
 //! 4. **Match** every remaining point: its error band ([`crate::depth`]),
-//!    or in the usual case the wedge that holds it (`crate::wedge`),
-//!    the segments the index offers for its key interval (the wedge path
-//!    walks the index's runs itself, skipping blocks on a loose index), the
-//!    walk over them (`crate::matching`), and the depth and stick.
+//!    or, moving forwards without a translation error, the wedge that
+//!    holds it (`crate::wedge`; half-plane keys, or pseudo-angle keys
+//!    when the wedge's interval has a single copy in the index's
+//!    unwrapped keys), the segments the index offers for its key interval
+//!    (the wedge path walks the index's runs itself, skipping blocks on a
+//!    loose index), the walk over them (`crate::matching`), and the depth
+//!    and stick.
 //!
 //! Memory is fixed at compile time: a `Processor<N, B>` holds the previous
 //! frame (`B` boundaries of up to `N` points), one search index and the
@@ -572,20 +575,28 @@ fn match_boundary<const N: usize>(
     matcher: Matcher,
 ) {
     let mut credit = *work;
-    if let (Pencil::Half { foe, side, .. }, true) = (
-        keying.pencil,
-        pair.geom.w() > 0.0 && pair.translation <= 0.0,
-    ) {
-        // (Half-plane keys have no period: the index always gives its lean
-        // view.)
-        match matcher {
-            Matcher::Indexed => {
-                match_wedge_lean(pair, keying, (foe, side), slots, b2, index, &mut credit)
+    let wedge = pair.geom.w() > 0.0 && pair.translation <= 0.0;
+    match (keying.pencil, wedge) {
+        (Pencil::Half { foe, side, .. }, true) => {
+            match matcher {
+                Matcher::Indexed => {
+                    match_wedge_lean(pair, keying, (foe, side), slots, b2, index, &mut credit)
+                }
+                Matcher::Reference => match_wedge_reference(pair, keying, (foe, side), slots, b2),
             }
-            Matcher::Reference => match_wedge_reference(pair, keying, (foe, side), slots, b2),
+            *work = credit;
+            return;
         }
-        *work = credit;
-        return;
+        (Pencil::Angular { foe }, true) => {
+            let args = (pair, keying, near_foe, foe);
+            match matcher {
+                Matcher::Indexed => match_wedge_angular(args, slots, b2, index, &mut credit),
+                Matcher::Reference => match_wedge_angular_reference(args, slots, b2, index),
+            }
+            *work = credit;
+            return;
+        }
+        _ => {}
     }
     for r in slots.iter_mut() {
         if r.status == Status::NoIntersection {
@@ -598,11 +609,7 @@ fn match_boundary<const N: usize>(
 /// The wedge path through an index's lean view ([`Index::lean`]): every
 /// point's run walked in locals ([`LeanWalk::point`]); the aside entries,
 /// if any, merged in by index ([`LeanWalk::point_aside`]), and on a loose
-/// index the block tree's skips taken too ([`LeanWalk::point_loose`]). An
-/// index without a lean view (keys with a period: unreachable for the
-/// half-plane keys of this path) leaves every point unmatched, flagged
-/// [`Status::NoIntersection`] ([`unmatched`]), not silently as step 1
-/// left it.
+/// index the block tree's skips taken too ([`LeanWalk::point_loose`]).
 #[inline(never)]
 fn match_wedge_lean<const N: usize>(
     pair: &Pair,
@@ -614,16 +621,13 @@ fn match_wedge_lean<const N: usize>(
     work: &mut Work,
 ) {
     let mut hint = index.hint();
-    let Some(Lean {
+    let Lean {
         segs,
         orient,
         aside,
         blocks,
-    }) = index.lean()
-    else {
-        unmatched(slots);
-        return;
-    };
+        ..
+    } = index.lean();
     let walk = LeanWalk {
         pair,
         segs,
@@ -660,6 +664,96 @@ fn match_wedge_lean<const N: usize>(
         }
     }
     index.set_hint(hint);
+}
+
+/// The wedge path for pseudo-angle keys ([`Pencil::Angular`]: a frame-2
+/// boundary that comes close to the FOE's row, or crosses it). Each
+/// point's wedge gets its pseudo-angle interval ([`Wedge::new_angular`]),
+/// and the index the one copy of it to walk ([`Lean::copy`]: the keys are
+/// unwrapped along the polyline, a ray's key is known up to turns); the
+/// copy's run is walked as a loose index's, with the aside entries merged
+/// in ([`wedge_run_aside`]). A point whose wedge has no single copy (the
+/// boundary winds round the FOE, or the point has no key) takes the band
+/// path ([`match_point`]), as every point of these boundaries did before.
+#[inline(never)]
+fn match_wedge_angular<const N: usize>(
+    (pair, keying, near_foe, foe): (&Pair, &Keying, f32, [f32; 2]),
+    slots: &mut [PointResult],
+    b2: &[Pixel],
+    index: &mut Index<N>,
+    work: &mut Work,
+) {
+    let (e2, e2_csc, cot_twice) = (pair.e2(), pair.e2_csc(), pair.config.cot_twice);
+    let segments = b2.len().saturating_sub(1);
+    for r in slots.iter_mut() {
+        if r.status != Status::NoIntersection {
+            continue;
+        }
+        let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
+        let lean = index.lean();
+        let keys = (key, keying.key_scale, lean.orient);
+        let Ok(mut wedge) = Wedge::new_angular(p, foe, (r1, e2, e2_csc), keys) else {
+            *r = PointResult::flagged(p1, Status::AtFoe);
+            continue;
+        };
+        let Some((kl, kh)) = lean.copy(wedge.kl, wedge.kh) else {
+            *r = match_point(pair, keying, near_foe, r, b2, index, work, Matcher::Indexed);
+            continue;
+        };
+        (wedge.kl, wedge.kh) = (kl, kh);
+        let (outcome, a) = wedge_run_aside::<true>(
+            &wedge,
+            (lean.segs, b2, lean.aside),
+            (index.hint(), lean.blocks),
+            (segments, cot_twice),
+            work,
+        );
+        index.set_hint(a);
+        *r = conclude_wedge(pair, p1, iz, r1, &wedge, outcome);
+    }
+}
+
+/// [`match_wedge_angular`]'s reference: the same wedges and copies, every
+/// segment offered to the walk in order with the interval the index holds
+/// for it ([`Index::interval`]; the unwrapped keys' rounding depends on
+/// the turns added, so a raw interval could differ from the index's in
+/// the last bit): the run search is checked, the keys are the index's.
+/// The points without a single copy take the band path's reference.
+#[cfg_attr(not(any(test, feature = "_reference")), allow(dead_code))]
+#[inline(never)]
+fn match_wedge_angular_reference<const N: usize>(
+    (pair, keying, near_foe, foe): (&Pair, &Keying, f32, [f32; 2]),
+    slots: &mut [PointResult],
+    b2: &[Pixel],
+    index: &mut Index<N>,
+) {
+    let (e2, e2_csc, cot_twice) = (pair.e2(), pair.e2_csc(), pair.config.cot_twice);
+    let segments = b2.len().saturating_sub(1);
+    let mut work = Work::new();
+    for r in slots.iter_mut() {
+        if r.status != Status::NoIntersection {
+            continue;
+        }
+        let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
+        let lean = index.lean();
+        let keys = (key, keying.key_scale, lean.orient);
+        let Ok(mut wedge) = Wedge::new_angular(p, foe, (r1, e2, e2_csc), keys) else {
+            *r = PointResult::flagged(p1, Status::AtFoe);
+            continue;
+        };
+        let Some((kl, kh)) = lean.copy(wedge.kl, wedge.kh) else {
+            *r = match_point(pair, keying, near_foe, r, b2, index, &mut work, Matcher::Reference);
+            continue;
+        };
+        (wedge.kl, wedge.kh) = (kl, kh);
+        let mut walker = WedgeWalker::new(wedge, b2, cot_twice);
+        for j in 0..segments {
+            if Visitor::segment(&mut walker, j, index.interval(j)).0 == Flow::Stop {
+                break;
+            }
+        }
+        *r = conclude_wedge(pair, p1, iz, r1, &wedge, walker.outcome());
+    }
 }
 
 /// Every point still to be matched flagged [`Status::NoIntersection`] (a
@@ -1411,9 +1505,7 @@ mod tests {
         let mut builder = index.builder((0.0, 1.0), Unkeyed::MeetAll);
         builder.push_all(b2.iter().map(key));
         builder.finish(None);
-        let Some(lean) = index.lean() else {
-            unreachable!("half-plane keys have no period");
-        };
+        let lean = index.lean();
         assert_eq!(
             lean.aside.len(),
             crate::search::MAX_ASIDE,

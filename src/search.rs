@@ -69,6 +69,16 @@ pub(crate) const MAX_NEAR: usize = 8;
 const PROBES: u32 = 6;
 /// At most this many copies of a periodic key are searched one by one.
 pub(crate) const MAX_COPIES: usize = 3;
+/// How far from 0 an unwrapped pseudo-angle key may lie for a walk of
+/// its copy ([`Lean::copy`]): a key in `[0, 4)` is computed to within a
+/// quarter of its margin `2⁻²⁰ (S/D + 4)` ([`crate::pencil`]), and adding
+/// turns rounds it by at most `2⁻²⁴ |k|` more, which the rest of the
+/// margin covers while `|k| ≤ 12 (S/D + 4)`, at least 48 (`S/D ≥ 0`).
+/// (A backstop: the unwrapped keys start in `(0, 8)`, and a boundary
+/// (monotone in `v`, [`crate::Frame::push_boundary`]) turns less than once
+/// round the FOE, so its keys span less than 4 and a copy that meets them
+/// lies within `(−5, 13)`.)
+const COPY_REACH: f32 = 32.0;
 /// The fan-out of the block tree, `2^FAN_BITS`.
 const FAN_BITS: u32 = 3;
 const FAN: usize = 1 << FAN_BITS;
@@ -169,6 +179,35 @@ pub(crate) struct Lean<'a> {
     pub(crate) orient: f32,
     pub(crate) aside: &'a [Aside],
     pub(crate) blocks: Blocks<'a>,
+    /// The keys' period (0: none) and range `[kmin, kmax]` ([`copies_in`]).
+    period: f32,
+    range: (f32, f32),
+}
+
+impl Lean<'_> {
+    /// The one copy of the oriented query `[ql, qh]` to walk
+    /// ([`copies_in`]): for keys without a period the query itself; for
+    /// periodic keys the copy `[ql + 4m, qh + 4m]` that can meet the keys'
+    /// range, or, when none can, `(−∞, −∞)` (it meets only intervals that
+    /// reach `−∞`, those of segments with an unkeyed end, and a walk's
+    /// low-end tests end the run at once); `None` when two or more can.
+    #[inline(always)]
+    pub(crate) fn copy(&self, ql: f32, qh: f32) -> Option<(f32, f32)> {
+        if self.period <= 0.0 {
+            return Some((ql, qh));
+        }
+        let mut c = [(0.0f32, 0.0f32); MAX_COPIES];
+        match copies_in((self.period, self.range), ql, qh, &mut c) {
+            Some(0) => Some((f32::NEG_INFINITY, f32::NEG_INFINITY)),
+            // Within a few turns of the first key, where the unwrapped
+            // keys' rounding stays inside their margins ([`COPY_REACH`]).
+            Some(1) => c
+                .first()
+                .copied()
+                .filter(|&(l, h)| l >= -COPY_REACH && h <= COPY_REACH),
+            _ => None,
+        }
+    }
 }
 
 /// A loose index's block tree (module docs): the `(min lo, max hi)` of
@@ -676,19 +715,36 @@ impl<const N: usize> Index<N> {
         Ok(met.0)
     }
 
-    /// For an index without a period: its segments, orientation, aside
-    /// list and block tree, for a caller that walks the run itself and
-    /// merges the aside entries into it by index ([`run_start_in`], then
-    /// `sm`, `lo`, `hi` as [`Self::visit`] does, and, on a loose index, the
-    /// tree's skips at aligned positions); `None` otherwise.
+    /// Its segments, orientation, aside list and block tree, for a caller
+    /// that walks the run itself and merges the aside entries into it by
+    /// index ([`run_start_in`], then `sm`, `lo`, `hi` as [`Self::visit`]
+    /// does, and, on a loose index, the tree's skips at aligned
+    /// positions); for periodic keys, with the copy of a query to walk
+    /// ([`Lean::copy`]).
     #[inline(always)]
-    pub(crate) fn lean(&self) -> Option<Lean<'_>> {
-        (self.period <= 0.0).then(|| Lean {
+    pub(crate) fn lean(&self) -> Lean<'_> {
+        Lean {
             segs: self.seg.get(..self.segments.min(N)).unwrap_or(&[]),
             orient: self.orient,
             aside: self.aside.as_slice(),
             blocks: self.blocks(),
-        })
+            period: self.period,
+            range: (self.kmin, self.kmax),
+        }
+    }
+
+    /// Segment `j`'s interval as the index holds it (oriented, unwrapped;
+    /// an aside entry's own), for the reference matcher of periodic keys:
+    /// the empty `(∞, −∞)` past the segments.
+    #[cfg_attr(not(any(test, feature = "_reference")), allow(dead_code))]
+    pub(crate) fn interval(&self, j: usize) -> (f32, f32) {
+        if let Some(&(_, l, h)) = self.aside.iter().find(|e| usize::from(e.0) == j) {
+            return (l, h);
+        }
+        self.seg
+            .get(j)
+            .filter(|_| j < self.segments)
+            .map_or((f32::INFINITY, f32::NEG_INFINITY), |g| (g.lo, g.hi))
     }
 
     /// Where the last run started (the next query's probes start there).
@@ -1057,35 +1113,7 @@ impl<const N: usize> Index<N> {
     /// itself, if it can), into `out`; `None` when there are more than
     /// [`MAX_COPIES`].
     fn copies(&self, ql: f32, qh: f32, out: &mut [(f32, f32); MAX_COPIES]) -> Option<usize> {
-        if self.period <= 0.0 {
-            if let Some(o) = out.first_mut() {
-                *o = (ql, qh);
-            }
-            return Some(usize::from(ql <= self.kmax && qh >= self.kmin));
-        }
-        if !(self.kmin <= self.kmax) {
-            return Some(0);
-        }
-        // The smallest m with qh + 4m ≥ kmin. Keys change by less than half
-        // a turn per segment, so |kmin|, |kmax| ≤ 2N + 4 and the quotient
-        // is small; it is clamped anyway before the (saturating) conversion.
-        let m0 = ((self.kmin - qh) * 0.25).clamp(-1.0e7, 1.0e7);
-        let mut m = m0 as i32;
-        if (m as f32) < m0 {
-            m = m.saturating_add(1);
-        }
-        let mut c = 0usize;
-        for slot in out.iter_mut() {
-            let shift = 4.0 * m as f32;
-            if ql + shift > self.kmax {
-                return Some(c);
-            }
-            *slot = (ql + shift, qh + shift);
-            c += 1;
-            m = m.saturating_add(1);
-        }
-        // All slots used: a further copy would overflow.
-        (ql + 4.0 * m as f32 > self.kmax).then_some(c)
+        copies_in((self.period, (self.kmin, self.kmax)), ql, qh, out)
     }
 
     /// The first segment `a` with `pm[a] ≥ t` ([`run_start_in`] from the
@@ -1095,6 +1123,47 @@ impl<const N: usize> Index<N> {
         let n = self.segments.min(N);
         run_start_in(self.seg.get(..n).unwrap_or(&[]), self.hint, t, work)
     }
+}
+
+/// The copies `[ql + 4m, qh + 4m]` of an oriented query that can meet
+/// the keys' range `[kmin, kmax]` of an index with keys of `period` (for
+/// non-periodic keys the query itself, if it can), into `out`; `None` when
+/// there are more than [`MAX_COPIES`].
+fn copies_in(
+    (period, (kmin, kmax)): (f32, (f32, f32)),
+    ql: f32,
+    qh: f32,
+    out: &mut [(f32, f32); MAX_COPIES],
+) -> Option<usize> {
+    if period <= 0.0 {
+        if let Some(o) = out.first_mut() {
+            *o = (ql, qh);
+        }
+        return Some(usize::from(ql <= kmax && qh >= kmin));
+    }
+    if !(kmin <= kmax) {
+        return Some(0);
+    }
+    // The smallest m with qh + 4m ≥ kmin. Keys change by less than half
+    // a turn per segment, so |kmin|, |kmax| ≤ 2N + 4 and the quotient
+    // is small; it is clamped anyway before the (saturating) conversion.
+    let m0 = ((kmin - qh) * 0.25).clamp(-1.0e7, 1.0e7);
+    let mut m = m0 as i32;
+    if (m as f32) < m0 {
+        m = m.saturating_add(1);
+    }
+    let mut c = 0usize;
+    for slot in out.iter_mut() {
+        let shift = 4.0 * m as f32;
+        if ql + shift > kmax {
+            return Some(c);
+        }
+        *slot = (ql + shift, qh + shift);
+        c += 1;
+        m = m.saturating_add(1);
+    }
+    // All slots used: a further copy would overflow.
+    (ql + 4.0 * m as f32 > kmax).then_some(c)
 }
 
 /// The first segment `a` of `seg` with `pm[a] ≥ t`: probes from `hint`,
@@ -1686,5 +1755,44 @@ pub(crate) mod tests {
                 );
             }
         }
+    }
+
+    /// [`Lean::copy`] on pseudo-angle keys: the one copy of a query that can
+    /// meet the keys' range, the query that meets none (`(−∞, −∞)`), none
+    /// when two copies can (the keys span nearly a turn, or many turns);
+    /// and the query itself without a period.
+    #[test]
+    fn lean_copy_picks_the_single_copy() {
+        let mut index = Index::<16>::new();
+        let mut b = index.builder((4.0, 1.0), Unkeyed::MeetAll);
+        b.push_all([0.5f32, 1.5, 2.5, 3.5, 3.9].iter().map(|&k| (k, 0.0)));
+        b.finish(None);
+        let lean = index.lean();
+        let none = Some((f32::NEG_INFINITY, f32::NEG_INFINITY));
+        // (The unwrapped keys start at some whole number of turns.)
+        let o = lean.range.0 - 0.5;
+        assert_eq!(lean.range, (0.5 + o, 3.9 + o));
+        assert_eq!(lean.copy(1.0, 1.2), Some((1.0 + o, 1.2 + o)));
+        assert_eq!(lean.copy(5.0, 5.2), Some((1.0 + o, 1.2 + o)));
+        assert_eq!(lean.copy(-3.0, -2.8), Some((1.0 + o, 1.2 + o)));
+        assert_eq!(lean.copy(0.1, 0.3), none);
+        assert_eq!(lean.copy(4.1, 4.3), none);
+        // [-0.2, 0.6] and [3.8, 4.6] both meet [0.5, 3.9].
+        assert_eq!(lean.copy(-0.2, 0.6), None);
+        let mut wound = Index::<64>::new();
+        let mut b = wound.builder((4.0, 1.0), Unkeyed::MeetAll);
+        // Nine turns at 1.5 a step: a query meets many copies; and past
+        // COPY_REACH, one.
+        b.push_all((0..26).map(|i| ((1.5 * i as f32) % 4.0, 0.0)));
+        b.finish(None);
+        let lean = wound.lean();
+        assert!(lean.range.1 - lean.range.0 > 36.0, "{:?}", lean.range);
+        assert_eq!(lean.copy(1.0, 1.1), None, "many copies");
+        // Without a period: the query itself.
+        let mut flat = Index::<16>::new();
+        let mut b = flat.builder((0.0, 1.0), Unkeyed::MeetAll);
+        b.push_all([0.1f32, 0.2, 0.3].iter().map(|&k| (k, 0.0)));
+        b.finish(None);
+        assert_eq!(flat.lean().copy(5.0, 6.0), Some((5.0, 6.0)));
     }
 }

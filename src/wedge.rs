@@ -1,8 +1,11 @@
-//! The usual case of the matching stage: forward motion (`W' > 0`), no
-//! translation error, and a frame-2 boundary on one side of the FOE's row
-//! (half-plane keys, [`crate::pencil`]). Here the error band of
-//! [`crate::depth`] is replaced by a slightly larger region whose test is
-//! mostly a comparison of keys the index already holds: the **wedge**.
+//! The usual case of the matching stage: forward motion (`W' > 0`) and no
+//! translation error, with a frame-2 boundary on one side of the FOE's
+//! row (half-plane keys, [`crate::pencil`]) or near it (pseudo-angle keys,
+//! [`Wedge::new_angular`]: the same wedge, its key interval found in the
+//! index's unwrapped keys, [`crate::search::Lean::copy`]). Here the error
+//! band of [`crate::depth`] is replaced by a slightly larger region whose
+//! test is mostly a comparison of keys the index already holds: the
+//! **wedge**.
 //!
 //! # The wedge holds the band
 //! With the notation of [`crate::depth`] and no translation error, the band
@@ -164,6 +167,66 @@ impl Wedge {
         (r1, e2, e2_csc): (f32, f32, f32),
         (key, key_scale, orient): (f32, f32, f32),
     ) -> Result<Self, AtFoe> {
+        let (mut w, y_up) = Self::frame(p, foe, (r1, e2, e2_csc))?;
+        let (d, t) = (w.d, w.t);
+        let k = orient * key;
+        // (A NaN fails.)
+        (w.kl, w.kh) = if t <= 0.125 && k.is_finite() {
+            // The keys of the rays within atan T of d's, from d's own
+            // (module docs): `m` bounds its margin (D ≥ ρ₁), `S(k) + 2m`
+            // the keys' rate of change at d, and `δ` the change over the
+            // wedge.
+            let m = key_scale * y_up + ULP20;
+            let ka = k.abs();
+            let rate = 1.0 + ka * (2.0 * ka - 2.0) + 2.0 * m;
+            let delta = t * rate * (1.0 + t * (2.0 + 6.0 * t)) * (1.0 + 1.53e-5) + m;
+            (k - delta, k + delta)
+        } else {
+            exact_keys(d, t, side, key_scale, orient)
+        };
+        Ok(w)
+    }
+
+    /// [`Self::new`] for pseudo-angle keys ([`crate::pencil`], `key` the
+    /// point's raw one, in `[0, 4)`, or [`crate::pencil::NO_KEY`]): the
+    /// interval `k ± δ` of the oriented key `k`, `δ = T + m` rounded up,
+    /// with `m = 2⁻²⁰ (S/ρ₁ + 4)` bounding the key's margin (its `D =
+    /// |d_u| + |d_v| ≥ ρ₁`) and `T ≥ θ` the wedge's half-angle: a
+    /// pseudo-angle changes by at most one unit per radian. Not yet
+    /// unwrapped: the index gives the copy to walk ([`crate::search::Lean::copy`]);
+    /// a segment (less than half a turn about the FOE) has the rays whose
+    /// keys lie between its ends' unwrapped keys, so the filter of the
+    /// module docs holds on the unwrapped keys.
+    /// A point without a key gets `(−∞, ∞)` (no copy is single: the caller
+    /// takes the band path).
+    #[inline(always)]
+    pub(crate) fn new_angular(
+        p: [f32; 2],
+        foe: [f32; 2],
+        (r1, e2, e2_csc): (f32, f32, f32),
+        (key, key_scale, orient): (f32, f32, f32),
+    ) -> Result<Self, AtFoe> {
+        let (mut w, y_up) = Self::frame(p, foe, (r1, e2, e2_csc))?;
+        let k = orient * key;
+        // (A NaN fails.)
+        (w.kl, w.kh) = if k.is_finite() {
+            let m = key_scale * y_up + 4.0 * ULP20;
+            let delta = (w.t + m) * (1.0 + 1.53e-5) + ULP20;
+            (k - delta, k + delta)
+        } else {
+            (f32::NEG_INFINITY, f32::INFINITY)
+        };
+        Ok(w)
+    }
+
+    /// The wedge's geometry without its keys (`kl = kh = 0`), and `y₊ ≥
+    /// 1/ρ₁`: [`Self::new`] and [`Self::new_angular`] add the keys.
+    #[inline(always)]
+    fn frame(
+        p: [f32; 2],
+        foe: [f32; 2],
+        (r1, e2, e2_csc): (f32, f32, f32),
+    ) -> Result<(Self, f32), AtFoe> {
         let d = sub(p, foe);
         let re = r1 + e2;
         let r2 = dot(d, d);
@@ -179,36 +242,24 @@ impl Wedge {
         // most 1.5 x⁴ there), x itself from above.
         let x = re * y_up;
         let t = x * (1.0 + x * (1.0 + x * (1.0 + 2.0 * x))) * (1.0 + 1.53e-5);
-        let k = orient * key;
-        // (A NaN fails.)
-        let (kl, kh) = if t <= 0.125 && k.is_finite() {
-            // The keys of the rays within atan T of d's, from d's own
-            // (module docs): `m` bounds its margin (D ≥ ρ₁), `S(k) + 2m`
-            // the keys' rate of change at d, and `δ` the change over the
-            // wedge.
-            let m = key_scale * y_up + ULP20;
-            let ka = k.abs();
-            let rate = 1.0 + ka * (2.0 * ka - 2.0) + 2.0 * m;
-            let delta = t * rate * (1.0 + t * (2.0 + 6.0 * t)) * (1.0 + 1.53e-5) + m;
-            (k - delta, k + delta)
-        } else {
-            exact_keys(d, t, side, key_scale, orient)
-        };
         let rho_re = rho * re;
-        Ok(Self {
-            foe,
-            p,
-            d,
-            r2,
-            inv_r2: y * y,
-            rho,
-            rho_re,
-            t,
-            kl,
-            kh,
-            x_min: r2 - rho_re,
-            g0: rho * e2_csc,
-        })
+        Ok((
+            Self {
+                foe,
+                p,
+                d,
+                r2,
+                inv_r2: y * y,
+                rho,
+                rho_re,
+                t,
+                kl: 0.0,
+                kh: 0.0,
+                x_min: r2 - rho_re,
+                g0: rho * e2_csc,
+            },
+            y_up,
+        ))
     }
 
     /// A vertex in the wedge's frame: `w = v − F`, `X = d·w`, `Y = d × w`
@@ -706,6 +757,87 @@ mod tests {
                 let c = b.vertex(q);
                 assert!(Band::contains(&c), "case {case}: q outside the band");
             }
+            inside += 1;
+        }
+        assert!(inside > 5_000, "{inside}");
+    }
+
+    /// [`wedge_holds_every_band_point`] for pseudo-angle keys
+    /// ([`Wedge::new_angular`]): every band point's key, with its margin,
+    /// meets a copy (a multiple of 4 away) of the wedge's interval, and
+    /// the walk takes it as a piece. The FOE anywhere near the image, the
+    /// point and the polyline point on either side of its row.
+    #[test]
+    fn angular_wedge_holds_every_band_point() {
+        use crate::pencil::{Keying, Pencil};
+        let mut rng = Rng(0x5a1e_77c3);
+        let mut inside = 0;
+        let key_scale = 9.536_743e-7 * 1024.0;
+        for case in 0..40_000 {
+            let w = 0.05 + rng.next();
+            let foe = [512.0 * rng.next(), 480.0 * rng.next()];
+            let c2 = [255.5f32, 239.5];
+            let g = [w * (foe[0] - c2[0]), w * (foe[1] - c2[1])];
+            let p = [512.0 * rng.next(), 480.0 * rng.next()];
+            let (r1, e2) = (0.05 + rng.next(), 0.05 + rng.next());
+            let ang = rng.next() * core::f32::consts::TAU;
+            let rad = f64::from(r1) * f64::from(rng.next());
+            let pt = [
+                f64::from(p[0]) + rad * f64::from(libm::cosf(ang)),
+                f64::from(p[1]) + rad * f64::from(libm::sinf(ang)),
+            ];
+            let wf = f64::from(w);
+            let at = [
+                wf * (pt[0] - f64::from(c2[0])) - f64::from(g[0]),
+                wf * (pt[1] - f64::from(c2[1])) - f64::from(g[1]),
+            ];
+            let s = wf + 0.01 + 60.0 * f64::from(rng.next()) * f64::from(rng.next());
+            let tau = 1.0 / (s - wf);
+            let p2 = [pt[0] + tau * at[0], pt[1] + tau * at[1]];
+            let ang2 = rng.next() * core::f32::consts::TAU;
+            let rad2 = f64::from(e2) * f64::from(rng.next());
+            let q = [
+                (p2[0] + rad2 * f64::from(libm::cosf(ang2))) as f32,
+                (p2[1] + rad2 * f64::from(libm::sinf(ang2))) as f32,
+            ];
+            if !(q[0].abs() < 3000.0 && q[1].abs() < 3000.0) {
+                continue;
+            }
+            let keying = Keying {
+                pencil: Pencil::Angular { foe },
+                eps: 0.0,
+                key_scale,
+                period: 4.0,
+            };
+            let (kq, mq) = keying.key(q);
+            if !kq.is_finite() {
+                continue;
+            }
+            let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+            let key = keying.key(p).0;
+            let Ok(wedge) =
+                Wedge::new_angular(p, foe, (r1, e2, e2 * 11.52), (key, key_scale, orient))
+            else {
+                continue;
+            };
+            // The copy of q's oriented key nearest the wedge's.
+            let k = orient * kq;
+            let mid = 0.5 * (wedge.kl + wedge.kh);
+            let shift = 4.0 * libm::roundf((k - mid) * 0.25);
+            let (lo, hi) = (k - mq - shift, k + mq - shift);
+            assert!(
+                hi >= wedge.kl && lo <= wedge.kh,
+                "case {case}: key {k} ± {mq} (copy {lo}..{hi}) outside [{}, {}]",
+                wedge.kl,
+                wedge.kh
+            );
+            let v = wedge.vertex(q);
+            let mut walk = WedgeWalk::NEW;
+            let r = walk.take(&wedge, 5, (&v, &v), (lo, hi), 10, 11.34);
+            assert!(
+                walk.next == 6 || r == Err(Status::Grazing),
+                "case {case}: q {q:?} not in the wedge of {p:?} (foe {foe:?})"
+            );
             inside += 1;
         }
         assert!(inside > 5_000, "{inside}");

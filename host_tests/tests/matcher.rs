@@ -152,3 +152,77 @@ fn indexed_search_equals_reference_on_embedded_data() {
     }
     assert!(pairs >= 60, "{pairs}");
 }
+
+/// The wedge path for pseudo-angle keys (a frame-2 boundary near or across
+/// the FOE's row) against its reference, on boundaries built for it: a
+/// steep line across the FOE's row, a curve round the FOE's left side, and
+/// a hairpin round it (in along the row above it, down, and out below it:
+/// its keys span nearly a turn, so wedges near the row have two copies in
+/// the unwrapped keys and take the band path), each exact and rounded to
+/// the pixel grid, frame 2 the frame-1 boundary seen from 0.4 closer (a
+/// constant depth, so every point has its correspondent). (Counted when
+/// written: every point of the line and the curve walked a wedge, and one
+/// of the exact hairpin's took the band path.)
+#[test]
+fn angular_wedge_equals_reference_near_and_round_the_foe() {
+    use roadstereo::{Camera, Motion, Pixel};
+    let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).expect("camera");
+    let m = Motion::new([0.0, 0.0, 0.4], [0.0, 0.0, 0.0]).expect("motion");
+    let foe = [255.5f64, 239.5f64];
+    // Depth 6: frame 2 sees every point 6/5.6 times as far from the FOE.
+    let s = 6.0 / 5.6;
+    let line: Vec<[f64; 2]> = (0..360)
+        .map(|i| [100.0 + 0.3 * (i as f64 - 180.0), 60.0 + i as f64])
+        .collect();
+    let curve: Vec<[f64; 2]> = (0..300)
+        .map(|i| {
+            let a = -1.4 + 2.8 * i as f64 / 299.0;
+            [foe[0] - 150.0 * a.cos(), foe[1] + 150.0 * a.sin()]
+        })
+        .collect();
+    // (Within 1.6 px of the FOE's row over the legs, as a v-monotone
+    // curve must be to turn nearly once round the FOE.)
+    let mut hairpin: Vec<[f64; 2]> = (0..120)
+        .map(|i| [470.0 - 3.9 * i as f64, foe[1] - 1.6 + 0.003 * i as f64])
+        .collect();
+    hairpin.extend((1..60).map(|i| [6.0 + 0.1 * i as f64, foe[1] - 1.24 + 0.04 * i as f64]));
+    hairpin.extend((0..120).map(|i| [12.0 + 3.9 * i as f64, foe[1] + 1.24 + 0.003 * i as f64]));
+    let inside = |p: &Pixel| p.u >= 0.0 && p.u <= 511.0 && p.v >= 0.0 && p.v <= 479.0;
+    let mut oks = 0;
+    for (name, b) in [("line", &line), ("curve", &curve), ("hairpin", &hairpin)] {
+        for quantised in [false, true] {
+            let px = |q: [f64; 2]| {
+                let q = if quantised { [q[0].round(), q[1].round()] } else { q };
+                Pixel::new(q[0] as f32, q[1] as f32)
+            };
+            let mut b1: Vec<Pixel> = b.iter().map(|&q| px(q)).filter(inside).collect();
+            let mut b2: Vec<Pixel> = b
+                .iter()
+                .map(|&q| px([foe[0] + s * (q[0] - foe[0]), foe[1] + s * (q[1] - foe[1])]))
+                .filter(inside)
+                .collect();
+            // Rounding may repeat a row: keep the first point of each.
+            b1.dedup_by(|a, b| a.v <= b.v);
+            b2.dedup_by(|a, b| a.v <= b.v);
+            let (f1, f2) = (frame(cam, &[b1]), frame(cam, &[b2]));
+            let unlimited = Config::DEFAULT
+                .with_work_budget(Config::MAX_WORK_PER_POINT)
+                .expect("valid");
+            let mut p = Box::new(Processor::<N, B>::new(unlimited));
+            assert!(matches!(p.process(&f1, None), Ok(Step::First)));
+            let fast = p.process_against_kept(&f2, &m).expect("structure").clone();
+            let slow = p
+                .reference_against_kept(&f2, &m)
+                .expect("structure")
+                .clone();
+            if let Some((k, i, a, b)) = first_difference(&fast, &slow) {
+                panic!("{name} (quantised: {quantised}): boundary {k} point {i}: indexed {a:?}, reference {b:?}");
+            }
+            let pts = fast.boundaries()[0].points();
+            let ok = pts.iter().filter(|r| r.status() == Status::Ok).count();
+            println!("{name} (quantised: {quantised}): {ok} of {} ok", pts.len());
+            oks += ok;
+        }
+    }
+    assert!(oks > 100, "the wedges matched {oks} points");
+}

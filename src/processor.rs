@@ -742,7 +742,16 @@ fn match_wedge_angular_reference<const N: usize>(
             continue;
         };
         let Some((kl, kh)) = lean.copy(wedge.kl, wedge.kh) else {
-            *r = match_point(pair, keying, near_foe, r, b2, index, &mut work, Matcher::Reference);
+            *r = match_point(
+                pair,
+                keying,
+                near_foe,
+                r,
+                b2,
+                index,
+                &mut work,
+                Matcher::Reference,
+            );
             continue;
         };
         (wedge.kl, wedge.kh) = (kl, kh);

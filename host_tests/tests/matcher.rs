@@ -192,7 +192,11 @@ fn angular_wedge_equals_reference_near_and_round_the_foe() {
     for (name, b) in [("line", &line), ("curve", &curve), ("hairpin", &hairpin)] {
         for quantised in [false, true] {
             let px = |q: [f64; 2]| {
-                let q = if quantised { [q[0].round(), q[1].round()] } else { q };
+                let q = if quantised {
+                    [q[0].round(), q[1].round()]
+                } else {
+                    q
+                };
                 Pixel::new(q[0] as f32, q[1] as f32)
             };
             let mut b1: Vec<Pixel> = b.iter().map(|&q| px(q)).filter(inside).collect();

@@ -697,7 +697,7 @@ fn match_wedge_angular<const N: usize>(
             continue;
         };
         let Some((kl, kh)) = lean.copy(wedge.kl, wedge.kh) else {
-            *r = match_point(pair, keying, near_foe, r, b2, index, work, Matcher::Indexed);
+            *r = band_point((pair, keying, near_foe), r, b2, index, work);
             continue;
         };
         (wedge.kl, wedge.kh) = (kl, kh);
@@ -711,6 +711,20 @@ fn match_wedge_angular<const N: usize>(
         index.set_hint(a);
         *r = conclude_wedge(pair, p1, iz, r1, &wedge, outcome);
     }
+}
+
+/// [`match_point`] for a point of [`match_wedge_angular`] whose wedge has
+/// no single copy (rare: out of line, not a second inlined band path).
+#[cold]
+#[inline(never)]
+fn band_point<const N: usize>(
+    (pair, keying, near_foe): (&Pair, &Keying, f32),
+    r: &PointResult,
+    b2: &[Pixel],
+    index: &mut Index<N>,
+    work: &mut Work,
+) -> PointResult {
+    match_point(pair, keying, near_foe, r, b2, index, work, Matcher::Indexed)
 }
 
 /// [`match_wedge_angular`]'s reference: the same wedges and copies, every

@@ -43,10 +43,11 @@
 //! range misses the query (at an aligned position, the largest such block),
 //! so a long run costs about one step per block it crosses and per segment
 //! it visits, not one per segment. A tight index never builds or reads the
-//! tree. The wedge path walks the runs of every index without a period
-//! itself (`Index::lean`): it merges the aside entries in by index and, on
-//! a loose index, skips from a segment that misses the query over the
-//! largest aligned block that misses it too ([`Blocks::skip_at`]).
+//! tree. The wedge path walks the runs of every index itself
+//! (`Index::lean`; for periodic keys the one copy of its query that can
+//! meet the keys, `Lean::copy`): it merges the aside entries in by index
+//! and, on a loose index, skips from a segment that misses the query over
+//! the largest aligned block that misses it too ([`Blocks::skip_at`]).
 //!
 //! The fold test of a polyline whose vertices all have keys (no period)
 //! needs no index at all (`crate::fold`).

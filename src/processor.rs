@@ -727,12 +727,15 @@ fn band_point<const N: usize>(
     match_point(pair, keying, near_foe, r, b2, index, work, Matcher::Indexed)
 }
 
-/// [`match_wedge_angular`]'s reference: the same wedges and copies, every
-/// segment offered to the walk in order with the interval the index holds
-/// for it ([`Index::interval`]; the unwrapped keys' rounding depends on
-/// the turns added, so a raw interval could differ from the index's in
-/// the last bit): the run search is checked, the keys are the index's.
-/// The points without a single copy take the band path's reference.
+/// [`match_wedge_angular`]'s reference: the same wedges, every segment
+/// offered to the walk in order with no key filter at all (the interval
+/// `(−∞, ∞)`), so that the geometry alone decides: a segment the indexed
+/// walk leaves out (its key interval, unwrapped, misses the copy of the
+/// wedge's) must have no part in the wedge, which checks the keys, their
+/// unwrapping, the keys' range and the copy as well as the run search.
+/// (Which points take the band path, those whose wedge has no single
+/// copy, is the index's answer for both; they take the band path's
+/// reference.)
 #[cfg_attr(not(any(test, feature = "_reference")), allow(dead_code))]
 #[inline(never)]
 fn match_wedge_angular_reference<const N: usize>(
@@ -770,8 +773,9 @@ fn match_wedge_angular_reference<const N: usize>(
         };
         (wedge.kl, wedge.kh) = (kl, kh);
         let mut walker = WedgeWalker::new(wedge, b2, cot_twice);
+        let every = (f32::NEG_INFINITY, f32::INFINITY);
         for j in 0..segments {
-            if Visitor::segment(&mut walker, j, index.interval(j)).0 == Flow::Stop {
+            if Visitor::segment(&mut walker, j, every).0 == Flow::Stop {
                 break;
             }
         }

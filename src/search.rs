@@ -75,10 +75,11 @@ pub(crate) const MAX_COPIES: usize = 3;
 /// quarter of its margin `2⁻²⁰ (S/D + 4)` ([`crate::pencil`]), and adding
 /// turns rounds it by at most `2⁻²⁴ |k|` more, which the rest of the
 /// margin covers while `|k| ≤ 12 (S/D + 4)`, at least 48 (`S/D ≥ 0`).
-/// (A backstop: the unwrapped keys start in `(0, 8)`, and a boundary
+/// (A backstop: the unwrapped keys start within 8 of 0 (in `(0, 8)`, or
+/// `(−8, 0)` once the rebuild flips their orientation), and a boundary
 /// (monotone in `v`, [`crate::Frame::push_boundary`]) turns less than once
 /// round the FOE, so its keys span less than 4 and a copy that meets them
-/// lies within `(−5, 13)`.)
+/// lies within 13 of 0.)
 const COPY_REACH: f32 = 32.0;
 /// The fan-out of the block tree, `2^FAN_BITS`.
 const FAN_BITS: u32 = 3;
@@ -190,8 +191,11 @@ impl Lean<'_> {
     /// ([`copies_in`]): for keys without a period the query itself; for
     /// periodic keys the copy `[ql + 4m, qh + 4m]` that can meet the keys'
     /// range, or, when none can, `(−∞, −∞)` (it meets only intervals that
-    /// reach `−∞`, those of segments with an unkeyed end, and a walk's
-    /// low-end tests end the run at once); `None` when two or more can.
+    /// reach `−∞`, those of segments with an unkeyed end: a walk's run
+    /// starts where its probes from the hint, then a bisection, reach
+    /// segment 0, a few units, and its low-end tests end the run at the
+    /// first segment that does not reach `−∞`); `None` when two or more
+    /// can.
     #[inline(always)]
     pub(crate) fn copy(&self, ql: f32, qh: f32) -> Option<(f32, f32)> {
         if self.period <= 0.0 {
@@ -732,20 +736,6 @@ impl<const N: usize> Index<N> {
             period: self.period,
             range: (self.kmin, self.kmax),
         }
-    }
-
-    /// Segment `j`'s interval as the index holds it (oriented, unwrapped;
-    /// an aside entry's own), for the reference matcher of periodic keys:
-    /// the empty `(∞, −∞)` past the segments.
-    #[cfg_attr(not(any(test, feature = "_reference")), allow(dead_code))]
-    pub(crate) fn interval(&self, j: usize) -> (f32, f32) {
-        if let Some(&(_, l, h)) = self.aside.iter().find(|e| usize::from(e.0) == j) {
-            return (l, h);
-        }
-        self.seg
-            .get(j)
-            .filter(|_| j < self.segments)
-            .map_or((f32::INFINITY, f32::NEG_INFINITY), |g| (g.lo, g.hi))
     }
 
     /// Where the last run started (the next query's probes start there).

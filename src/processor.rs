@@ -188,8 +188,11 @@ impl<const N: usize, const B: usize> Processor<N, B> {
 
     /// [`Processor::process_against_kept`] with the reference matcher: every
     /// frame-2 segment offered to every point's walk in order, no index
-    /// (the fold test keeps its index). For the tests that the indexed
-    /// search changes nothing; behind the private `_reference` feature.
+    /// (the fold test keeps its index, and on a boundary of pseudo-angle
+    /// keys the index still says which points take the band path, those
+    /// whose wedge has no single copy: [`crate::search::Lean::copy`]). For
+    /// the tests that the indexed search changes nothing; behind the
+    /// private `_reference` feature.
     #[cfg(any(test, feature = "_reference"))]
     #[doc(hidden)]
     pub fn reference_against_kept(
@@ -697,9 +700,13 @@ fn match_wedge_angular<const N: usize>(
             continue;
         };
         let Some((kl, kh)) = lean.copy(wedge.kl, wedge.kh) else {
+            #[cfg(test)]
+            tests::ANGULAR.with(|c| c.set((c.get().0, c.get().1 + 1)));
             *r = band_point((pair, keying, near_foe), r, b2, index, work);
             continue;
         };
+        #[cfg(test)]
+        tests::ANGULAR.with(|c| c.set((c.get().0 + 1, c.get().1)));
         (wedge.kl, wedge.kh) = (kl, kh);
         let (outcome, a) = wedge_run_aside::<true>(
             &wedge,
@@ -879,8 +886,13 @@ impl LeanWalk<'_> {
         };
         // When no aside entry has a part in the wedge, offered in their
         // places they would change nothing: the run is walked without
-        // them, their units paid first. (Not on a loose index: there the
-        // test measured dearer than the merge.)
+        // them, their units paid first (all of them, where the merge
+        // charges only those before a walk that stops early: the results
+        // are the merge's unless the budget binds). The test is not
+        // charged, and when an entry has a part the merge tests the
+        // entries again: at most `MAX_ASIDE` tests a point, a constant.
+        // (Not on a loose index: there the test measured dearer than the
+        // merge.)
         if !SKIP {
             if let Some(units) = aside_idle(&wedge, self.b2, self.aside) {
                 let (outcome, a) = match work.spend(units) {
@@ -1503,6 +1515,82 @@ mod tests {
     use super::*;
     extern crate std;
     use std::vec::Vec;
+
+    std::thread_local! {
+        /// Points of this thread's tests that `match_wedge_angular` walked
+        /// through a wedge, and that it sent to the band path.
+        pub(super) static ANGULAR: core::cell::Cell<(usize, usize)> =
+            const { core::cell::Cell::new((0, 0)) };
+    }
+
+    /// The wedge path for pseudo-angle keys is taken, and its band-path
+    /// fallback too, where they should be: a steep line across the FOE's
+    /// row (every point walked through a wedge, none to the band path),
+    /// and a hairpin round the FOE within 1.6 px of its row, whose keys
+    /// span nearly a turn (some points to the band path); and every
+    /// result equals the reference's. (The host test
+    /// `angular_wedge_equals_reference_near_and_round_the_foe` runs more
+    /// shapes without the counts.)
+    #[test]
+    fn angular_wedge_and_its_band_fallback_are_taken() {
+        use crate::{Camera, Motion};
+        let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).expect("camera");
+        let m = Motion::new([0.0, 0.0, 0.4], [0.0, 0.0, 0.0]).expect("motion");
+        let foe = [255.5f32, 239.5f32];
+        let s = 6.0f32 / 5.6;
+        let scale =
+            |q: [f32; 2]| Pixel::new(foe[0] + s * (q[0] - foe[0]), foe[1] + s * (q[1] - foe[1]));
+        let line: Vec<[f32; 2]> = (0..360)
+            .map(|i| [100.0 + 0.3 * (i as f32 - 180.0), 60.0 + i as f32])
+            .collect();
+        let mut hairpin: Vec<[f32; 2]> = (0..120)
+            .map(|i| [470.0 - 3.9 * i as f32, foe[1] - 1.6 + 0.003 * i as f32])
+            .collect();
+        hairpin.extend((1..60).map(|i| [6.0 + 0.1 * i as f32, foe[1] - 1.24 + 0.04 * i as f32]));
+        hairpin.extend((0..120).map(|i| [12.0 + 3.9 * i as f32, foe[1] + 1.24 + 0.003 * i as f32]));
+        let inside = |p: &Pixel| p.u >= 0.0 && p.u <= 511.0 && p.v >= 0.0 && p.v <= 479.0;
+        for (name, b, band) in [("line", &line, false), ("hairpin", &hairpin, true)] {
+            let b1: Vec<Pixel> = b
+                .iter()
+                .map(|q| Pixel::new(q[0], q[1]))
+                .filter(inside)
+                .collect();
+            let b2: Vec<Pixel> = b.iter().map(|&q| scale(q)).filter(inside).collect();
+            let mut f1 = Frame::<512, 1>::new(cam);
+            let mut f2 = Frame::<512, 1>::new(cam);
+            f1.push_boundary(&b1).expect("frame 1");
+            f2.push_boundary(&b2).expect("frame 2");
+            let unlimited = Config::DEFAULT
+                .with_work_budget(Config::MAX_WORK_PER_POINT)
+                .expect("budget");
+            let mut p = std::boxed::Box::new(Processor::<512, 1>::new(unlimited));
+            assert!(p.process(&f1, None).is_ok());
+            ANGULAR.with(|c| c.set((0, 0)));
+            let fast = p.process_against_kept(&f2, &m).expect("fast").clone();
+            let (walked, to_band) = ANGULAR.with(|c| c.get());
+            let slow = p
+                .reference_against_kept(&f2, &m)
+                .expect("reference")
+                .clone();
+            assert_eq!(
+                fast.boundaries()[0].points(),
+                slow.boundaries()[0].points(),
+                "{name}"
+            );
+            let ok = fast.boundaries()[0]
+                .points()
+                .iter()
+                .filter(|r| r.status == Status::Ok)
+                .count();
+            assert!(walked > 100, "{name}: {walked} points walked a wedge");
+            if band {
+                assert!(to_band > 0, "{name}: no point took the band path");
+            } else {
+                assert_eq!(to_band, 0, "{name}: {to_band} points took the band path");
+                assert!(ok > 300, "{name}: {ok} ok");
+            }
+        }
+    }
 
     /// A wedge wholly beyond the FOE's row (no keyed point in it) walked
     /// through a loose index whose aside list is full, so that segments

@@ -75,11 +75,13 @@ pub(crate) const MAX_COPIES: usize = 3;
 /// quarter of its margin `2⁻²⁰ (S/D + 4)` ([`crate::pencil`]), and adding
 /// turns rounds it by at most `2⁻²⁴ |k|` more, which the rest of the
 /// margin covers while `|k| ≤ 12 (S/D + 4)`, at least 48 (`S/D ≥ 0`).
-/// (A backstop: the unwrapped keys start within 8 of 0 (in `(0, 8)`, or
-/// `(−8, 0)` once the rebuild flips their orientation), and a boundary
-/// (monotone in `v`, [`crate::Frame::push_boundary`]) turns less than once
-/// round the FOE, so its keys span less than 4 and a copy that meets them
-/// lies within 13 of 0.)
+/// The first unwrapped key lies in `[4, 8)`, or `(0, 4]` for keys
+/// oriented the other way (a flip at the rebuild negates them all), and a
+/// boundary (monotone in `v`, [`crate::Frame::push_boundary`]) turns less
+/// than once round the FOE, so its keys usually span less than 4 and lie
+/// within 12 of 0. Not always: across the unkeyed disc round the FOE the
+/// unwrapping guesses the turn, and a boundary that zig-zags through the
+/// disc many times can pile the guesses up; hence the check.
 const COPY_REACH: f32 = 32.0;
 /// The fan-out of the block tree, `2^FAN_BITS`.
 const FAN_BITS: u32 = 3;
@@ -195,17 +197,21 @@ impl Lean<'_> {
     /// starts where its probes from the hint, then a bisection, reach
     /// segment 0, a few units, and its low-end tests end the run at the
     /// first segment that does not reach `−∞`); `None` when two or more
-    /// can.
+    /// can, or when the keys reach beyond [`COPY_REACH`] of 0.
     #[inline(always)]
     pub(crate) fn copy(&self, ql: f32, qh: f32) -> Option<(f32, f32)> {
         if self.period <= 0.0 {
             return Some((ql, qh));
         }
+        // Within a few turns of 0, where the unwrapped keys' rounding
+        // stays inside their margins ([`COPY_REACH`]). (A NaN fails.)
+        let (kmin, kmax) = self.range;
+        if kmin <= kmax && !(kmin >= -COPY_REACH && kmax <= COPY_REACH) {
+            return None;
+        }
         let mut c = [(0.0f32, 0.0f32); MAX_COPIES];
         match copies_in((self.period, self.range), ql, qh, &mut c) {
             Some(0) => Some((f32::NEG_INFINITY, f32::NEG_INFINITY)),
-            // Within a few turns of the first key, where the unwrapped
-            // keys' rounding stays inside their margins ([`COPY_REACH`]).
             Some(1) => c
                 .first()
                 .copied()
@@ -1772,13 +1778,35 @@ pub(crate) mod tests {
         assert_eq!(lean.copy(-0.2, 0.6), None);
         let mut wound = Index::<64>::new();
         let mut b = wound.builder((4.0, 1.0), Unkeyed::MeetAll);
-        // Nine turns at 1.5 a step: a query meets many copies; and past
-        // COPY_REACH, one.
+        // Nine turns at 1.5 a step: a query meets many copies.
         b.push_all((0..26).map(|i| ((1.5 * i as f32) % 4.0, 0.0)));
         b.finish(None);
         let lean = wound.lean();
         assert!(lean.range.1 - lean.range.0 > 36.0, "{:?}", lean.range);
         assert_eq!(lean.copy(1.0, 1.1), None, "many copies");
+        // Keys beyond COPY_REACH of 0 (not from the builder: a backstop):
+        // no walk, whether one copy meets them or none.
+        let far = |range| Lean {
+            segs: &[],
+            orient: 1.0,
+            aside: &[],
+            blocks: Blocks {
+                tree: &[],
+                levels: 0,
+                segments: 0,
+            },
+            period: 4.0,
+            range,
+        };
+        assert_eq!(far((30.0, 31.0)).copy(2.2, 2.4), Some((30.2, 30.4)));
+        assert_eq!(far((31.0, 33.0)).copy(3.2, 3.4), None, "one copy");
+        assert_eq!(far((31.0, 33.0)).copy(2.0, 2.5), None, "no copy");
+        assert_eq!(far((-34.0, -33.0)).copy(2.2, 2.4), None);
+        // No keyed segment (an empty range): the empty copy.
+        assert_eq!(
+            far((f32::INFINITY, f32::NEG_INFINITY)).copy(2.2, 2.4),
+            Some((f32::NEG_INFINITY, f32::NEG_INFINITY))
+        );
         // Without a period: the query itself.
         let mut flat = Index::<16>::new();
         let mut b = flat.builder((0.0, 1.0), Unkeyed::MeetAll);

@@ -197,8 +197,9 @@ impl Wedge {
     /// a segment (less than half a turn about the FOE) has the rays whose
     /// keys lie between its ends' unwrapped keys, so the filter of the
     /// module docs holds on the unwrapped keys.
-    /// A point without a key gets `(−∞, ∞)` (no copy is single: the caller
-    /// takes the band path).
+    /// A point without a key gets `(−∞, ∞)`: no copy of it is single (the
+    /// caller takes the band path) unless the index has no keyed segment
+    /// (then the empty copy, which meets only the unkeyed ones).
     #[inline(always)]
     pub(crate) fn new_angular(
         p: [f32; 2],
@@ -838,6 +839,24 @@ mod tests {
                 walk.next == 6 || r == Err(Status::Grazing),
                 "case {case}: q {q:?} not in the wedge of {p:?} (foe {foe:?})"
             );
+            // And the band itself holds it (the wedge is the larger).
+            let band = Band::new(
+                p,
+                [w * (p[0] - c2[0]) - g[0], w * (p[1] - c2[1]) - g[1]],
+                w,
+                &PointErrors {
+                    r1,
+                    e2,
+                    e2_csc: e2 * 11.52,
+                    spread_a: 0.0,
+                    spread_w: 0.0,
+                },
+                0.0,
+            );
+            if let Ok(b) = band {
+                let c = b.vertex(q);
+                assert!(Band::contains(&c), "case {case}: q outside the band");
+            }
             inside += 1;
         }
         assert!(inside > 5_000, "{inside}");

@@ -197,17 +197,11 @@ impl Lean<'_> {
     /// starts where its probes from the hint, then a bisection, reach
     /// segment 0, a few units, and its low-end tests end the run at the
     /// first segment that does not reach `−∞`); `None` when two or more
-    /// can, or when the keys reach beyond [`COPY_REACH`] of 0.
+    /// can. For an index whose keys are within reach ([`Self::in_reach`]).
     #[inline(always)]
     pub(crate) fn copy(&self, ql: f32, qh: f32) -> Option<(f32, f32)> {
         if self.period <= 0.0 {
             return Some((ql, qh));
-        }
-        // Within a few turns of 0, where the unwrapped keys' rounding
-        // stays inside their margins ([`COPY_REACH`]). (A NaN fails.)
-        let (kmin, kmax) = self.range;
-        if kmin <= kmax && !(kmin >= -COPY_REACH && kmax <= COPY_REACH) {
-            return None;
         }
         let mut c = [(0.0f32, 0.0f32); MAX_COPIES];
         match copies_in((self.period, self.range), ql, qh, &mut c) {
@@ -218,6 +212,16 @@ impl Lean<'_> {
                 .filter(|&(l, h)| l >= -COPY_REACH && h <= COPY_REACH),
             _ => None,
         }
+    }
+
+    /// Whether the keys lie within [`COPY_REACH`] of 0 (or there are none,
+    /// or no period), where the unwrapped keys' rounding stays inside
+    /// their margins: else no copy is to be walked, every point takes the
+    /// band path. (Once per boundary, not per point.) (A NaN fails.)
+    #[inline(always)]
+    pub(crate) fn in_reach(&self) -> bool {
+        let (kmin, kmax) = self.range;
+        self.period <= 0.0 || kmin > kmax || (kmin >= -COPY_REACH && kmax <= COPY_REACH)
     }
 }
 
@@ -1785,7 +1789,7 @@ pub(crate) mod tests {
         assert!(lean.range.1 - lean.range.0 > 36.0, "{:?}", lean.range);
         assert_eq!(lean.copy(1.0, 1.1), None, "many copies");
         // Keys beyond COPY_REACH of 0 (not from the builder: a backstop):
-        // no walk, whether one copy meets them or none.
+        // out of reach, whether one copy meets them or none.
         let far = |range| Lean {
             segs: &[],
             orient: 1.0,
@@ -1798,15 +1802,19 @@ pub(crate) mod tests {
             period: 4.0,
             range,
         };
+        assert!(far((30.0, 31.0)).in_reach());
         assert_eq!(far((30.0, 31.0)).copy(2.2, 2.4), Some((30.2, 30.4)));
-        assert_eq!(far((31.0, 33.0)).copy(3.2, 3.4), None, "one copy");
-        assert_eq!(far((31.0, 33.0)).copy(2.0, 2.5), None, "no copy");
-        assert_eq!(far((-34.0, -33.0)).copy(2.2, 2.4), None);
-        // No keyed segment (an empty range): the empty copy.
+        assert!(!far((31.0, 33.0)).in_reach());
+        assert!(!far((-34.0, -33.0)).in_reach());
+        assert!(!far((-34.0, f32::NAN)).in_reach());
+        // No keyed segment (an empty range): in reach, the empty copy.
+        let empty = far((f32::INFINITY, f32::NEG_INFINITY));
+        assert!(empty.in_reach());
         assert_eq!(
-            far((f32::INFINITY, f32::NEG_INFINITY)).copy(2.2, 2.4),
+            empty.copy(2.2, 2.4),
             Some((f32::NEG_INFINITY, f32::NEG_INFINITY))
         );
+        assert!(index.lean().in_reach());
         // Without a period: the query itself.
         let mut flat = Index::<16>::new();
         let mut b = flat.builder((0.0, 1.0), Unkeyed::MeetAll);

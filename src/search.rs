@@ -11,7 +11,10 @@
 //!
 //! 1. Keys are *oriented* (multiplied by ±1) so that they rise from the
 //!    first to the last keyed vertex, and pseudo-angles are *unwrapped*
-//!    along the polyline (consecutive keys less than half a turn apart).
+//!    along the polyline (consecutive keys less than half a turn apart; a
+//!    segment whose ends are half a turn apart to within their margins,
+//!    one passing within a hair of the FOE, may go either way round and
+//!    is taken as one with an unkeyed end).
 //! 2. A few segments are kept *aside*, in a short sorted list that every
 //!    query checks: segments with an unkeyable end (frame 2: they may meet
 //!    any ray) and *outlying* segments, whose interval reaches far beyond
@@ -1412,6 +1415,8 @@ impl<const N: usize> Builder<'_, N> {
             return;
         };
         let mut k = self.o * raw;
+        // Whether the segment ending here may go either way round the FOE.
+        let mut doubtful = false;
         if self.period > 0.0 && k.is_finite() {
             // Consecutive keys are less than half a turn apart.
             k += self.offset;
@@ -1423,16 +1428,29 @@ impl<const N: usize> Builder<'_, N> {
                 self.offset += 4.0;
                 k += 4.0;
             }
+            // A segment that passes (nearly) through the FOE has ends half
+            // a turn apart: within its ends' margins of that (each key is
+            // computed to within a quarter of its margin, `crate::pencil`)
+            // the way round it goes, and so its interval, is not known, and
+            // it is taken as an unkeyed one (below). (For the first vertex
+            // `d` is infinite, and there is no segment.)
+            let m = e + i
+                .checked_sub(1)
+                .and_then(|j| self.index.margin.get(j))
+                .copied()
+                .unwrap_or(0.0);
+            doubtful = 2.0 - (k - self.keyed).abs() <= 2.0 * m;
             self.keyed = k;
         }
         let ends = self.order.push(k, e);
         if let Some(g) = i.checked_sub(1).and_then(|j| self.index.seg.get_mut(j)) {
-            if let Some(((plo, phi), (vlo, vhi))) = ends {
+            if let (Some(((plo, phi), (vlo, vhi))), false) = (ends, doubtful) {
                 g.lo = fmin(plo, vlo);
                 g.hi = fmax(phi, vhi);
                 self.sum += g.hi - g.lo;
             } else {
-                // An unkeyed end: the rebuild sorts it out.
+                // An unkeyed end (or a doubtful way round): the rebuild
+                // sorts it out.
                 (g.lo, g.hi) = match self.unkeyed {
                     Unkeyed::MeetAll => (f32::NEG_INFINITY, f32::INFINITY),
                     Unkeyed::MeetNone => (f32::INFINITY, f32::NEG_INFINITY),
@@ -1821,5 +1839,35 @@ pub(crate) mod tests {
         b.push_all([0.1f32, 0.2, 0.3].iter().map(|&k| (k, 0.0)));
         b.finish(None);
         assert_eq!(flat.lean().copy(5.0, 6.0), Some((5.0, 6.0)));
+    }
+
+    /// A segment of pseudo-angle keys whose ends are half a turn apart to
+    /// within their margins (it passes within a hair of the FOE) may go
+    /// either way round: it is offered to every query, as a segment with
+    /// an unkeyed end is, not to the half-turn its rounded keys suggest.
+    /// (Here the keys say 2 + 10⁻⁶ apart, unwrapped to the other way
+    /// round, while a ray of key 2 may well meet it.)
+    #[test]
+    fn a_segment_half_a_turn_long_meets_every_key() {
+        for (a, b) in [(1.0f32, 3.000_001f32), (3.000_001, 1.0), (0.5, 2.499_999)] {
+            let mut index = Index::<8>::new();
+            let mut builder = index.builder((4.0, 1.0), Unkeyed::MeetAll);
+            builder.push_all([(a, 1.0e-5), (b, 1.0e-5)].into_iter());
+            builder.finish(None);
+            let mid = 0.5 * (a + b);
+            let mut seen = Record {
+                seen: [false; CAP],
+                last: None,
+                ordered: true,
+            };
+            let mut work = Work::new();
+            work.grant(1000);
+            let q = Query::Keys(mid - 0.01, mid + 0.01);
+            assert!(index.visit(q, false, None, &mut work, &mut seen).is_ok());
+            assert!(
+                seen.seen[0],
+                "({a}, {b}): the segment was not offered for key {mid}"
+            );
+        }
     }
 }

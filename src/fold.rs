@@ -10,8 +10,7 @@
 //! e]` meets the key interval of a segment `j ≤ i − w − 1` or `j ≥ i + w`
 //! (`w` = [`FOLD_WINDOW`]; segment `j` from vertex `j` to `j + 1`, its
 //! interval the hull of its ends' widened keys, as the search index builds
-//! it; a segment with an unkeyed end meets nothing here, nor one of
-//! pseudo-angle keys half a turn long, `crate::search`).
+//! it; a segment with an unkeyed end meets nothing here).
 //!
 //! One rule, decided the cheapest way the boundary allows, each giving the
 //! brute force's answer (the third unless the work budget runs out first:

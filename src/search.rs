@@ -11,10 +11,11 @@
 //!
 //! 1. Keys are *oriented* (multiplied by ±1) so that they rise from the
 //!    first to the last keyed vertex, and pseudo-angles are *unwrapped*
-//!    along the polyline (consecutive keys less than half a turn apart; a
-//!    segment whose ends are half a turn apart to within their margins,
-//!    one passing within a hair of the FOE, may go either way round and
-//!    is taken as one with an unkeyed end).
+//!    along the polyline (consecutive keys less than half a turn apart; in
+//!    an index whose unkeyed ends meet every key, frame 2's, a segment
+//!    whose ends are half a turn apart to within their margins, one
+//!    passing within a hair of the FOE, may go either way round and is
+//!    taken as one with an unkeyed end).
 //! 2. A few segments are kept *aside*, in a short sorted list that every
 //!    query checks: segments with an unkeyable end (frame 2: they may meet
 //!    any ray) and *outlying* segments, whose interval reaches far beyond
@@ -1432,14 +1433,18 @@ impl<const N: usize> Builder<'_, N> {
             // a turn apart: within its ends' margins of that (each key is
             // computed to within a quarter of its margin, `crate::pencil`)
             // the way round it goes, and so its interval, is not known, and
-            // it is taken as an unkeyed one (below). (For the first vertex
-            // `d` is infinite, and there is no segment.)
-            let m = e + i
-                .checked_sub(1)
-                .and_then(|j| self.index.margin.get(j))
-                .copied()
-                .unwrap_or(0.0);
-            doubtful = 2.0 - (k - self.keyed).abs() <= 2.0 * m;
+            // it is taken as an unkeyed one (below). Only where an unkeyed
+            // end meets every key, frame 2's index: the fold index's "meets
+            // none" would be the less careful answer there. (For the first
+            // vertex `d` is infinite, and there is no segment.)
+            if self.unkeyed == Unkeyed::MeetAll {
+                let m = e + i
+                    .checked_sub(1)
+                    .and_then(|j| self.index.margin.get(j))
+                    .copied()
+                    .unwrap_or(0.0);
+                doubtful = 2.0 - (k - self.keyed).abs() <= 2.0 * m;
+            }
             self.keyed = k;
         }
         let ends = self.order.push(k, e);

@@ -688,9 +688,6 @@ fn match_wedge_angular<const N: usize>(
 ) {
     let (e2, e2_csc, cot_twice) = (pair.e2(), pair.e2_csc(), pair.config.cot_twice);
     let segments = b2.len().saturating_sub(1);
-    // Keys out of reach (a backstop, `Lean::in_reach`): the band path for
-    // every point.
-    let reach = index.lean().in_reach();
     for r in slots.iter_mut() {
         if r.status != Status::NoIntersection {
             continue;
@@ -702,7 +699,7 @@ fn match_wedge_angular<const N: usize>(
             *r = PointResult::flagged(p1, Status::AtFoe);
             continue;
         };
-        let Some((kl, kh)) = lean.copy(wedge.kl, wedge.kh).filter(|_| reach) else {
+        let Some((kl, kh)) = lean.copy(wedge.kl, wedge.kh) else {
             #[cfg(test)]
             tests::ANGULAR.with(|c| c.set((c.get().0, c.get().1 + 1)));
             *r = band_point((pair, keying, near_foe), r, b2, index, work);
@@ -757,7 +754,6 @@ fn match_wedge_angular_reference<const N: usize>(
     let (e2, e2_csc, cot_twice) = (pair.e2(), pair.e2_csc(), pair.config.cot_twice);
     let segments = b2.len().saturating_sub(1);
     let mut work = Work::new();
-    let reach = index.lean().in_reach();
     for r in slots.iter_mut() {
         if r.status != Status::NoIntersection {
             continue;
@@ -769,7 +765,7 @@ fn match_wedge_angular_reference<const N: usize>(
             *r = PointResult::flagged(p1, Status::AtFoe);
             continue;
         };
-        let Some((kl, kh)) = lean.copy(wedge.kl, wedge.kh).filter(|_| reach) else {
+        let Some((kl, kh)) = lean.copy(wedge.kl, wedge.kh) else {
             *r = match_point(
                 pair,
                 keying,

@@ -85,7 +85,9 @@ pub(crate) const MAX_COPIES: usize = 3;
 /// than once round the FOE, so its keys usually span less than 4 and lie
 /// within 12 of 0. Not always: across the unkeyed disc round the FOE the
 /// unwrapping guesses the turn, and a boundary that zig-zags through the
-/// disc many times can pile the guesses up; hence the check.
+/// disc many times can pile the guesses up; hence the check in
+/// [`copies_in`], for every query (the band path visits every segment, the
+/// fold test assumes a fold, the wedge path gives the point to the band).
 const COPY_REACH: f32 = 32.0;
 /// The fan-out of the block tree, `2^FAN_BITS`.
 const FAN_BITS: u32 = 3;
@@ -201,7 +203,7 @@ impl Lean<'_> {
     /// starts where its probes from the hint, then a bisection, reach
     /// segment 0, a few units, and its low-end tests end the run at the
     /// first segment that does not reach `−∞`); `None` when two or more
-    /// can. For an index whose keys are within reach ([`Self::in_reach`]).
+    /// can, or when the keys lie beyond [`COPY_REACH`] of 0.
     #[inline(always)]
     pub(crate) fn copy(&self, ql: f32, qh: f32) -> Option<(f32, f32)> {
         if self.period <= 0.0 {
@@ -210,22 +212,9 @@ impl Lean<'_> {
         let mut c = [(0.0f32, 0.0f32); MAX_COPIES];
         match copies_in((self.period, self.range), ql, qh, &mut c) {
             Some(0) => Some((f32::NEG_INFINITY, f32::NEG_INFINITY)),
-            Some(1) => c
-                .first()
-                .copied()
-                .filter(|&(l, h)| l >= -COPY_REACH && h <= COPY_REACH),
+            Some(1) => c.first().copied(),
             _ => None,
         }
-    }
-
-    /// Whether the keys lie within [`COPY_REACH`] of 0 (or there are none,
-    /// or no period), where the unwrapped keys' rounding stays inside
-    /// their margins: else no copy is to be walked, every point takes the
-    /// band path. (Once per boundary, not per point.) (A NaN fails.)
-    #[inline(always)]
-    pub(crate) fn in_reach(&self) -> bool {
-        let (kmin, kmax) = self.range;
-        self.period <= 0.0 || kmin > kmax || (kmin >= -COPY_REACH && kmax <= COPY_REACH)
     }
 }
 
@@ -1146,8 +1135,15 @@ fn copies_in(
         }
         return Some(usize::from(ql <= kmax && qh >= kmin));
     }
-    if !(kmin <= kmax) {
+    // No keyed segment: no copy. (A NaN fails, and the next test takes it.)
+    if kmin > kmax {
         return Some(0);
+    }
+    // Keys beyond `COPY_REACH` of 0 may be off by more than their margins:
+    // as many copies as can be (every segment visited, or a fold assumed).
+    // (A NaN fails.)
+    if !(kmin >= -COPY_REACH && kmax <= COPY_REACH) {
+        return None;
     }
     // The smallest m with qh + 4m ≥ kmin. Keys change by less than half
     // a turn per segment, so |kmin|, |kmax| ≤ 2N + 4 and the quotient
@@ -1811,8 +1807,24 @@ pub(crate) mod tests {
         let lean = wound.lean();
         assert!(lean.range.1 - lean.range.0 > 36.0, "{:?}", lean.range);
         assert_eq!(lean.copy(1.0, 1.1), None, "many copies");
-        // Keys beyond COPY_REACH of 0 (not from the builder: a backstop):
-        // out of reach, whether one copy meets them or none.
+        // More copies than searched one by one (and keys past COPY_REACH):
+        // a query visits every segment.
+        assert!(lean.range.1 > COPY_REACH, "{:?}", lean.range);
+        let mut seen = Record {
+            seen: [false; CAP],
+            last: None,
+            ordered: true,
+        };
+        let mut work = Work::new();
+        work.grant(10_000);
+        let q = Query::Keys(40.0, 40.1);
+        assert!(wound.visit(q, false, None, &mut work, &mut seen).is_ok());
+        assert!(
+            seen.seen.iter().take(25).all(|&x| x),
+            "every segment offered"
+        );
+        // Keys beyond COPY_REACH of 0 (hand-made): no walk, whether one
+        // copy meets them or none.
         let far = |range| Lean {
             segs: &[],
             orient: 1.0,
@@ -1825,19 +1837,16 @@ pub(crate) mod tests {
             period: 4.0,
             range,
         };
-        assert!(far((30.0, 31.0)).in_reach());
         assert_eq!(far((30.0, 31.0)).copy(2.2, 2.4), Some((30.2, 30.4)));
-        assert!(!far((31.0, 33.0)).in_reach());
-        assert!(!far((-34.0, -33.0)).in_reach());
-        assert!(!far((-34.0, f32::NAN)).in_reach());
-        // No keyed segment (an empty range): in reach, the empty copy.
-        let empty = far((f32::INFINITY, f32::NEG_INFINITY));
-        assert!(empty.in_reach());
+        assert_eq!(far((31.0, 33.0)).copy(3.2, 3.4), None, "one copy");
+        assert_eq!(far((31.0, 33.0)).copy(2.0, 2.5), None, "no copy");
+        assert_eq!(far((-34.0, -33.0)).copy(2.2, 2.4), None);
+        assert_eq!(far((-34.0, f32::NAN)).copy(2.2, 2.4), None);
+        // No keyed segment (an empty range): the empty copy.
         assert_eq!(
-            empty.copy(2.2, 2.4),
+            far((f32::INFINITY, f32::NEG_INFINITY)).copy(2.2, 2.4),
             Some((f32::NEG_INFINITY, f32::NEG_INFINITY))
         );
-        assert!(index.lean().in_reach());
         // Without a period: the query itself.
         let mut flat = Index::<16>::new();
         let mut b = flat.builder((0.0, 1.0), Unkeyed::MeetAll);

@@ -692,22 +692,23 @@ fn match_wedge_angular<const N: usize>(
         if r.status != Status::NoIntersection {
             continue;
         }
-        let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
+        let (p1, iz, r1) = (r.pixel1, r.z, r.z_near);
         let lean = index.lean();
-        let keys = (key, keying.key_scale, lean.orient);
-        let Ok(mut wedge) = Wedge::new_angular(p, foe, (r1, e2, e2_csc), keys) else {
-            *r = PointResult::flagged(p1, Status::AtFoe);
-            continue;
-        };
-        let Some((kl, kh)) = lean.copy(wedge.kl, wedge.kh) else {
-            #[cfg(test)]
-            tests::ANGULAR.with(|c| c.set((c.get().0, c.get().1 + 1)));
-            *r = band_point((pair, keying, near_foe), r, b2, index, work);
-            continue;
+        let wedge = match angular_wedge(r, (foe, e2, e2_csc), keying, &lean) {
+            AngularPoint::Walk(w) => w,
+            AngularPoint::AtFoe => {
+                *r = PointResult::flagged(p1, Status::AtFoe);
+                continue;
+            }
+            AngularPoint::Band => {
+                #[cfg(test)]
+                tests::ANGULAR.with(|c| c.set((c.get().0, c.get().1 + 1)));
+                *r = band_point((pair, keying, near_foe), r, b2, index, work);
+                continue;
+            }
         };
         #[cfg(test)]
         tests::ANGULAR.with(|c| c.set((c.get().0 + 1, c.get().1)));
-        (wedge.kl, wedge.kh) = (kl, kh);
         let (outcome, a) = wedge_run_aside::<true>(
             &wedge,
             (lean.segs, b2, lean.aside),
@@ -717,6 +718,42 @@ fn match_wedge_angular<const N: usize>(
         );
         index.set_hint(a);
         *r = conclude_wedge(pair, p1, iz, r1, &wedge, outcome);
+    }
+}
+
+/// What the wedge path for pseudo-angle keys does with a point left by
+/// steps 1–2 ([`angular_wedge`]).
+enum AngularPoint {
+    /// Its wedge, with the one copy of its key interval to walk.
+    Walk(Wedge),
+    /// Within `3 (r₁ + e₂)` of the FOE ([`Status::AtFoe`]).
+    AtFoe,
+    /// No single copy of its key interval (or no key): the band path.
+    Band,
+}
+
+/// The point in `r`'s wedge for the FOE `foe` and errors `e2`, `e2_csc`
+/// ([`Wedge::new_angular`]), its key interval replaced by the copy the
+/// index's lean view gives ([`Lean::copy`]); the same for the fast path
+/// and its reference.
+#[inline(always)]
+fn angular_wedge(
+    r: &PointResult,
+    (foe, e2, e2_csc): ([f32; 2], f32, f32),
+    keying: &Keying,
+    lean: &Lean,
+) -> AngularPoint {
+    let (p, r1, key) = (r.pixel2.arr(), r.z_near, r.z_far);
+    let keys = (key, keying.key_scale, lean.orient);
+    let Ok(mut wedge) = Wedge::new_angular(p, foe, (r1, e2, e2_csc), keys) else {
+        return AngularPoint::AtFoe;
+    };
+    match lean.copy(wedge.kl, wedge.kh) {
+        Some((kl, kh)) => {
+            (wedge.kl, wedge.kh) = (kl, kh);
+            AngularPoint::Walk(wedge)
+        }
+        None => AngularPoint::Band,
     }
 }
 
@@ -758,27 +795,28 @@ fn match_wedge_angular_reference<const N: usize>(
         if r.status != Status::NoIntersection {
             continue;
         }
-        let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
+        let (p1, iz, r1) = (r.pixel1, r.z, r.z_near);
         let lean = index.lean();
-        let keys = (key, keying.key_scale, lean.orient);
-        let Ok(mut wedge) = Wedge::new_angular(p, foe, (r1, e2, e2_csc), keys) else {
-            *r = PointResult::flagged(p1, Status::AtFoe);
-            continue;
+        let wedge = match angular_wedge(r, (foe, e2, e2_csc), keying, &lean) {
+            AngularPoint::Walk(w) => w,
+            AngularPoint::AtFoe => {
+                *r = PointResult::flagged(p1, Status::AtFoe);
+                continue;
+            }
+            AngularPoint::Band => {
+                *r = match_point(
+                    pair,
+                    keying,
+                    near_foe,
+                    r,
+                    b2,
+                    index,
+                    &mut work,
+                    Matcher::Reference,
+                );
+                continue;
+            }
         };
-        let Some((kl, kh)) = lean.copy(wedge.kl, wedge.kh) else {
-            *r = match_point(
-                pair,
-                keying,
-                near_foe,
-                r,
-                b2,
-                index,
-                &mut work,
-                Matcher::Reference,
-            );
-            continue;
-        };
-        (wedge.kl, wedge.kh) = (kl, kh);
         let mut walker = WedgeWalker::new(wedge, b2, cot_twice);
         let every = (f32::NEG_INFINITY, f32::INFINITY);
         for j in 0..segments {

@@ -676,8 +676,9 @@ fn match_wedge_lean<const N: usize>(
 /// unwrapped along the polyline, a ray's key is known up to turns); the
 /// copy's run is walked as a loose index's, with the aside entries merged
 /// in ([`wedge_run_aside`]). A point whose wedge has no single copy (the
-/// boundary winds round the FOE, or the point has no key) takes the band
-/// path ([`match_point`]), as every point of these boundaries did before.
+/// boundary's keys span nearly a turn or more, or lie out of reach, or the
+/// point has no key) takes the band path ([`match_point`]), as every point
+/// of these boundaries did before.
 #[inline(never)]
 fn match_wedge_angular<const N: usize>(
     (pair, keying, near_foe, foe): (&Pair, &Keying, f32, [f32; 2]),

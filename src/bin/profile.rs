@@ -33,6 +33,13 @@ static WINDOWS: &[(&str, &[u8])] = &[
     // costliest such pair when the demo matched consecutive frames; the
     // fusion demo pairs frame 15 with key frame 12).
     ("demo_15", include_bytes!("data/demo_15.bin")),
+    // The fusion demo's two costliest pairs, frames 8 and 9 and frames 12
+    // and 13 (each the first partner of a new key frame, so a consecutive
+    // pair: the demo's matching of those frames, its digests the demo's;
+    // `cargo run --release --example pair_of -- ../src/bin/data/drive.bin
+    // 9 ../src/bin/data/demo_9.bin` in host_tests writes them).
+    ("demo_9", include_bytes!("data/demo_9.bin")),
+    ("demo_13", include_bytes!("data/demo_13.bin")),
     // Spurious frame-2 detector points (N = 256): the wedge path's lean walk
     // with the index's aside entries merged in.
     ("spur_f2", include_bytes!("data/adv_spur_f2_256.bin")),

@@ -1,0 +1,480 @@
+//! Building an index: the keys pushed vertex by vertex ([`Builder`], with
+//! the order tracker [`KeyOrder`] that step 1 shares), the envelopes, the
+//! outlier pass and the rebuild, the block tree.
+
+use super::*;
+
+impl<const N: usize> Index<N> {
+    /// Start indexing a polyline: push its vertex keys and their margins
+    /// in order ([`Builder::push`]), then [`Builder::finish`]. `period` 4
+    /// for pseudo-angles; `orient` the likely orientation of the keys (+1
+    /// rising, −1 falling: any value gives the same index, a wrong one
+    /// costs a rebuild). A segment's interval is that of its end keys,
+    /// each widened by its margin.
+    #[inline(always)]
+    pub(crate) fn builder(
+        &mut self,
+        (period, orient): (f32, f32),
+        unkeyed: Unkeyed,
+    ) -> Builder<'_, N> {
+        self.period = period;
+        self.hint = 0;
+        self.levels = 0;
+        self.aside.clear();
+        self.near.clear();
+        self.near_overflow = false;
+        Builder {
+            o: if orient < 0.0 { -1.0 } else { 1.0 },
+            period,
+            unkeyed,
+            n: 0,
+            order: KeyOrder::NEW,
+            keyed: NO_KEY,
+            offset: 0.0,
+            first: NO_KEY,
+            last: NO_KEY,
+            run: f32::NEG_INFINITY,
+            sum: 0.0,
+            index: self,
+        }
+    }
+
+    /// The suffix minima `sm`; whether somewhere the envelopes are more
+    /// than `wide` apart.
+    fn suffix_minima(&mut self, wide: f32) -> bool {
+        let s = self.segments;
+        let Some(seg) = self.seg.get_mut(..s) else {
+            return false;
+        };
+        let (mut run, mut gap) = (f32::INFINITY, f32::NEG_INFINITY);
+        for g in seg.iter_mut().rev() {
+            run = fmin(run, g.lo);
+            g.sm = run;
+            gap = fmax(gap, g.pm - run);
+        }
+        // (A NaN gap fails: loose.)
+        !(gap <= wide)
+    }
+
+    /// The slow path of [`Self::build`]: orient the intervals as `orient`,
+    /// set aside the unkeyed segments and those of outlying vertices, and
+    /// rebuild the envelopes without them.
+    fn rebuild(&mut self, orient: f32, wide: f32) {
+        let s = self.segments;
+        let Some(seg) = self.seg.get_mut(..s) else {
+            return;
+        };
+        if orient != self.orient {
+            for g in seg.iter_mut() {
+                (g.lo, g.hi) = (-g.hi, -g.lo);
+            }
+            self.orient = orient;
+        }
+        // Outliers: a segment whose interval reaches more than `wide`
+        // beyond those of the segments two places before and after it
+        // (both segments of a spurious vertex do; along a boundary whose
+        // keys move one way, neither end of an interval passes both of
+        // those). A heuristic for speed only: any choice gives the same
+        // results.
+        // (An empty interval, `(∞, −∞)`, or a missing neighbour leaves the
+        // neighbours' hull as it is; with neither there is no hull, `hi =
+        // −∞`: intervals are never otherwise inverted, and a non-empty one
+        // has `hi > −∞`.)
+        let mut aside = heapless::Vec::<(u16, f32, f32), MAX_ASIDE>::new();
+        let ends = |i: usize| {
+            seg.get(i)
+                .map_or((f32::INFINITY, f32::NEG_INFINITY), |x| (x.lo, x.hi))
+        };
+        for (j, g) in seg.iter().enumerate() {
+            let all = g.lo == f32::NEG_INFINITY;
+            let out = g.lo.is_finite() && g.hi.is_finite() && {
+                let (bl, bh) = j
+                    .checked_sub(2)
+                    .map_or((f32::INFINITY, f32::NEG_INFINITY), ends);
+                let (al, ah) = ends(j + 2);
+                let (lo, hi) = (fmin(bl, al), fmax(bh, ah));
+                hi > f32::NEG_INFINITY && (g.hi - hi > wide || lo - g.lo > wide)
+            };
+            if (all || out) && !aside.is_full() {
+                if let Ok(jj) = u16::try_from(j) {
+                    let _ = aside.push((jj, g.lo, g.hi));
+                }
+            }
+        }
+        for &(j, _, _) in aside.iter() {
+            if let Some(g) = seg.get_mut(usize::from(j)) {
+                (g.lo, g.hi) = (f32::INFINITY, f32::NEG_INFINITY);
+            }
+        }
+        self.aside = aside;
+        let Some(seg) = self.seg.get_mut(..s) else {
+            return;
+        };
+        let mut run = f32::NEG_INFINITY;
+        for g in seg.iter_mut() {
+            run = fmax(run, g.hi);
+            g.pm = run;
+        }
+        // The block tree for runs through the rebuilt envelopes, when they
+        // are still loose (tight runs are short: no tree needed).
+        self.loose = self.suffix_minima(wide);
+        if self.loose {
+            self.build_tree();
+        }
+    }
+
+    /// The block tree over the current intervals (module docs): as many
+    /// levels as fit in the `tree` array (each level `l` has
+    /// `⌈s / FAN^l⌉` blocks of two values), at most [`LEVELS`]; every loop
+    /// bounded by the array or by the blocks of the level below.
+    fn build_tree(&mut self) {
+        let s = self.segments;
+        self.levels = 0;
+        let (mut base, mut below_base, mut below_n, mut size) = (0usize, 0usize, s, 1usize);
+        for level in 1..=LEVELS {
+            size = size.saturating_mul(FAN);
+            let n = s.div_ceil(size);
+            let Some(end) = base.checked_add(2 * n).filter(|&e| e <= N) else {
+                return;
+            };
+            for b in 0..n {
+                let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+                for c in b * FAN..((b + 1) * FAN).min(below_n) {
+                    let (l, h) = if level == 1 {
+                        self.seg
+                            .get(c)
+                            .map_or((f32::INFINITY, f32::NEG_INFINITY), |g| (g.lo, g.hi))
+                    } else {
+                        let i = below_base + 2 * c;
+                        (
+                            self.tree.get(i).copied().unwrap_or(f32::INFINITY),
+                            self.tree.get(i + 1).copied().unwrap_or(f32::NEG_INFINITY),
+                        )
+                    };
+                    lo = fmin(lo, l);
+                    hi = fmax(hi, h);
+                }
+                if let Some(t) = self.tree.get_mut(base + 2 * b) {
+                    *t = lo;
+                }
+                if let Some(t) = self.tree.get_mut(base + 2 * b + 1) {
+                    *t = hi;
+                }
+            }
+            self.levels = level;
+            below_base = base;
+            below_n = n;
+            base = end;
+            if n <= 1 {
+                return;
+            }
+        }
+    }
+}
+
+/// Whether the widened keys of a polyline's vertices, in order, each lie
+/// wholly above the one before (`up`) or wholly below (`down`), and
+/// whether one of them is unkeyed (`odd`): fed one vertex at a time.
+/// Strictly ordered keys ([`KeyOrder::strict`]) meet no segment but their
+/// own two, so nothing folds and the envelopes are the intervals
+/// themselves.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct KeyOrder {
+    /// The previous vertex's key and its widened ends.
+    prev: f32,
+    plo: f32,
+    phi: f32,
+    first: bool,
+    up: bool,
+    down: bool,
+    odd: bool,
+}
+
+impl KeyOrder {
+    pub(crate) const NEW: KeyOrder = KeyOrder {
+        prev: NO_KEY,
+        plo: 0.0,
+        phi: 0.0,
+        first: true,
+        up: true,
+        down: true,
+        odd: false,
+    };
+
+    /// The next vertex's key ([`NO_KEY`] where none) and margin; whether
+    /// it and the one before are both keyed, with their widened ends
+    /// `((previous lo, previous hi), (lo, hi))`.
+    #[inline(always)]
+    pub(crate) fn push(&mut self, k: f32, e: f32) -> Option<((f32, f32), (f32, f32))> {
+        let (vlo, vhi) = (k - e, k + e);
+        let (plo, phi) = (self.plo, self.phi);
+        let both = (k + self.prev).is_finite();
+        let first = self.first;
+        (self.prev, self.plo, self.phi, self.first) = (k, vlo, vhi, false);
+        if first {
+            return None;
+        }
+        if !both {
+            self.odd = true;
+            return None;
+        }
+        self.up &= vlo > phi;
+        self.down &= vhi < plo;
+        Some(((plo, phi), (vlo, vhi)))
+    }
+
+    /// Whether [`Self::strict`] is false whatever vertices come next (one
+    /// was unkeyed, or the keys went both ways): only pushes clear `up`
+    /// and `down` and set `odd`.
+    #[inline(always)]
+    pub(crate) fn settled(&self) -> bool {
+        self.odd || !(self.up || self.down)
+    }
+
+    /// Every vertex keyed and the widened keys strictly ordered one way,
+    /// for keys without a period (`period` 0).
+    pub(crate) fn strict(&self, period: f32) -> bool {
+        !self.odd && period <= 0.0 && (self.up || self.down)
+    }
+}
+
+/// Builds an [`Index`] one vertex at a time (pass 1 of the module docs:
+/// oriented, unwrapped keys, intervals, prefix maxima and the widths' sum,
+/// in locals while the vertices come).
+pub(crate) struct Builder<'a, const N: usize> {
+    index: &'a mut Index<N>,
+    o: f32,
+    period: f32,
+    unkeyed: Unkeyed,
+    n: usize,
+    order: KeyOrder,
+    keyed: f32,
+    offset: f32,
+    first: f32,
+    last: f32,
+    run: f32,
+    sum: f32,
+}
+
+impl<const N: usize> Builder<'_, N> {
+    /// Push every vertex `keys` gives, raw key ([`NO_KEY`] where none) and
+    /// margin, in order (through [`Self::push_run`]); at most `N` count.
+    #[inline(always)]
+    pub(crate) fn push_all(&mut self, keys: impl Iterator<Item = (f32, f32)>) {
+        let mut keys = keys;
+        self.push_run(|m| {
+            let (raw, e) = keys.next()?;
+            *m = e;
+            Some(raw)
+        });
+    }
+
+    /// [`Self::push_stored`] for every raw key `keys` gives, in order
+    /// (through [`Self::push_run`]).
+    #[inline(always)]
+    pub(crate) fn push_all_stored(&mut self, keys: impl Iterator<Item = f32>) {
+        let mut keys = keys;
+        self.push_run(|_| keys.next());
+    }
+
+    /// Push vertices while `next` gives their raw keys, each with its
+    /// margin put in (or already in) the slot it is handed; at most `N`.
+    /// While the keys have no period and are finite (the usual polyline)
+    /// a lean loop writes the intervals and prefix maxima (the values
+    /// [`Self::push_stored`] gives) without the key-order test (the index
+    /// is then not [`Index::strict`], a shortcut of the fold test only);
+    /// from the first vertex it cannot take on, [`Self::push_stored`].
+    #[inline(always)]
+    fn push_run(&mut self, mut next: impl FnMut(&mut f32) -> Option<f32>) {
+        let mut pending = None;
+        if self.n == 0 && self.period <= 0.0 {
+            let Some(raw) = self.index.margin.first_mut().and_then(&mut next) else {
+                return;
+            };
+            self.push_stored(raw);
+            let k = self.o * raw;
+            let (Some(&e), true) = (self.index.margin.first(), k.is_finite()) else {
+                return self.push_rest(next);
+            };
+            let o = self.o;
+            let (mut prev, mut plo, mut phi) = (k, k - e, k + e);
+            let (mut run, mut sum) = (self.run, self.sum);
+            let mut n = 1usize;
+            let slots = self
+                .index
+                .margin
+                .iter_mut()
+                .skip(1)
+                .zip(self.index.seg.iter_mut());
+            for (m, g) in slots {
+                let Some(raw) = next(m) else {
+                    break;
+                };
+                let k = o * raw;
+                if !(k + prev).is_finite() {
+                    pending = Some(raw);
+                    break;
+                }
+                let e = *m;
+                let (vlo, vhi) = (k - e, k + e);
+                g.lo = fmin(plo, vlo);
+                g.hi = fmax(phi, vhi);
+                sum += g.hi - g.lo;
+                run = fmax(run, g.hi);
+                g.pm = run;
+                (prev, plo, phi) = (k, vlo, vhi);
+                n += 1;
+            }
+            if n > 1 {
+                self.order = KeyOrder {
+                    prev,
+                    plo,
+                    phi,
+                    first: false,
+                    up: false,
+                    down: false,
+                    odd: false,
+                };
+                (self.n, self.run, self.sum, self.last) = (n, run, sum, prev);
+            }
+        }
+        if let Some(raw) = pending {
+            self.push_stored(raw);
+        }
+        self.push_rest(next);
+    }
+
+    /// One vertex, raw key and margin, through [`Self::push_stored`] (the
+    /// tests' way past the lean loop).
+    #[cfg(test)]
+    pub(super) fn push(&mut self, raw: f32, e: f32) {
+        if let Some(m) = self.index.margin.get_mut(self.n) {
+            *m = e;
+            self.push_stored(raw);
+        }
+    }
+
+    /// The rest of [`Self::push_run`], one [`Self::push_stored`] at a time.
+    fn push_rest(&mut self, mut next: impl FnMut(&mut f32) -> Option<f32>) {
+        while let Some(raw) = self.index.margin.get_mut(self.n).and_then(&mut next) {
+            self.push_stored(raw);
+        }
+    }
+
+    /// The next vertex's raw key ([`NO_KEY`] where none), its margin
+    /// already in place (in `margin[n]`); at most `N` count.
+    #[inline(always)]
+    fn push_stored(&mut self, raw: f32) {
+        let i = self.n;
+        let Some(&e) = self.index.margin.get(i) else {
+            return;
+        };
+        let mut k = self.o * raw;
+        // Whether the segment ending here may go either way round the FOE.
+        let mut doubtful = false;
+        if self.period > 0.0 && k.is_finite() {
+            // Consecutive keys are less than half a turn apart.
+            k += self.offset;
+            let d = k - self.keyed;
+            if d > 2.0 {
+                self.offset -= 4.0;
+                k -= 4.0;
+            } else if d < -2.0 {
+                self.offset += 4.0;
+                k += 4.0;
+            }
+            // A segment that passes (nearly) through the FOE has ends half
+            // a turn apart: within its ends' margins of that (each key is
+            // computed to within a quarter of its margin, `crate::pencil`)
+            // the way round it goes, and so its interval, is not known, and
+            // it is taken as an unkeyed one (below). Only where an unkeyed
+            // end meets every key, frame 2's index: the fold index's "meets
+            // none" would be the less careful answer there. (For the first
+            // vertex `d` is infinite, and there is no segment.)
+            if self.unkeyed == Unkeyed::MeetAll {
+                let m = e + i
+                    .checked_sub(1)
+                    .and_then(|j| self.index.margin.get(j))
+                    .copied()
+                    .unwrap_or(0.0);
+                doubtful = 2.0 - (k - self.keyed).abs() <= 2.0 * m;
+            }
+            self.keyed = k;
+        }
+        let ends = self.order.push(k, e);
+        if let Some(g) = i.checked_sub(1).and_then(|j| self.index.seg.get_mut(j)) {
+            if let (Some(((plo, phi), (vlo, vhi))), false) = (ends, doubtful) {
+                g.lo = fmin(plo, vlo);
+                g.hi = fmax(phi, vhi);
+                self.sum += g.hi - g.lo;
+            } else {
+                // An unkeyed end (or a doubtful way round): the rebuild
+                // sorts it out.
+                (g.lo, g.hi) = match self.unkeyed {
+                    Unkeyed::MeetAll => (f32::NEG_INFINITY, f32::INFINITY),
+                    Unkeyed::MeetNone => (f32::INFINITY, f32::NEG_INFINITY),
+                };
+            }
+            self.run = fmax(self.run, g.hi);
+            g.pm = self.run;
+        }
+        if k.is_finite() {
+            if !self.first.is_finite() {
+                self.first = k;
+            }
+            self.last = k;
+        }
+        self.n = i + 1;
+    }
+
+    /// Pass 2 and, when needed, the slow path (module docs); `near(j)`
+    /// says whether segment `j` comes within the FOE-near radius (frame 2
+    /// with `W' < 0`; `None` otherwise).
+    pub(crate) fn finish(self, near: Option<&dyn Fn(usize) -> bool>) {
+        let Builder {
+            index,
+            o,
+            n,
+            first,
+            last,
+            sum,
+            order,
+            period,
+            ..
+        } = self;
+        let s = n.saturating_sub(1);
+        index.segments = s;
+        index.strict = order.strict(period);
+        let odd = order.odd;
+        // The keys (oriented by `o`) fall overall: orient them the other way.
+        let flip = last < first;
+        index.orient = o;
+        let wide = WIDE * sum / fmax(s as f32, 1.0);
+        let loose = index.suffix_minima(wide);
+        index.loose = loose;
+        if loose || odd || flip {
+            index.rebuild(if flip { -o } else { o }, wide);
+        }
+        index.kmin = index.seg.first().map_or(f32::INFINITY, |g| g.sm);
+        index.kmax = index
+            .seg
+            .get(s.wrapping_sub(1))
+            .map_or(f32::NEG_INFINITY, |g| g.pm);
+        for &(_, l, h) in index.aside.iter() {
+            if l.is_finite() && h.is_finite() {
+                index.kmin = fmin(index.kmin, l);
+                index.kmax = fmax(index.kmax, h);
+            }
+        }
+        if let Some(is_near) = near {
+            for j in 0..s {
+                if is_near(j) {
+                    match u16::try_from(j).ok().map(|jj| index.near.push(jj)) {
+                        Some(Ok(())) => {}
+                        _ => index.near_overflow = true,
+                    }
+                }
+            }
+        }
+    }
+}

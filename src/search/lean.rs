@@ -1,0 +1,245 @@
+//! The walks' view of an index ([`Lean`], [`Blocks`]): the copies of a
+//! periodic query, the block tree's skips, and the run's start (probes,
+//! then bisection), shared by the wedge path and the index's own visits.
+
+use super::*;
+
+/// An index's view for a caller that walks runs itself ([`Index::lean`]).
+#[derive(Clone, Copy)]
+pub(crate) struct Lean<'a> {
+    pub(crate) segs: &'a [Seg],
+    pub(crate) orient: f32,
+    pub(crate) aside: &'a [Aside],
+    pub(crate) blocks: Blocks<'a>,
+    /// The keys' period (0: none) and range `[kmin, kmax]` ([`copies_in`]).
+    pub(super) period: f32,
+    pub(super) range: (f32, f32),
+}
+
+impl Lean<'_> {
+    /// The one copy of the oriented query `[ql, qh]` to walk
+    /// ([`copies_in`]): for keys without a period the query itself; for
+    /// periodic keys the copy `[ql + 4m, qh + 4m]` that can meet the keys'
+    /// range, or, when none can, `(−∞, −∞)` (it meets only intervals that
+    /// reach `−∞`, those of segments with an unkeyed end: a walk's run
+    /// starts where its probes from the hint, then a bisection, reach
+    /// segment 0, a few units, and its low-end tests end the run at the
+    /// first segment that does not reach `−∞`); `None` when two or more
+    /// can, or when the keys lie beyond [`COPY_REACH`] of 0.
+    #[inline(always)]
+    pub(crate) fn copy(&self, ql: f32, qh: f32) -> Option<(f32, f32)> {
+        if self.period <= 0.0 {
+            return Some((ql, qh));
+        }
+        let mut c = [(0.0f32, 0.0f32); MAX_COPIES];
+        match copies_in((self.period, self.range), ql, qh, &mut c) {
+            Some(0) => Some((f32::NEG_INFINITY, f32::NEG_INFINITY)),
+            Some(1) => c.first().copied(),
+            _ => None,
+        }
+    }
+}
+
+/// A loose index's block tree (module docs): the `(min lo, max hi)` of
+/// every aligned block of `FAN^l` segments, level after level.
+#[derive(Clone, Copy)]
+pub(crate) struct Blocks<'a> {
+    pub(super) tree: &'a [f32],
+    pub(super) levels: usize,
+    pub(super) segments: usize,
+}
+
+impl Blocks<'_> {
+    /// Whether there is a tree (a loose index).
+    #[inline(always)]
+    pub(crate) fn any(&self) -> bool {
+        self.levels > 0
+    }
+
+    /// At segment `j` of a loose index's run: how many segments from `j`
+    /// on a block skip passes over: the largest block aligned at `j` whose
+    /// key range `meets` does not accept (0: look at segment `j` itself).
+    /// At most [`LEVELS`] steps.
+    #[inline(always)]
+    pub(crate) fn skip_at(&self, j: usize, meets: impl Fn(f32, f32) -> bool) -> usize {
+        // Only a position aligned to a block starts one.
+        if j & (FAN - 1) != 0 {
+            return 0;
+        }
+        let (mut base, mut n, mut skip) = (0usize, self.segments, 0usize);
+        let mut shift = 0u32;
+        for _ in 0..self.levels.min(LEVELS) {
+            shift += FAN_BITS;
+            n = n.div_ceil(FAN);
+            // (`shift` ≤ 3 · LEVELS = 12.)
+            let size = 1usize << shift;
+            if j & (size - 1) != 0 {
+                break;
+            }
+            let b = j >> shift;
+            let (lo, hi) = (
+                self.tree
+                    .get(base + 2 * b)
+                    .copied()
+                    .unwrap_or(f32::NEG_INFINITY),
+                self.tree
+                    .get(base + 2 * b + 1)
+                    .copied()
+                    .unwrap_or(f32::INFINITY),
+            );
+            // A block that meets the query holds every larger block's
+            // range too: stop there.
+            if lo <= hi && meets(lo, hi) {
+                break;
+            }
+            skip = size;
+            base += 2 * n;
+        }
+        skip
+    }
+}
+
+impl<const N: usize> Index<N> {
+    /// The block tree as [`Blocks`] (no levels when none is built).
+    #[inline(always)]
+    pub(super) fn blocks(&self) -> Blocks<'_> {
+        Blocks {
+            tree: &self.tree,
+            levels: self.levels,
+            segments: self.segments,
+        }
+    }
+
+    /// [`Blocks::skip_at`] on this index's tree.
+    #[inline(always)]
+    pub(super) fn skip_at(&self, j: usize, meets: impl Fn(f32, f32) -> bool) -> usize {
+        self.blocks().skip_at(j, meets)
+    }
+
+    /// The copies `[ql + 4m, qh + 4m]` of an oriented query that can meet
+    /// the keys' range `[kmin, kmax]` (for non-periodic keys the query
+    /// itself, if it can), into `out`; `None` when there are more than
+    /// [`MAX_COPIES`].
+    pub(super) fn copies(
+        &self,
+        ql: f32,
+        qh: f32,
+        out: &mut [(f32, f32); MAX_COPIES],
+    ) -> Option<usize> {
+        copies_in((self.period, (self.kmin, self.kmax)), ql, qh, out)
+    }
+
+    /// The first segment `a` with `pm[a] ≥ t` ([`run_start_in`] from the
+    /// hint).
+    #[inline(always)]
+    pub(crate) fn run_start(&self, t: f32, work: &mut Work) -> Result<usize, OutOfWork> {
+        let n = self.segments.min(N);
+        run_start_in(self.seg.get(..n).unwrap_or(&[]), self.hint, t, work)
+    }
+}
+
+/// The copies `[ql + 4m, qh + 4m]` of an oriented query that can meet
+/// the keys' range `[kmin, kmax]` of an index with keys of `period` (for
+/// non-periodic keys the query itself, if it can), into `out`; `None` when
+/// there are more than [`MAX_COPIES`].
+fn copies_in(
+    (period, (kmin, kmax)): (f32, (f32, f32)),
+    ql: f32,
+    qh: f32,
+    out: &mut [(f32, f32); MAX_COPIES],
+) -> Option<usize> {
+    if period <= 0.0 {
+        if let Some(o) = out.first_mut() {
+            *o = (ql, qh);
+        }
+        return Some(usize::from(ql <= kmax && qh >= kmin));
+    }
+    // No keyed segment: no copy. (A NaN fails, and the next test takes it.)
+    if kmin > kmax {
+        return Some(0);
+    }
+    // Keys beyond `COPY_REACH` of 0 may be off by more than their margins:
+    // as many copies as can be (every segment visited, or a fold assumed).
+    // (A NaN fails.)
+    if !(kmin >= -COPY_REACH && kmax <= COPY_REACH) {
+        return None;
+    }
+    // The smallest m with qh + 4m ≥ kmin. Keys change by less than half
+    // a turn per segment, so |kmin|, |kmax| ≤ 2N + 4 and the quotient
+    // is small; it is clamped anyway before the (saturating) conversion.
+    let m0 = ((kmin - qh) * 0.25).clamp(-1.0e7, 1.0e7);
+    let mut m = m0 as i32;
+    if (m as f32) < m0 {
+        m = m.saturating_add(1);
+    }
+    let mut c = 0usize;
+    for slot in out.iter_mut() {
+        let shift = 4.0 * m as f32;
+        if ql + shift > kmax {
+            return Some(c);
+        }
+        *slot = (ql + shift, qh + shift);
+        c += 1;
+        m = m.saturating_add(1);
+    }
+    // All slots used: a further copy would overflow.
+    (ql + 4.0 * m as f32 > kmax).then_some(c)
+}
+
+/// The first segment `a` of `seg` with `pm[a] ≥ t`: probes from `hint`,
+/// then bisection after [`PROBES`] (each bisection step one unit of work).
+#[inline(always)]
+pub(crate) fn run_start_in(
+    seg: &[Seg],
+    hint: usize,
+    t: f32,
+    work: &mut Work,
+) -> Result<usize, OutOfWork> {
+    let n = seg.len();
+    let at = |j: usize| seg.get(j).map_or(f32::INFINITY, |g| g.pm);
+    let mut j = hint.min(n.saturating_sub(1));
+    let mut probes = PROBES;
+    if at(j) >= t {
+        // Back while the one before still reaches t.
+        while j > 0 && at(j - 1) >= t {
+            if probes == 0 {
+                return bisect(seg, 0, j, t, work);
+            }
+            probes -= 1;
+            j -= 1;
+        }
+        Ok(j)
+    } else {
+        // Forward to the first that reaches t.
+        while j < n && at(j) < t {
+            if probes == 0 {
+                return bisect(seg, j, n, t, work);
+            }
+            probes -= 1;
+            j += 1;
+        }
+        Ok(j)
+    }
+}
+
+/// First index in `[lo, hi)` with `v[j] ≥ t` (non-decreasing `v`), or `hi`;
+/// each step one unit of work.
+fn bisect(
+    v: &[Seg],
+    mut lo: usize,
+    mut hi: usize,
+    t: f32,
+    work: &mut Work,
+) -> Result<usize, OutOfWork> {
+    hi = hi.min(v.len());
+    while lo < hi {
+        work.spend(1)?;
+        let m = lo + (hi - lo) / 2;
+        if v.get(m).map_or(f32::INFINITY, |g| g.pm) >= t {
+            hi = m;
+        } else {
+            lo = m + 1;
+        }
+    }
+    Ok(hi)
+}

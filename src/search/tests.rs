@@ -1,0 +1,341 @@
+//! The search structure's unit tests: every query against a scan of every
+//! segment, the fold test against brute force, the copies of periodic keys.
+
+use super::*;
+use crate::test_rng::Rng;
+extern crate std;
+use std::vec::Vec;
+
+pub(crate) const CAP: usize = 96;
+
+/// A random key sequence of one of several shapes, with margins; some
+/// keys missing ([`NO_KEY`]); periodic ones in `[0, 4)` when `period`.
+pub(crate) fn keys(rng: &mut Rng, shape: u32, n: usize, period: bool) -> Vec<(f32, f32)> {
+    let mut k = rng.next() * 2.0 - 1.0;
+    let step = 0.002 + 0.05 * rng.next();
+    let mut out = Vec::new();
+    for i in 0..n {
+        let e = 1.0e-4 * rng.next();
+        k += match shape {
+            // Monotone.
+            0 => step,
+            // Monotone with jitter.
+            1 => step * (1.0 + 1.5 * (rng.next() - 0.5)),
+            // A fold halfway.
+            2 if i > n / 2 => -step,
+            2 => step,
+            // Nearly constant (radial).
+            3 => 1.0e-4 * (rng.next() - 0.5),
+            // Zig-zag.
+            _ => {
+                if i % 2 == 0 {
+                    step
+                } else {
+                    -0.8 * step
+                }
+            }
+        };
+        let mut v = k;
+        // Spikes (spurious points).
+        if rng.next() < 0.04 {
+            v += (rng.next() - 0.5) * 3.0;
+        }
+        if period {
+            v = v.rem_euclid(4.0);
+        }
+        if rng.next() < 0.02 {
+            out.push((NO_KEY, 0.0));
+        } else {
+            out.push((v, e));
+        }
+    }
+    out
+}
+
+/// The segments' intervals as the builder forms them, in raw keys
+/// unwrapped along the polyline for periodic keys (`None`: an end
+/// without a key).
+pub(crate) fn intervals(ks: &[(f32, f32)], period: bool) -> Vec<Option<(f32, f32)>> {
+    let mut unwrapped = Vec::new();
+    let (mut offset, mut last) = (0.0f32, NO_KEY);
+    for &(k, e) in ks {
+        if !k.is_finite() {
+            unwrapped.push((k, e));
+            continue;
+        }
+        let mut v = k + offset;
+        if period {
+            let d = v - last;
+            if d > 2.0 {
+                offset -= 4.0;
+                v -= 4.0;
+            } else if d < -2.0 {
+                offset += 4.0;
+                v += 4.0;
+            }
+            last = v;
+        }
+        unwrapped.push((v, e));
+    }
+    unwrapped
+        .windows(2)
+        .map(|w| {
+            let ((a, ea), (b, eb)) = (w[0], w[1]);
+            (a.is_finite() && b.is_finite()).then(|| (fmin(a - ea, b - eb), fmax(a + ea, b + eb)))
+        })
+        .collect()
+}
+
+/// Whether an interval meets `[lo, hi]` or one of its copies `+ 4m`.
+pub(crate) fn meets(iv: (f32, f32), (lo, hi): (f32, f32), period: bool) -> bool {
+    if !period {
+        return iv.0 <= hi && iv.1 >= lo;
+    }
+    (-40..=40).any(|m| {
+        let s = 4.0 * m as f32;
+        iv.0 <= hi + s && iv.1 >= lo + s
+    })
+}
+
+/// The segments offered, and whether in increasing order.
+#[derive(Clone, Copy)]
+struct Record {
+    seen: [bool; CAP],
+    last: Option<usize>,
+    ordered: bool,
+}
+impl Visitor for Record {
+    fn segment(&mut self, j: usize, _: (f32, f32)) -> (Flow, u32) {
+        self.ordered &= self.last.is_none_or(|l| j > l);
+        self.last = Some(j);
+        if let Some(s) = self.seen.get_mut(j) {
+            *s = true;
+        }
+        (Flow::Continue, 0)
+    }
+}
+
+#[derive(Clone, Copy)]
+struct Count(usize, usize);
+impl Visitor for Count {
+    fn segment(&mut self, j: usize, _: (f32, f32)) -> (Flow, u32) {
+        // Increasing indices, counted.
+        assert!(self.1 == usize::MAX || j > self.1, "{j} after {}", self.1);
+        self.1 = j;
+        self.0 += 1;
+        (Flow::Continue, 0)
+    }
+}
+
+/// The index offers every segment whose interval meets the query (a
+/// segment with an unkeyed end meets every query, in frame 2's index),
+/// in increasing order, whatever the shape of the keys: monotone,
+/// jittering, folding, radial, zig-zag, with spikes and missing keys,
+/// periodic or not, either orientation guess.
+#[test]
+fn visit_offers_every_segment_that_meets_the_query() {
+    let mut rng = Rng(0x5ea7_c401);
+    let mut index = Index::<CAP>::new();
+    for case in 0..3000 {
+        let (shape, period) = (case % 5, case % 3 == 0);
+        let n = 2 + (rng.next() * (CAP - 2) as f32) as usize;
+        let ks = keys(&mut rng, shape, n, period);
+        let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+        let mut b = index.builder((if period { 4.0 } else { 0.0 }, orient), Unkeyed::MeetAll);
+        if case % 2 == 0 {
+            b.push_all(ks.iter().copied());
+        } else {
+            for &(k, e) in &ks {
+                b.push(k, e);
+            }
+        }
+        b.finish(None);
+        let ivs = intervals(&ks, period);
+        for _ in 0..8 {
+            let c = if period {
+                4.0 * rng.next()
+            } else {
+                rng.next() * 3.0 - 1.5
+            };
+            let w = 0.2 * rng.next() * rng.next();
+            let q = (c - w, c + w);
+            let mut rec = Record {
+                seen: [false; CAP],
+                last: None,
+                ordered: true,
+            };
+            let mut work = Work::new();
+            work.grant(u32::MAX);
+            assert!(index
+                .visit(Query::Keys(q.0, q.1), false, None, &mut work, &mut rec)
+                .is_ok());
+            assert!(rec.ordered, "case {case}: out of order");
+            for (j, iv) in ivs.iter().enumerate() {
+                let must = iv.is_none_or(|iv| meets(iv, q, period));
+                assert!(
+                    !must || rec.seen[j],
+                    "case {case} (shape {shape}, period {period}): segment {j} {iv:?} meets {q:?} but was not offered"
+                );
+            }
+            let mut count = Count(0, usize::MAX);
+            let mut work = Work::new();
+            work.grant(u32::MAX);
+            assert!(index
+                .visit(Query::Everything, false, None, &mut work, &mut count)
+                .is_ok());
+            assert_eq!(count.0, n - 1, "case {case}: every segment for Everything");
+        }
+    }
+}
+
+/// The fold test (the `strict` certificate, the envelopes' `O(1)`
+/// answer and the query) equals the brute force: a vertex folds when its
+/// widened key meets a segment outside its window (a segment with an
+/// unkeyed end meets nothing here).
+#[test]
+fn folds_equals_brute_force() {
+    let mut rng = Rng(0xf01d_0002);
+    let mut index = Index::<CAP>::new();
+    let w = 4;
+    for case in 0..3000 {
+        let (shape, period) = (case % 5, case % 3 == 0);
+        let n = 2 + (rng.next() * (CAP - 2) as f32) as usize;
+        let ks = keys(&mut rng, shape, n, period);
+        let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+        let mut b = index.builder((if period { 4.0 } else { 0.0 }, orient), Unkeyed::MeetNone);
+        if case % 2 == 0 {
+            b.push_all(ks.iter().copied());
+        } else {
+            for &(k, e) in &ks {
+                b.push(k, e);
+            }
+        }
+        b.finish(None);
+        let ivs = intervals(&ks, period);
+        for (i, &(k, e)) in ks.iter().enumerate() {
+            if !k.is_finite() {
+                continue;
+            }
+            let brute = ivs.iter().enumerate().any(|(j, iv)| {
+                let outside = j + w < i || j > i + w - 1;
+                outside && iv.is_some_and(|iv| meets(iv, (k - e, k + e), period))
+            });
+            let mut work = Work::new();
+            work.grant(u32::MAX);
+            let fast = index.folds(i, k, w, &mut work);
+            assert_eq!(
+                fast,
+                Ok(brute),
+                "case {case} (shape {shape}, period {period}) vertex {i} key {k}"
+            );
+        }
+    }
+}
+
+/// [`Lean::copy`] on pseudo-angle keys: the one copy of a query that can
+/// meet the keys' range, the query that meets none (`(−∞, −∞)`), none
+/// when two copies can (the keys span nearly a turn, or many turns);
+/// and the query itself without a period.
+#[test]
+fn lean_copy_picks_the_single_copy() {
+    let mut index = Index::<16>::new();
+    let mut b = index.builder((4.0, 1.0), Unkeyed::MeetAll);
+    b.push_all([0.5f32, 1.5, 2.5, 3.5, 3.9].iter().map(|&k| (k, 0.0)));
+    b.finish(None);
+    let lean = index.lean();
+    let none = Some((f32::NEG_INFINITY, f32::NEG_INFINITY));
+    // (The unwrapped keys start at some whole number of turns.)
+    let o = lean.range.0 - 0.5;
+    assert_eq!(lean.range, (0.5 + o, 3.9 + o));
+    assert_eq!(lean.copy(1.0, 1.2), Some((1.0 + o, 1.2 + o)));
+    assert_eq!(lean.copy(5.0, 5.2), Some((1.0 + o, 1.2 + o)));
+    assert_eq!(lean.copy(-3.0, -2.8), Some((1.0 + o, 1.2 + o)));
+    assert_eq!(lean.copy(0.1, 0.3), none);
+    assert_eq!(lean.copy(4.1, 4.3), none);
+    // [-0.2, 0.6] and [3.8, 4.6] both meet [0.5, 3.9].
+    assert_eq!(lean.copy(-0.2, 0.6), None);
+    let mut wound = Index::<64>::new();
+    let mut b = wound.builder((4.0, 1.0), Unkeyed::MeetAll);
+    // Nine turns at 1.5 a step: a query meets many copies.
+    b.push_all((0..26).map(|i| ((1.5 * i as f32) % 4.0, 0.0)));
+    b.finish(None);
+    let lean = wound.lean();
+    assert!(lean.range.1 - lean.range.0 > 36.0, "{:?}", lean.range);
+    assert_eq!(lean.copy(1.0, 1.1), None, "many copies");
+    // More copies than searched one by one (and keys past COPY_REACH):
+    // a query visits every segment.
+    assert!(lean.range.1 > COPY_REACH, "{:?}", lean.range);
+    let mut seen = Record {
+        seen: [false; CAP],
+        last: None,
+        ordered: true,
+    };
+    let mut work = Work::new();
+    work.grant(10_000);
+    let q = Query::Keys(40.0, 40.1);
+    assert!(wound.visit(q, false, None, &mut work, &mut seen).is_ok());
+    assert!(
+        seen.seen.iter().take(25).all(|&x| x),
+        "every segment offered"
+    );
+    // Keys beyond COPY_REACH of 0 (hand-made): no walk, whether one
+    // copy meets them or none.
+    let far = |range| Lean {
+        segs: &[],
+        orient: 1.0,
+        aside: &[],
+        blocks: Blocks {
+            tree: &[],
+            levels: 0,
+            segments: 0,
+        },
+        period: 4.0,
+        range,
+    };
+    assert_eq!(far((30.0, 31.0)).copy(2.2, 2.4), Some((30.2, 30.4)));
+    assert_eq!(far((31.0, 33.0)).copy(3.2, 3.4), None, "one copy");
+    assert_eq!(far((31.0, 33.0)).copy(2.0, 2.5), None, "no copy");
+    assert_eq!(far((-34.0, -33.0)).copy(2.2, 2.4), None);
+    assert_eq!(far((-34.0, f32::NAN)).copy(2.2, 2.4), None);
+    // No keyed segment (an empty range): the empty copy.
+    assert_eq!(
+        far((f32::INFINITY, f32::NEG_INFINITY)).copy(2.2, 2.4),
+        Some((f32::NEG_INFINITY, f32::NEG_INFINITY))
+    );
+    // Without a period: the query itself.
+    let mut flat = Index::<16>::new();
+    let mut b = flat.builder((0.0, 1.0), Unkeyed::MeetAll);
+    b.push_all([0.1f32, 0.2, 0.3].iter().map(|&k| (k, 0.0)));
+    b.finish(None);
+    assert_eq!(flat.lean().copy(5.0, 6.0), Some((5.0, 6.0)));
+}
+
+/// A segment of pseudo-angle keys whose ends are half a turn apart to
+/// within their margins (it passes within a hair of the FOE) may go
+/// either way round: it is offered to every query, as a segment with
+/// an unkeyed end is, not to the half-turn its rounded keys suggest.
+/// (Here the keys say 2 + 10⁻⁶ apart, unwrapped to the other way
+/// round, while a ray of key 2 may well meet it.)
+#[test]
+fn a_segment_half_a_turn_long_meets_every_key() {
+    for (a, b) in [(1.0f32, 3.000_001f32), (3.000_001, 1.0), (0.5, 2.499_999)] {
+        let mut index = Index::<8>::new();
+        let mut builder = index.builder((4.0, 1.0), Unkeyed::MeetAll);
+        builder.push_all([(a, 1.0e-5), (b, 1.0e-5)].into_iter());
+        builder.finish(None);
+        let mid = 0.5 * (a + b);
+        let mut seen = Record {
+            seen: [false; CAP],
+            last: None,
+            ordered: true,
+        };
+        let mut work = Work::new();
+        work.grant(1000);
+        let q = Query::Keys(mid - 0.01, mid + 0.01);
+        assert!(index.visit(q, false, None, &mut work, &mut seen).is_ok());
+        assert!(
+            seen.seen[0],
+            "({a}, {b}): the segment was not offered for key {mid}"
+        );
+    }
+}

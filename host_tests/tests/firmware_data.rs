@@ -79,7 +79,7 @@ fn embedded_frames_match_the_generator() {
 /// `host_tests/src/drive/adversarial.rs` and `adversarial_found.json`
 /// (regenerate with `cargo run --release --bin adversarial`), and every
 /// pair passes the library's validation: two boundaries of exactly N
-/// points in each frame, at most one point per image row, every boundary
+/// points in each frame, rows strictly one way, every boundary
 /// accepted by `Frame::push_boundary`, the motion by `Motion::new`.
 #[test]
 fn adversarial_frames_match_the_generator_and_pass_validation() {
@@ -124,9 +124,13 @@ fn adversarial_frames_match_the_generator_and_pass_validation() {
                     .collect();
                 for b in &bs {
                     assert_eq!(b.len(), n, "{} {n}: N points per boundary", m.name);
+                    // Rows strictly one way (the library's own rule); most
+                    // members have one point per row, the forward spirals
+                    // about an FOE inside the image up to two.
                     assert!(
-                        b.windows(2).all(|w| (w[1].v - w[0].v).abs() >= 0.999),
-                        "{} {n}: one point per row",
+                        b.windows(2).all(|w| w[1].v < w[0].v)
+                            || b.windows(2).all(|w| w[1].v > w[0].v),
+                        "{} {n}: rows one way",
                         m.name
                     );
                 }

@@ -43,7 +43,7 @@ static STRESS: [(u32, &[u8]); 2] = [
     (512, include_bytes!("data/stress_512.bin")),
 ];
 
-// The adversarial family: `static ADVERSARIAL: &[(&str, u32, &[u8])]`, one
+// The adversarial family: `static ADVERSARIAL: &[(&str, u32, u8, &[u8])]` (name, N, error model, data), one
 // (member, N, RSD1 frame pair) per line, written by the generator
 // (`cd host_tests && cargo run --release --bin adversarial`).
 include!("data/adversarial.rs");
@@ -319,12 +319,18 @@ fn main() -> ! {
             r.processed
         );
     }
-    for (name, n, data) in ADVERSARIAL.iter() {
+    for (name, n, errors, data) in ADVERSARIAL.iter() {
         let Some(m) = load(data, &mut f1, &mut f2) else {
             defmt::error!("bad adversarial data for {=str} n={=u32}", name, n);
             fw::exit(false)
         };
+        let Some(c) = member_config(*errors, Config::DEFAULT_WORK_PER_POINT) else {
+            defmt::error!("bad error model for {=str}", name);
+            fw::exit(false)
+        };
+        processor.set_config(c);
         let r = measure_pair(processor, &f1, &f2, &m);
+        processor.set_config(Config::DEFAULT);
         defmt::info!(
             "adversarial name={=str} n={=u32} points={=u32} instr={=u32} per_point={=u32} digest={=u32:08x} processed={=bool} work_spent={=u32} work_granted={=u32} {=str}",
             name,
@@ -365,6 +371,22 @@ fn main() -> ! {
         p - f - s
     );
     fw::exit(true)
+}
+
+/// An adversarial member's configuration: its error model (the id in
+/// `data/adversarial.rs`, `Errors::id` in `host_tests/src/drive/adversarial.rs`)
+/// with a work budget of `w` units per point.
+fn member_config(errors: u8, w: u32) -> Option<Config> {
+    let c = match errors {
+        0 => Config::DEFAULT,
+        1 => Config::DEFAULT.with_rotation_error([0.01; 3]).ok()?,
+        2 => Config::DEFAULT
+            .with_rotation_error([0.0, 0.0, 0.001])
+            .ok()?,
+        3 => Config::DEFAULT.with_translation_error(0.02).ok()?,
+        _ => return None,
+    };
+    c.with_work_budget(w).ok()
 }
 
 /// Budgets of the work sweep, units per point: the smallest accepted, two
@@ -418,12 +440,12 @@ fn worst_case_sweep(
             }
         }
     }
-    for (name, n, data) in ADVERSARIAL.iter().filter(|a| a.1 == 256) {
+    for (name, n, errors, data) in ADVERSARIAL.iter().filter(|a| a.1 == 256) {
         let Some(m) = load(data, f1, f2) else {
             continue;
         };
         for w in SWEEP {
-            let Ok(c) = Config::DEFAULT.with_work_budget(w) else {
+            let Some(c) = member_config(*errors, w) else {
                 continue;
             };
             processor.set_config(c);

@@ -194,6 +194,11 @@ pub struct Params {
     /// below the horizon; 0: the whole image).
     #[serde(default)]
     pub top: f64,
+    /// The camera moves backwards: the two frames swapped (frame 2's view
+    /// first) and the motion inverted. The per-frame settings above
+    /// (`zigzag`, `spurious`, `lift`) name the frames before the swap.
+    #[serde(default)]
+    pub reverse: bool,
 }
 
 impl Params {
@@ -209,6 +214,50 @@ impl Params {
             spurious: Vec::new(),
             lift: None,
             top: 0.0,
+            reverse: false,
+        }
+    }
+}
+
+/// The error model a member's processor is configured with (`Config`
+/// builders; the bench firmware's `member_config` maps the same ids).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Errors {
+    /// `Config::DEFAULT`: localisation errors only.
+    #[default]
+    Default,
+    /// A rotation error of 0.01 rad about each axis
+    /// (`with_rotation_error([0.01; 3])`): step 1 certifies no image, the
+    /// points are checked one by one.
+    Rotation,
+    /// A rotation error of 0.001 rad about the optical axis only.
+    RotationZ,
+    /// A translation error of 0.02 (`with_translation_error(0.02)`): the
+    /// wedge does not hold the band, every point takes the band path.
+    Translation,
+}
+
+impl Errors {
+    /// The processor's configuration (the bench firmware's `member_config`
+    /// at the default work budget).
+    pub fn config(self) -> roadstereo::Config {
+        let c = roadstereo::Config::DEFAULT;
+        match self {
+            Errors::Default => Ok(c),
+            Errors::Rotation => c.with_rotation_error([0.01; 3]),
+            Errors::RotationZ => c.with_rotation_error([0.0, 0.0, 0.001]),
+            Errors::Translation => c.with_translation_error(0.02),
+        }
+        .expect("valid error bounds")
+    }
+
+    /// The id in the firmware's table.
+    pub fn id(self) -> u8 {
+        match self {
+            Errors::Default => 0,
+            Errors::Rotation => 1,
+            Errors::RotationZ => 2,
+            Errors::Translation => 3,
         }
     }
 }
@@ -223,6 +272,9 @@ pub struct Member {
     pub what: String,
     /// The pair.
     pub params: Params,
+    /// The processor's error model.
+    #[serde(default)]
+    pub errors: Errors,
 }
 
 /// Vertex 1 and vertex N − 2 of both boundaries moved to the left image
@@ -251,14 +303,16 @@ pub fn hand_members() -> Vec<Member> {
         name: name.into(),
         what: what.into(),
         params,
+        errors: Errors::Default,
     };
+    let with = |errors: Errors, member: Member| Member { errors, ..member };
     let fig6 = Params::fig6();
     let straight = Params {
         scene: Scene::Straight,
         rows: Rows::Integer,
         ..Params::fig6()
     };
-    vec![
+    let v = vec![
         m(
             "spur_f2",
             "the representative pair, vertex 1 and N-2 of each frame-2 boundary moved to the left image edge (column 0): one early and one late outlying key in the frame-2 index",
@@ -363,7 +417,141 @@ pub fn hand_members() -> Vec<Member> {
                 ..fig6.clone()
             },
         ),
-    ]
+    ];
+    // Found by an adversarial review (issue 11): backward motion (every
+    // point on the band path), forward log spirals about an FOE inside the
+    // image, and configured motion errors; the formula of README's "Worst
+    // case" did not hold on them until they joined the family.
+    let get = |name: &str| {
+        v.iter()
+            .find(|x| x.name == name)
+            .map(|x| x.params.clone())
+            .unwrap_or_else(Params::fig6)
+    };
+    let spur = |frames: u8, boundary: usize, from_end: bool, k: usize, u: f64| Spur {
+        frames,
+        boundary,
+        from_end,
+        k,
+        u,
+    };
+    let (foe_row, near_foe, radial_stair) = (get("foe_row"), get("near_foe"), get("radial_stair"));
+    let extra = vec![
+        m(
+            "back_spiral",
+            "moving backwards past log spirals 1.9 degrees off the radial direction, exact columns, the FOE just above the image (row -22), the camera turned 1.5 degrees, spurious points in both frames: every point takes the band path, whose runs reach to the FOE",
+            Params {
+                scene: Scene::Spiral { deg: 1.9 },
+                quantise: false,
+                foe: Foe::At {
+                    u: 243.064,
+                    v: -22.152,
+                },
+                turn: [0.0, 1.475, 0.0],
+                spurious: vec![
+                    spur(3, 1, true, 4, 0.864),
+                    spur(1, 0, true, 7, 0.0),
+                    spur(3, 0, false, 4, 0.264),
+                    spur(3, 1, true, 1, 1.0),
+                ],
+                reverse: true,
+                ..fig6.clone()
+            },
+        ),
+        m(
+            "back_radial_stair",
+            "radial_stair driven backwards: the band path along a near-radial staircase",
+            Params {
+                reverse: true,
+                ..radial_stair
+            },
+        ),
+        m(
+            "back_foe_row",
+            "foe_row driven backwards: pseudo-angle keys on the band path",
+            Params {
+                reverse: true,
+                ..foe_row.clone()
+            },
+        ),
+        m(
+            "fwd_spiral",
+            "log spirals 10.7 degrees off radial about an FOE inside the image (row 170), exact columns, a 2 px zig-zag in frame 2, the camera turned 1 degree, spurious points: pseudo-angle keys, the fold test's queries and long angular walks",
+            Params {
+                scene: Scene::Spiral { deg: 10.69 },
+                quantise: false,
+                foe: Foe::At {
+                    u: 207.844,
+                    v: 169.838,
+                },
+                turn: [0.558, 0.0, -0.929],
+                zigzag: [0.0, 2.0],
+                spurious: vec![
+                    spur(3, 0, true, 8, 0.0),
+                    spur(2, 0, true, 0, 0.0),
+                    spur(1, 0, true, 2, 1.0),
+                ],
+                ..fig6.clone()
+            },
+        ),
+        m(
+            "fwd_spiral_zz",
+            "log spirals 1.9 degrees off radial about an FOE at row 143, columns rounded, a 10 px zig-zag in frame 2, spurious points in both frames",
+            Params {
+                scene: Scene::Spiral { deg: 1.87 },
+                foe: Foe::At {
+                    u: 197.826,
+                    v: 142.712,
+                },
+                turn: [1.054, -0.026, 0.0],
+                zigzag: [0.0, 10.0],
+                spurious: vec![
+                    spur(2, 1, true, 4, 0.0),
+                    spur(2, 0, true, 10, 1.0),
+                    spur(2, 0, false, 0, 0.0),
+                    spur(1, 1, false, 5, 0.551),
+                    spur(3, 1, false, 9, 0.0),
+                    spur(3, 1, true, 5, 1.0),
+                ],
+                ..fig6.clone()
+            },
+        ),
+        with(
+            Errors::Rotation,
+            m(
+                "foe_row_rot_err",
+                "foe_row with a rotation error of 0.01 rad about each axis configured: no certified image, the band widened by the rotation's uncertainty",
+                foe_row.clone(),
+            ),
+        ),
+        with(
+            Errors::RotationZ,
+            m(
+                "foe_row_rot_z",
+                "foe_row with a rotation error of 0.001 rad about the optical axis",
+                foe_row,
+            ),
+        ),
+        with(
+            Errors::Rotation,
+            m(
+                "near_foe_rot_err",
+                "near_foe with a rotation error of 0.01 rad about each axis",
+                near_foe.clone(),
+            ),
+        ),
+        with(
+            Errors::Translation,
+            m(
+                "near_foe_trans_err",
+                "near_foe with a translation error of 0.02: every point on the band path",
+                near_foe,
+            ),
+        ),
+    ];
+    let mut v = v;
+    v.extend(extra);
+    v
 }
 
 /// The members the seeded search kept (`adversarial_found.json`).
@@ -678,7 +866,12 @@ pub fn render(p: &Params, n: usize) -> Result<(Intrinsics, Vec<DriveFrame>), Str
         }
         b[len - 1] = q;
     }
-    let (t, a) = m.p1.motion_to(&m.p2);
+    let (t, a) = if p.reverse {
+        frames.swap(0, 1);
+        m.p2.motion_to(&m.p1)
+    } else {
+        m.p1.motion_to(&m.p2)
+    };
     let out = frames
         .iter()
         .enumerate()
@@ -763,10 +956,11 @@ pub fn host_cost(
     k: &Intrinsics,
     frames: &[DriveFrame],
     reps: usize,
+    errors: Errors,
 ) -> (f64, Vec<(String, usize)>) {
-    use roadstereo::{Config, Processor, Status};
+    use roadstereo::{Processor, Status};
     let (f1, f2, m) = library_pair(k, frames);
-    let mut p = Box::new(Processor::<512, 2>::new(Config::default()));
+    let mut p = Box::new(Processor::<512, 2>::new(errors.config()));
     let mut best = f64::INFINITY;
     for _ in 0..reps.max(1) {
         p.reset();
@@ -793,13 +987,15 @@ pub fn firmware_table(members: &[Member]) -> String {
         "// Generated by `cd host_tests && cargo run --release --bin adversarial` (see\n\
          // host_tests/src/drive/adversarial.rs): the adversarial family, one RSD1 frame\n\
          // pair per member and N. Do not edit.\n\
-         static ADVERSARIAL: &[(&str, u32, &[u8])] = &[\n",
+         // The third field is the member's error model (`Errors::id`).\n\
+         static ADVERSARIAL: &[(&str, u32, u8, &[u8])] = &[\n",
     );
     for m in members {
         for n in SIZES {
             s.push_str(&format!(
-                "    (\"{}\", {n}, include_bytes!(\"{}\")),\n",
+                "    (\"{}\", {n}, {}, include_bytes!(\"{}\")),\n",
                 m.name,
+                m.errors.id(),
                 file_name(&m.name, n)
             ));
         }

@@ -17,7 +17,7 @@
 //! chosen by a tournament of three (or six, half the time) over the members
 //! and the mutants so far.
 //! At the end the costliest mutants are timed again (3 × `--reps`), and the
-//! `--keep` costliest of distinct shapes (scene, rounding, frames with
+//! `--keep` costliest of distinct shapes (scene, rounding, direction, frames with
 //! spurious points, FOE moved, zig-zag, lift) are written to
 //! `src/drive/adversarial_found.json` as `search_1`, `search_2`, …, then
 //! every data file is rewritten (`--no-write` skips both).
@@ -145,8 +145,9 @@ fn shape(p: &Params) -> String {
     };
     let spur_frames = p.spurious.iter().fold(0, |m, s| m | s.frames);
     format!(
-        "{scene} q{} spurs:{spur_frames} foe:{} zz:{}{} lift:{}",
+        "{scene} q{} back:{} spurs:{spur_frames} foe:{} zz:{}{} lift:{}",
         p.quantise,
+        p.reverse,
         matches!(p.foe, Foe::At { .. }),
         p.zigzag[0] > 0.0,
         p.zigzag[1] > 0.0,
@@ -166,6 +167,9 @@ fn describe(p: &Params) -> String {
         if p.quantise { "rounded" } else { "exact" },
         p.rows
     );
+    if p.reverse {
+        s += ", driven backwards";
+    }
     if let Foe::At { u, v } = p.foe {
         s += &format!(", FOE at ({u:.1}, {v:.1})");
     }

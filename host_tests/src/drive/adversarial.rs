@@ -1025,8 +1025,9 @@ pub fn write_all(dir: &std::path::Path, members: &[Member]) -> Result<usize, Str
 
 // ---- the seeded search ----
 
-/// A random change to a pair (one of: rounding, rows, scene, FOE, camera
-/// turn, zig-zag, a spurious point added, moved or removed, the lift).
+/// A random change to a pair (one of: rounding or the direction of
+/// travel, rows, scene, FOE, camera turn, zig-zag, a spurious point added,
+/// moved or removed, the lift).
 /// Every change is in paper pixels or counted from a boundary's end, so a
 /// mutant is the same scene at every N.
 pub fn mutate(p: &Params, g: &mut synth::Rng) -> Params {
@@ -1053,6 +1054,7 @@ fn mutate_raw(p: &Params, g: &mut synth::Rng) -> Params {
     let mut q = p.clone();
     let pick = |g: &mut synth::Rng, n: usize| (g.next_u64() % n as u64) as usize;
     match pick(g, 10) {
+        0 if g.chance(0.25) => q.reverse = !q.reverse,
         0 => q.quantise = !q.quantise,
         1 => {
             q.rows = match q.rows {

@@ -723,13 +723,18 @@ fn resample(
     top: f64,
 ) -> Result<Vec<[f64; 2]>, String> {
     let bottom = f64::from(k.height) - 1.0;
-    let inside: Vec<[f64; 2]> = curve
-        .iter()
-        .copied()
-        .filter(|p| {
-            (top..=bottom).contains(&p[1]) && (0.0..=f64::from(k.width) - 1.0).contains(&p[0])
-        })
-        .collect();
+    let seen = |p: &[f64; 2]| {
+        (top..=bottom).contains(&p[1]) && (0.0..=f64::from(k.width) - 1.0).contains(&p[0])
+    };
+    // One stretch of the curve inside the image: a curve that leaves it and
+    // comes back would be bridged by a chord far from the true curve (a
+    // pair outside the error model).
+    let first = curve.iter().position(seen).unwrap_or(curve.len());
+    let last = curve.iter().rposition(seen).unwrap_or(0);
+    if first <= last && !curve[first..=last].iter().all(seen) {
+        return Err("curve leaves the image and comes back".into());
+    }
+    let inside: Vec<[f64; 2]> = curve.iter().copied().filter(seen).collect();
     if inside.len() < 2 || inside.windows(2).any(|w| w[1][1] >= w[0][1]) {
         return Err("curve not v-monotone inside the image".into());
     }

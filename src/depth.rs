@@ -519,9 +519,42 @@ pub(crate) fn interval(s_near: f32, s_far: f32, iz: f32, kappa: f32) -> Option<D
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::test_rng::Rng;
+
+    /// A frame-2 point the band of `p` holds, for the pair `W' = w`, `g`
+    /// and the principal point `c2`: a true frame-1 point within `r₁` of
+    /// `p`, its depth `s` drawn by `depth` (`None`: no point), a polyline
+    /// point within `e₂` of its correspondent, computed in `f64`.
+    pub(crate) fn band_point(
+        rng: &mut Rng,
+        (w, g, c2): (f32, [f32; 2], [f32; 2]),
+        p: [f32; 2],
+        (r1, e2): (f32, f32),
+        depth: impl FnOnce(&mut Rng, f64) -> Option<f64>,
+    ) -> Option<[f32; 2]> {
+        let ang = rng.next() * core::f32::consts::TAU;
+        let rad = f64::from(r1) * f64::from(rng.next());
+        let pt = [
+            f64::from(p[0]) + rad * f64::from(libm::cosf(ang)),
+            f64::from(p[1]) + rad * f64::from(libm::sinf(ang)),
+        ];
+        let wf = f64::from(w);
+        let at = [
+            wf * (pt[0] - f64::from(c2[0])) - f64::from(g[0]),
+            wf * (pt[1] - f64::from(c2[1])) - f64::from(g[1]),
+        ];
+        let s = depth(rng, wf)?;
+        let tau = 1.0 / (s - wf);
+        let p2 = [pt[0] + tau * at[0], pt[1] + tau * at[1]];
+        let ang2 = rng.next() * core::f32::consts::TAU;
+        let rad2 = f64::from(e2) * f64::from(rng.next());
+        Some([
+            (p2[0] + rad2 * f64::from(libm::cosf(ang2))) as f32,
+            (p2[1] + rad2 * f64::from(libm::sinf(ang2))) as f32,
+        ])
+    }
 
     /// The band's region holds every frame-2 point the error model allows:
     /// random true frame-1 points within `r₁`, translation errors within
@@ -551,31 +584,14 @@ mod tests {
             let Ok(band) = Band::new(p, a, w, &err, 20.0) else {
                 continue;
             };
-            // A true point and depth.
-            let ang = rng.next() * core::f32::consts::TAU;
-            let rad = f64::from(err.r1) * f64::from(rng.next());
-            let pt = [
-                f64::from(p[0]) + rad * f64::from(libm::cosf(ang)),
-                f64::from(p[1]) + rad * f64::from(libm::sinf(ang)),
-            ];
-            let wf = f64::from(w);
-            let at = [
-                wf * (pt[0] - f64::from(c2[0])) - f64::from(g[0]),
-                wf * (pt[1] - f64::from(c2[1])) - f64::from(g[1]),
-            ];
-            let s = 0.5 + 40.0 * f64::from(rng.next());
-            if s - wf <= 0.0 {
+            // A true point and depth, a polyline point within e2 of it.
+            let depth = |rng: &mut Rng, wf: f64| {
+                let s = 0.5 + 40.0 * f64::from(rng.next());
+                (s - wf > 0.0).then_some(s)
+            };
+            let Some(q) = band_point(&mut rng, (w, g, c2), p, (err.r1, err.e2), depth) else {
                 continue;
-            }
-            let tau = 1.0 / (s - wf);
-            let p2 = [pt[0] + tau * at[0], pt[1] + tau * at[1]];
-            // A polyline point within e2 of it.
-            let ang2 = rng.next() * core::f32::consts::TAU;
-            let rad2 = f64::from(err.e2) * f64::from(rng.next());
-            let q = [
-                (p2[0] + rad2 * f64::from(libm::cosf(ang2))) as f32,
-                (p2[1] + rad2 * f64::from(libm::sinf(ang2))) as f32,
-            ];
+            };
             let c = band.vertex(q);
             assert!(
                 band.segment(&c, &c).is_some() && Band::contains(&c),

@@ -663,39 +663,13 @@ impl Visitor for WedgeWalker<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::depth::tests::band_point;
     use crate::depth::{Band, PointErrors};
     use crate::test_rng::Rng;
 
-    /// A frame-2 point the band of `p` holds, for the pair `W' = w`, `g`
-    /// and the principal point `c2`: a true frame-1 point within `r₁` of
-    /// `p`, any depth, a polyline point within `e₂` of its correspondent,
-    /// computed in `f64`.
-    fn band_point(
-        rng: &mut Rng,
-        (w, g, c2): (f32, [f32; 2], [f32; 2]),
-        p: [f32; 2],
-        (r1, e2): (f32, f32),
-    ) -> [f32; 2] {
-        let ang = rng.next() * core::f32::consts::TAU;
-        let rad = f64::from(r1) * f64::from(rng.next());
-        let pt = [
-            f64::from(p[0]) + rad * f64::from(libm::cosf(ang)),
-            f64::from(p[1]) + rad * f64::from(libm::sinf(ang)),
-        ];
-        let wf = f64::from(w);
-        let at = [
-            wf * (pt[0] - f64::from(c2[0])) - f64::from(g[0]),
-            wf * (pt[1] - f64::from(c2[1])) - f64::from(g[1]),
-        ];
-        let s = wf + 0.01 + 60.0 * f64::from(rng.next()) * f64::from(rng.next());
-        let tau = 1.0 / (s - wf);
-        let p2 = [pt[0] + tau * at[0], pt[1] + tau * at[1]];
-        let ang2 = rng.next() * core::f32::consts::TAU;
-        let rad2 = f64::from(e2) * f64::from(rng.next());
-        [
-            (p2[0] + rad2 * f64::from(libm::cosf(ang2))) as f32,
-            (p2[1] + rad2 * f64::from(libm::sinf(ang2))) as f32,
-        ]
+    /// A forward depth (`s > W'`) for [`band_point`].
+    fn forward(rng: &mut Rng, wf: f64) -> Option<f64> {
+        Some(wf + 0.01 + 60.0 * f64::from(rng.next()) * f64::from(rng.next()))
     }
 
     /// Whether the band of `p` ([`Band`], no translation error) holds `q`
@@ -739,7 +713,9 @@ mod tests {
             let foe = [c2[0] + g[0] / w, c2[1] + g[1] / w];
             let p = [512.0 * rng.next(), 480.0 * rng.next()];
             let (r1, e2) = (0.05 + rng.next(), 0.05 + rng.next());
-            let q = band_point(&mut rng, (w, g, c2), p, (r1, e2));
+            let Some(q) = band_point(&mut rng, (w, g, c2), p, (r1, e2), forward) else {
+                continue;
+            };
             // The boundary's side of the FOE's row: q's, and q keyed.
             let dq = [q[0] - foe[0], q[1] - foe[1]];
             let side = if dq[1] >= 0.0 { 1.0 } else { -1.0 };
@@ -805,7 +781,9 @@ mod tests {
             let g = [w * (foe[0] - c2[0]), w * (foe[1] - c2[1])];
             let p = [512.0 * rng.next(), 480.0 * rng.next()];
             let (r1, e2) = (0.05 + rng.next(), 0.05 + rng.next());
-            let q = band_point(&mut rng, (w, g, c2), p, (r1, e2));
+            let Some(q) = band_point(&mut rng, (w, g, c2), p, (r1, e2), forward) else {
+                continue;
+            };
             if !(q[0].abs() < 3000.0 && q[1].abs() < 3000.0) {
                 continue;
             }

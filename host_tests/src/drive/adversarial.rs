@@ -312,7 +312,7 @@ pub fn hand_members() -> Vec<Member> {
         rows: Rows::Integer,
         ..Params::fig6()
     };
-    let v = vec![
+    let mut v = vec![
         m(
             "spur_f2",
             "the representative pair, vertex 1 and N-2 of each frame-2 boundary moved to the left image edge (column 0): one early and one late outlying key in the frame-2 index",
@@ -549,7 +549,6 @@ pub fn hand_members() -> Vec<Member> {
             ),
         ),
     ];
-    let mut v = v;
     v.extend(extra);
     v
 }

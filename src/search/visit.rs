@@ -330,22 +330,14 @@ impl<const N: usize> Index<N> {
         let meets = |l: f32, h: f32| l <= qh && h >= ql;
         let (mut j, mut ia) = (a, 0usize);
         loop {
-            let run_next = match self.seg.get(j) {
-                Some(g) if j < s && g.sm <= qh => j,
-                _ => usize::MAX,
-            };
-            let aside = self.aside.get(ia).copied();
-            let aside_next = aside.map_or(usize::MAX, |(k, _, _)| usize::from(k));
+            let aside_next = self
+                .aside
+                .get(ia)
+                .map_or(usize::MAX, |&(k, _, _)| usize::from(k));
             work.spend(1)?;
-            let (k, l, h) = match aside {
-                Some((_, l, h)) if aside_next < run_next => {
-                    ia += 1;
-                    (aside_next, l, h)
-                }
-                _ => {
-                    let Some(g) = self.seg.get(j).filter(|_| run_next != usize::MAX) else {
-                        return Ok(());
-                    };
+            let (k, l, h) = match self.seg.get(j) {
+                // The run's segment, unless the list's entry comes first.
+                Some(g) if j < s && g.sm <= qh && aside_next >= j => {
                     let skip = if self.levels > 0 {
                         self.skip_at(j, meets)
                     } else {
@@ -356,7 +348,16 @@ impl<const N: usize> Index<N> {
                         continue;
                     }
                     j += 1;
-                    (run_next, g.lo, g.hi)
+                    (j - 1, g.lo, g.hi)
+                }
+                // The list's entry (before the run's next segment, or past
+                // the run's end), or the end of both.
+                _ => {
+                    let Some(&(_, l, h)) = self.aside.get(ia) else {
+                        return Ok(());
+                    };
+                    ia += 1;
+                    (aside_next, l, h)
                 }
             };
             if meets(l, h) && !(k >= skip0 && k <= skip1) {
@@ -415,42 +416,84 @@ impl<const N: usize> Index<N> {
                 self.hint = j;
             }
         }
-        let hits = |l: f32, h: f32| {
-            l <= h
-                && (everything
-                    || l == f32::NEG_INFINITY
-                    || copies.iter().any(|&(cl, ch)| l <= ch && h >= cl))
-        };
+        let run = (j, top, everything);
+        // One copy (every non-periodic query, most periodic ones): its test
+        // without the loop over the copies (the same test).
+        if let ([(cl, ch)], false) = (copies, everything) {
+            let (cl, ch) = (*cl, *ch);
+            return self.merge(run, |l, h| l <= ch && h >= cl, with_near, skip, work, visit);
+        }
+        let meets = |l: f32, h: f32| copies.iter().any(|&(cl, ch)| l <= ch && h >= cl);
+        self.merge(run, meets, with_near, skip, work, visit)
+    }
+
+    /// The merge of [`Self::visit_general`], from run start `j` to where the
+    /// suffix minimum passes `top` (`everything`: every segment), with
+    /// `meets` the copies' test of an interval.
+    #[inline(always)]
+    fn merge(
+        &mut self,
+        (mut j, top, everything): (usize, f32, bool),
+        meets: impl Fn(f32, f32) -> bool + Copy,
+        with_near: bool,
+        skip: Option<(usize, usize)>,
+        work: &mut Work,
+        visit: &mut dyn Visitor,
+    ) -> Result<(), OutOfWork> {
+        let s = self.segments;
+        let hits = |l: f32, h: f32| l <= h && (everything || l == f32::NEG_INFINITY || meets(l, h));
         let skipped = |k: usize| skip.is_some_and(|(x, y)| k >= x && k <= y);
         // The merge of three sorted streams: the run, the aside list and
         // (optionally) the near list, each bounded by its length; every
         // step advances one of them.
         let near: &[u16] = if with_near { &self.near } else { &[] };
         let (mut ia, mut inear) = (0usize, 0usize);
+        // A loose index's skips (the same test at every step).
+        let skips = self.levels > 0 && !everything;
         loop {
-            // A loose index: skip the blocks of the run no copy meets (the
-            // aside and near entries in them keep their own streams, which
-            // the merge below still takes in index order).
-            if self.levels > 0
-                && !everything
-                && self.seg.get(j).is_some_and(|g| j < s && g.sm <= top)
-            {
-                let k = self.skip_at(j, |l, h| copies.iter().any(|&(cl, ch)| l <= ch && h >= cl));
-                if k > 0 {
-                    j += k;
-                    work.spend(1)?;
-                    continue;
-                }
-            }
             let next_aside = self
                 .aside
                 .get(ia)
                 .map_or(usize::MAX, |&(k, _, _)| usize::from(k));
             let next_near = near.get(inear).map_or(usize::MAX, |&k| usize::from(k));
-            let next_run = match self.seg.get(j) {
-                Some(g) if j < s && g.sm <= top => j,
-                _ => usize::MAX,
+            let lists = next_aside.min(next_near);
+            // The run's stretch before the lists' next entry: the steps of
+            // the merge below that take the run's segment alone, in a loop
+            // of their own (the same steps, units and offers in the same
+            // order: a skip is tried first at every step, as below).
+            // Bounded by the run: every pass advances `j`.
+            let g = loop {
+                // The run's next segment, while its suffix minimum is not
+                // past the query.
+                let g = self.seg.get(j).copied().filter(|g| j < s && g.sm <= top);
+                // A loose index: skip the blocks of the run no copy meets
+                // (the aside and near entries in them keep their own
+                // streams, which the merge still takes in index order).
+                if skips && g.is_some() {
+                    let k = self.skip_at(j, meets);
+                    if k > 0 {
+                        j += k;
+                        work.spend(1)?;
+                        continue;
+                    }
+                }
+                match g {
+                    Some(g) if j < lists => {
+                        work.spend(1)?;
+                        let (il, ih) = (fmin(f32::INFINITY, g.lo), fmax(f32::NEG_INFINITY, g.hi));
+                        if hits(g.lo, g.hi) && !skipped(j) {
+                            let (flow, units) = visit.segment(j, (il, ih));
+                            work.spend(units)?;
+                            if flow == Flow::Stop {
+                                return Ok(());
+                            }
+                        }
+                        j += 1;
+                    }
+                    _ => break g,
+                }
             };
+            let next_run = if g.is_some() { j } else { usize::MAX };
             let next = next_run.min(next_aside).min(next_near);
             if next == usize::MAX {
                 return Ok(());
@@ -472,7 +515,7 @@ impl<const N: usize> Index<N> {
                 inear += 1;
             }
             if next == next_run {
-                if let Some(g) = self.seg.get(j) {
+                if let Some(g) = g {
                     take |= hits(g.lo, g.hi);
                     (il, ih) = (fmin(il, g.lo), fmax(ih, g.hi));
                 }

@@ -143,10 +143,17 @@ impl Walk {
 /// distance from `F`) misses the band; `c₀` and `|h|` are taken 0.1 %
 /// larger and the left side 0.1 % smaller for rounding, far more than the
 /// band's own arithmetic is off, so a rejected segment is one the band's
-/// clip rejects too.
+/// clip rejects too. The distance is tried first from below by the
+/// segment's smaller distance from the FOE's row, `min(t_a, t_b)` with `t
+/// = side · (v − F_v)` (every point of the segment is at least that far
+/// from `F`, as `t` is linear along it): no division, and on a boundary
+/// that keeps well below or above the FOE it decides most segments; the
+/// exact distance only when that bound does not.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Radial {
     foe: [f32; 2],
+    /// The side of the FOE's row the boundary keeps to (+1 below).
+    side: f32,
     /// The point's own key interval (oriented as the intervals offered).
     own: (f32, f32),
     /// `(1.001 c₀)²`, `1.001 |h|`, `m²`.
@@ -158,7 +165,12 @@ pub(crate) struct Radial {
 impl Radial {
     /// The test for `band` (`None` unless it narrows towards the FOE),
     /// with the FOE, the point's own key interval and the FOE-near radius.
-    pub(crate) fn new(band: &Band, foe: [f32; 2], own: (f32, f32), near_foe: f32) -> Option<Self> {
+    pub(crate) fn new(
+        band: &Band,
+        (foe, side): ([f32; 2], f32),
+        own: (f32, f32),
+        near_foe: f32,
+    ) -> Option<Self> {
         let w = band.w();
         if !(w < 0.0 && band.h <= 0.0) {
             return None;
@@ -172,6 +184,7 @@ impl Radial {
         let c0 = c0 * 1.001;
         Some(Self {
             foe,
+            side,
             own,
             c0sq: c0 * c0,
             h: h * 1.001,
@@ -192,6 +205,17 @@ impl Radial {
         let d = dc * (1.0 - dc * dc * (1.0 / 6.0)) * 0.999 - self.h;
         if !(d > 0.0) {
             return false;
+        }
+        // A lower bound of the distance first: the distance from the row.
+        let t = fmin(
+            self.side * (a[1] - self.foe[1]),
+            self.side * (b[1] - self.foe[1]),
+        );
+        if t > 0.0 {
+            let t2 = t * t;
+            if t2 >= self.m2 && d * d * t2 > self.c0sq {
+                return true;
+            }
         }
         // The squared distance from the FOE to the segment.
         let ua = [a[0] - self.foe[0], a[1] - self.foe[1]];
@@ -293,5 +317,98 @@ impl Visitor for Walker<'_> {
                 (Flow::Stop, CLIP_UNITS)
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::depth::tests::band_point;
+    use crate::depth::PointErrors;
+    use crate::test_rng::Rng;
+
+    /// [`Radial::rejects`] is only a shortcut of the band's clip: moving
+    /// backwards (`W' < 0`, no translation error, half-plane keys), a
+    /// segment through a band point (a true frame-1 point within `r₁`, any
+    /// depth, a polyline point within `e₂` of its correspondent, in `f64`)
+    /// is never rejected, and every segment it rejects (random ones about
+    /// the band point, most of them outside the band) has no part in the
+    /// band. Both bounds of the distance are exercised (the boundary well
+    /// below the FOE, and beside its row).
+    #[test]
+    fn radial_rejects_only_what_the_band_clips_away() {
+        let mut rng = Rng(0x7ad1_a150);
+        let (mut through, mut rejected) = (0, 0);
+        let key_scale = 9.536_743e-7 * 1024.0;
+        for case in 0..60_000 {
+            let w = -(0.05 + rng.next());
+            let c2 = [255.5f32, 239.5];
+            let foe = [512.0 * rng.next(), 480.0 * rng.next() - 120.0];
+            let g = [w * (foe[0] - c2[0]), w * (foe[1] - c2[1])];
+            let p = [512.0 * rng.next(), 480.0 * rng.next()];
+            let (r1, e2) = (0.05 + rng.next(), 0.05 + rng.next());
+            let backward = |rng: &mut Rng, _: f64| Some(0.01 + 30.0 * f64::from(rng.next()));
+            let Some(q) = band_point(&mut rng, (w, g, c2), p, (r1, e2), backward) else {
+                continue;
+            };
+            let side = if q[1] >= foe[1] { 1.0 } else { -1.0 };
+            let near_foe = 48.0 * (r1 + e2) + 8.0;
+            let errors = PointErrors {
+                r1,
+                e2,
+                e2_csc: e2 * 11.52,
+                spread_a: 0.0,
+                spread_w: 0.0,
+            };
+            let a = [w * (p[0] - c2[0]) - g[0], w * (p[1] - c2[1]) - g[1]];
+            let Ok(band) = Band::new(p, a, w, &errors, near_foe) else {
+                continue;
+            };
+            let key = |v: [f32; 2]| crate::pencil::half_key(v, (foe, side, 4.0), key_scale);
+            let (kp, mp) = key(p);
+            if !kp.is_finite() {
+                continue;
+            }
+            let Some(rad) = Radial::new(&band, (foe, side), (kp - mp, kp + mp), near_foe) else {
+                continue;
+            };
+            let interval = |u: [f32; 2], v: [f32; 2]| {
+                let ((ku, mu), (kv, mv)) = (key(u), key(v));
+                if (ku + kv).is_finite() {
+                    (fmin(ku - mu, kv - mv), fmax(ku + mu, kv + mv))
+                } else {
+                    (f32::NEG_INFINITY, f32::INFINITY)
+                }
+            };
+            // A segment through q, in any direction.
+            let ang = rng.next() * core::f32::consts::TAU;
+            let (l0, l1) = (8.0 * rng.next(), 8.0 * rng.next());
+            let u = [libm::cosf(ang), libm::sinf(ang)];
+            let s0 = [q[0] + l0 * u[0], q[1] + l0 * u[1]];
+            let s1 = [q[0] - l1 * u[0], q[1] - l1 * u[1]];
+            if !(interval(s0, s1).0.is_finite()) {
+                continue;
+            }
+            assert!(
+                !rad.rejects(s0, s1, interval(s0, s1)),
+                "case {case}: a segment through band point {q:?} rejected (p {p:?}, foe {foe:?})"
+            );
+            through += 1;
+            // A segment about q, shifted off it by up to 40 px.
+            let off = [80.0 * (rng.next() - 0.5), 80.0 * (rng.next() - 0.5)];
+            let (t0, t1) = (
+                [s0[0] + off[0], s0[1] + off[1]],
+                [s1[0] + off[0], s1[1] + off[1]],
+            );
+            let iv = interval(t0, t1);
+            if iv.0.is_finite() && rad.rejects(t0, t1, iv) {
+                assert!(
+                    band.segment(&band.vertex(t0), &band.vertex(t1)).is_none(),
+                    "case {case}: segment {t0:?} → {t1:?} rejected but in the band of {p:?}"
+                );
+                rejected += 1;
+            }
+        }
+        assert!(through > 10_000 && rejected > 2_000, "{through} {rejected}");
     }
 }

@@ -836,14 +836,14 @@ fn match_point<const N: usize>(
         Matcher::Reference => 1.0,
     };
     let radial = match (keying.pencil, pair.foe) {
-        (Pencil::Half { .. }, Some(foe)) => {
+        (Pencil::Half { side, .. }, Some(foe)) => {
             let (k, m) = keying.key(p);
             let own = if orient < 0.0 {
                 (-k - m, -k + m)
             } else {
                 (k - m, k + m)
             };
-            Radial::new(&band, foe, own, near_foe)
+            Radial::new(&band, (foe, side), own, near_foe)
         }
         _ => None,
     };

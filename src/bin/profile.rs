@@ -46,6 +46,14 @@ static WINDOWS: &[(&str, &[u8])] = &[
     // The adversarial family's costliest member at 2 × 256 (a frame-1
     // boundary across the FOE's row): the general band path.
     ("foe_row", include_bytes!("data/adv_foe_row_256.bin")),
+    // Backward motion on log spirals about an FOE just above the image
+    // (N = 256), within 1 % of the family's costliest member at 2 × 256
+    // and the costliest hand-made one: the band path's general visit, with
+    // the aside and FOE-near lists merged in and the work budget binding.
+    (
+        "back_spiral",
+        include_bytes!("data/adv_back_spiral_256.bin"),
+    ),
 ];
 
 /// Capacity: the bench's, so the per-frame code is the bench's too.

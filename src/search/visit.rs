@@ -480,9 +480,11 @@ impl<const N: usize> Index<N> {
                 match g {
                     Some(g) if j < lists => {
                         work.spend(1)?;
-                        let (il, ih) = (fmin(f32::INFINITY, g.lo), fmax(f32::NEG_INFINITY, g.hi));
+                        // (The merge's union of the streams' intervals is
+                        // the run's own here: `fmin(∞, l) = l`, `fmax(−∞,
+                        // h) = h` for every `l`, `h`, NaN included.)
                         if hits(g.lo, g.hi) && !skipped(j) {
-                            let (flow, units) = visit.segment(j, (il, ih));
+                            let (flow, units) = visit.segment(j, (g.lo, g.hi));
                             work.spend(units)?;
                             if flow == Flow::Stop {
                                 return Ok(());

@@ -196,27 +196,11 @@ impl Radial {
     /// band for certain.
     #[inline(always)]
     fn rejects(&self, a: [f32; 2], b: [f32; 2], (lo, hi): (f32, f32)) -> bool {
-        let delta = fmax(lo - self.own.1, self.own.0 - hi);
-        // (A NaN fails.)
-        if !(delta > self.h) {
-            return false;
-        }
-        let dc = fmin(delta, 1.0);
-        let d = dc * (1.0 - dc * dc * (1.0 / 6.0)) * 0.999 - self.h;
-        if !(d > 0.0) {
-            return false;
-        }
-        // A lower bound of the distance first: the distance from the row.
-        let t = fmin(
-            self.side * (a[1] - self.foe[1]),
-            self.side * (b[1] - self.foe[1]),
-        );
-        if t > 0.0 {
-            let t2 = t * t;
-            if t2 >= self.m2 && d * d * t2 > self.c0sq {
-                return true;
-            }
-        }
+        let d = match self.by_row(a[1], b[1], (lo, hi)) {
+            Row::Rejects => return true,
+            Row::Keeps => return false,
+            Row::Undecided(d) => d,
+        };
         // The squared distance from the FOE to the segment.
         let ua = [a[0] - self.foe[0], a[1] - self.foe[1]];
         let ab = [b[0] - a[0], b[1] - a[1]];
@@ -230,11 +214,55 @@ impl Radial {
         let r2 = v[0] * v[0] + v[1] * v[1];
         r2 >= self.m2 && d * d * r2 > self.c0sq
     }
+
+    /// The first part of [`Self::rejects`], from the key interval and the
+    /// rows `va`, `vb` of the segment's ends only: the key distance `d`
+    /// (`δ′ (1 − δ′²/6)` less `|h|`, rounded down) and the distance from
+    /// the FOE's row as the lower bound of the distance. The general visit
+    /// makes this test itself before it offers a segment
+    /// ([`crate::search::Visitor::radial`]), so that the segments it
+    /// rejects cost no call.
+    #[inline(always)]
+    pub(crate) fn by_row(&self, va: f32, vb: f32, (lo, hi): (f32, f32)) -> Row {
+        let delta = fmax(lo - self.own.1, self.own.0 - hi);
+        // (A NaN fails.)
+        if !(delta > self.h) {
+            return Row::Keeps;
+        }
+        let dc = fmin(delta, 1.0);
+        let d = dc * (1.0 - dc * dc * (1.0 / 6.0)) * 0.999 - self.h;
+        if !(d > 0.0) {
+            return Row::Keeps;
+        }
+        // A lower bound of the distance first: the distance from the row.
+        let t = fmin(
+            self.side * (va - self.foe[1]),
+            self.side * (vb - self.foe[1]),
+        );
+        if t > 0.0 {
+            let t2 = t * t;
+            if t2 >= self.m2 && d * d * t2 > self.c0sq {
+                return Row::Rejects;
+            }
+        }
+        Row::Undecided(d)
+    }
+}
+
+/// What [`Radial::by_row`] decides.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Row {
+    /// The segment misses the band.
+    Rejects,
+    /// The test cannot reject it.
+    Keeps,
+    /// The exact distance decides, with this key distance `d`.
+    Undecided(f32),
 }
 
 /// Work units a [`Radial`] rejection costs on top of the look (it is about
 /// as long as the look itself).
-const RADIAL_UNITS: u32 = 1;
+pub(crate) const RADIAL_UNITS: u32 = 1;
 
 /// A walk as an index [`Visitor`]: the band, the polyline, the last vertex
 /// computed (reused along a run), the walk, and the band's [`Radial`] test
@@ -293,7 +321,12 @@ impl<'a> Walker<'a> {
     }
 }
 
-impl Visitor for Walker<'_> {
+impl<'a> Visitor<'a> for Walker<'a> {
+    #[inline(always)]
+    fn radial(&self) -> Option<(Radial, &'a [Pixel])> {
+        self.radial.map(|r| (r, self.boundary))
+    }
+
     #[inline(always)]
     fn segment(&mut self, j: usize, interval: (f32, f32)) -> (Flow, u32) {
         if let (Some(rad), Some(a), Some(b)) =

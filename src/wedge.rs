@@ -639,7 +639,7 @@ impl<'a> WedgeWalker<'a> {
     }
 }
 
-impl Visitor for WedgeWalker<'_> {
+impl Visitor<'_> for WedgeWalker<'_> {
     #[inline(always)]
     fn segment(&mut self, j: usize, interval: (f32, f32)) -> (Flow, u32) {
         let (Some(a), Some(b)) = (self.vertex(j), self.vertex(j + 1)) else {

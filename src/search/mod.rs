@@ -181,12 +181,24 @@ pub(crate) enum Flow {
 }
 
 /// Takes the segments a query offers ([`Index::visit`]), in increasing
-/// index.
-pub(crate) trait Visitor {
+/// index; `'b` the lifetime of the polyline it walks, if any.
+pub(crate) trait Visitor<'b> {
     /// Segment `j` with its key interval (oriented; infinite for a segment
     /// listed as near the FOE): whether to go on, and the units of work
     /// its test took beyond the unit of looking at it (charged after).
     fn segment(&mut self, j: usize, interval: (f32, f32)) -> (Flow, u32);
+
+    /// The band walk's [`crate::matching::Radial`] test and its polyline,
+    /// if the visitor makes that test first for every segment it is
+    /// offered (rejecting for [`crate::matching::RADIAL_UNITS`] and
+    /// nothing else): the general visit then makes the test's first part
+    /// itself ([`crate::matching::Radial::by_row`]) and offers only the
+    /// segments it does not reject. The same units and outcome, without
+    /// the call.
+    #[inline(always)]
+    fn radial(&self) -> Option<(crate::matching::Radial, &'b [crate::camera::Pixel])> {
+        None
+    }
 }
 
 /// How segments with an unkeyable end count.

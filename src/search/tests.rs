@@ -104,7 +104,7 @@ struct Record {
     last: Option<usize>,
     ordered: bool,
 }
-impl Visitor for Record {
+impl Visitor<'_> for Record {
     fn segment(&mut self, j: usize, _: (f32, f32)) -> (Flow, u32) {
         self.ordered &= self.last.is_none_or(|l| j > l);
         self.last = Some(j);
@@ -117,7 +117,7 @@ impl Visitor for Record {
 
 #[derive(Clone, Copy)]
 struct Count(usize, usize);
-impl Visitor for Count {
+impl Visitor<'_> for Count {
     fn segment(&mut self, j: usize, _: (f32, f32)) -> (Flow, u32) {
         // Increasing indices, counted.
         assert!(self.1 == usize::MAX || j > self.1, "{j} after {}", self.1);

@@ -3,6 +3,7 @@
 //! test's queries built on them.
 
 use super::*;
+use crate::matching::{Row, RADIAL_UNITS};
 
 impl<const N: usize> Index<N> {
     /// Whether vertex `i`, whose raw key is `key`, may lie on a ray that
@@ -170,13 +171,13 @@ impl<const N: usize> Index<N> {
     /// unit of `work`, each one visited what the visitor reports,
     /// each bisection step one.
     #[inline(always)]
-    pub(crate) fn visit(
+    pub(crate) fn visit<'b>(
         &mut self,
         query: Query,
         with_near: bool,
         skip: Option<(usize, usize)>,
         work: &mut Work,
-        visit: &mut (impl Visitor + Copy),
+        visit: &mut (impl Visitor<'b> + Copy),
     ) -> Result<(), OutOfWork> {
         // The usual case: one run, no lists to merge; next, a run and the
         // aside list. Periodic keys take this way when at most one copy of
@@ -222,13 +223,13 @@ impl<const N: usize> Index<N> {
 
     /// [`Self::visit`] for one oriented interval and no lists.
     #[inline(always)]
-    fn visit_run(
+    fn visit_run<'b>(
         &mut self,
         ql: f32,
         qh: f32,
         skip: Option<(usize, usize)>,
         work: &mut Work,
-        visit: &mut (impl Visitor + Copy),
+        visit: &mut (impl Visitor<'b> + Copy),
     ) -> Result<(), OutOfWork> {
         // (A query that cannot meet the keys' range finds an empty run: its
         // start is past every segment, or its first suffix minimum above it.)
@@ -278,13 +279,13 @@ impl<const N: usize> Index<N> {
     /// blocks the query misses (each skip one unit). Bounded by the segment
     /// count: every step advances `j`.
     #[inline(never)]
-    fn visit_run_loose(
+    fn visit_run_loose<'b>(
         &mut self,
         mut j: usize,
         (ql, qh): (f32, f32),
         (skip0, skip1): (usize, usize),
         work: &mut Work,
-        visit: &mut dyn Visitor,
+        visit: &mut dyn Visitor<'b>,
     ) -> Result<(), OutOfWork> {
         let s = self.segments.min(N);
         let meets = |l: f32, h: f32| l <= qh && h >= ql;
@@ -315,12 +316,12 @@ impl<const N: usize> Index<N> {
     /// the query misses). Each step advances the run or the list; every
     /// segment looked at and every skip costs one unit.
     #[inline(never)]
-    fn visit_run_aside(
+    fn visit_run_aside<'b>(
         &mut self,
         (ql, qh): (f32, f32),
         (skip0, skip1): (usize, usize),
         work: &mut Work,
-        visit: &mut impl Visitor,
+        visit: &mut impl Visitor<'b>,
     ) -> Result<(), OutOfWork> {
         let a = self.run_start(ql, work)?;
         if a < self.segments {
@@ -375,13 +376,13 @@ impl<const N: usize> Index<N> {
     /// visitor by reference: this rare path keeps the usual one's visitor
     /// inlined.)
     #[inline(never)]
-    fn visit_general(
+    fn visit_general<'b>(
         &mut self,
         query: Query,
         with_near: bool,
         skip: Option<(usize, usize)>,
         work: &mut Work,
-        visit: &mut dyn Visitor,
+        visit: &mut dyn Visitor<'b>,
     ) -> Result<(), OutOfWork> {
         let s = self.segments;
         let mut copies = [(0.0f32, 0.0f32); MAX_COPIES];
@@ -431,14 +432,14 @@ impl<const N: usize> Index<N> {
     /// suffix minimum passes `top` (`everything`: every segment), with
     /// `meets` the copies' test of an interval.
     #[inline(always)]
-    fn merge(
+    fn merge<'b>(
         &mut self,
         (mut j, top, everything): (usize, f32, bool),
         meets: impl Fn(f32, f32) -> bool + Copy,
         with_near: bool,
         skip: Option<(usize, usize)>,
         work: &mut Work,
-        visit: &mut dyn Visitor,
+        visit: &mut dyn Visitor<'b>,
     ) -> Result<(), OutOfWork> {
         let s = self.segments;
         let hits = |l: f32, h: f32| l <= h && (everything || l == f32::NEG_INFINITY || meets(l, h));
@@ -450,6 +451,9 @@ impl<const N: usize> Index<N> {
         let (mut ia, mut inear) = (0usize, 0usize);
         // A loose index's skips (the same test at every step).
         let skips = self.levels > 0 && !everything;
+        // The visitor's cheap rejection, if it has one (the band walk's
+        // `Radial`): made here for the run's segments, the same units.
+        let quick = visit.radial();
         loop {
             let next_aside = self
                 .aside
@@ -484,6 +488,16 @@ impl<const N: usize> Index<N> {
                         // the run's own here: `fmin(∞, l) = l`, `fmax(−∞,
                         // h) = h` for every `l`, `h`, NaN included.)
                         if hits(g.lo, g.hi) && !skipped(j) {
+                            if let Some((rad, b2)) = quick {
+                                if let (Some(a), Some(b)) = (b2.get(j), b2.get(j + 1)) {
+                                    let (va, vb) = (a.v, b.v);
+                                    if rad.by_row(va, vb, (g.lo, g.hi)) == Row::Rejects {
+                                        work.spend(RADIAL_UNITS)?;
+                                        j += 1;
+                                        continue;
+                                    }
+                                }
+                            }
                             let (flow, units) = visit.segment(j, (g.lo, g.hi));
                             work.spend(units)?;
                             if flow == Flow::Stop {
@@ -539,7 +553,7 @@ impl<const N: usize> Index<N> {
 #[derive(Clone, Copy)]
 struct Met(bool);
 
-impl Visitor for Met {
+impl Visitor<'_> for Met {
     fn segment(&mut self, _: usize, _: (f32, f32)) -> (Flow, u32) {
         self.0 = true;
         (Flow::Stop, 0)

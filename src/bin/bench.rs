@@ -384,10 +384,76 @@ fn member_config(errors: u8, w: u32) -> Option<Config> {
             .with_rotation_error([0.0, 0.0, 0.001])
             .ok()?,
         3 => Config::DEFAULT.with_translation_error(0.02).ok()?,
+        // The configuration probes' ([`PROBES`]).
+        4 => Config::DEFAULT.with_localisation_error(0.5, 10.0).ok()?,
+        5 => Config::new(0.5, 0.5, 0.1, 1000.0)
+            .ok()?
+            .with_rotation_error([1.0e-6, 0.0, 0.0])
+            .ok()?,
+        6 => Config::new(0.5, 0.5, 0.1, 1000.0).ok()?,
+        7 => Config::DEFAULT.with_localisation_error(0.5, 2.0).ok()?,
         _ => return None,
     };
     c.with_work_budget(w).ok()
 }
+
+/// Configuration probes of the worst-case sweep: a member's frame pair (its
+/// name and N in the family) under another valid configuration (an id of
+/// [`member_config`]), logged as its own sweep row. An adversarial review
+/// found these over the envelope measured on the members' own
+/// configurations: a wide frame-2 error (the band's segments pass
+/// `Radial`'s cheap test and are clipped, about 100 instructions a unit), a
+/// tiny rotation error with a small minimum angle (every point checked in
+/// step 1), and a rotation error at small budgets (the fixed cost of a
+/// point, `C_P`).
+/// A probe with a window `(off, k)` takes points `off .. off + k` of each
+/// boundary in both frames (a smaller frame of the same pair).
+#[allow(clippy::type_complexity)]
+const PROBES: &[(&str, &str, u32, u8, Option<(usize, usize)>)] = &[
+    ("back_spiral+e2_10", "back_spiral", 256, 4, None),
+    ("back_spiral+e2_2", "back_spiral", 256, 7, None),
+    ("back_radial_stair+e2_10", "back_radial_stair", 256, 4, None),
+    (
+        "back_spiral+rot_1e-6+angle_0.1",
+        "back_spiral",
+        256,
+        5,
+        None,
+    ),
+    ("search_1+angle_0.1", "search_1", 256, 6, None),
+    ("fwd_spiral_zz+rot_z", "fwd_spiral_zz", 64, 2, None),
+    (
+        "fwd_spiral_zz+rot_z[16..64]",
+        "fwd_spiral_zz",
+        64,
+        2,
+        Some((16, 48)),
+    ),
+    ("fwd_spiral+rot_1e-6+angle_0.1", "fwd_spiral", 64, 5, None),
+    (
+        "fwd_spiral+rot_1e-6+angle_0.1[12..60]",
+        "fwd_spiral",
+        64,
+        5,
+        Some((12, 48)),
+    ),
+    (
+        "back_spiral+rot_1e-6[60..68]",
+        "back_spiral",
+        128,
+        5,
+        Some((60, 8)),
+    ),
+];
+
+/// Budgets of the configuration probes (the sweep's, up to twice the
+/// default: the probes' frames are long).
+const PROBE_SWEEP: [u32; 4] = [
+    Config::MIN_WORK_PER_POINT,
+    16,
+    Config::DEFAULT_WORK_PER_POINT,
+    160,
+];
 
 /// Budgets of the work sweep, units per point: the smallest accepted, two
 /// between, the default and up to 8 times it.
@@ -454,6 +520,59 @@ fn worst_case_sweep(
             defmt::info!(
                 "sweep name={=str} n={=u32} w={=u32} points={=u32} instr={=u32} processed={=bool} work_spent={=u32} over_budget={=usize}",
                 name,
+                n,
+                w,
+                r.points,
+                r.instr,
+                r.processed,
+                s.work_units().0,
+                s.status_counts().get(Status::OverBudget)
+            );
+        }
+    }
+    for (probe, member, n, errors, window) in PROBES {
+        let Some((_, _, _, data)) = ADVERSARIAL.iter().find(|a| a.0 == *member && a.1 == *n) else {
+            defmt::error!(
+                "no member {=str} n={=u32} for probe {=str}",
+                member,
+                n,
+                probe
+            );
+            continue;
+        };
+        let Some(m) = load(data, f1, f2) else {
+            continue;
+        };
+        if let Some((off, k)) = *window {
+            let (mut t1, mut t2) = (
+                Frame::<CAP, 2>::new(*f1.camera()),
+                Frame::<CAP, 2>::new(*f2.camera()),
+            );
+            let mut pushed = true;
+            for (src, dst) in [(&*f1, &mut t1), (&*f2, &mut t2)] {
+                for bd in src.boundaries() {
+                    let pts = bd.points();
+                    let part = pts.get(off..(off + k).min(pts.len())).unwrap_or(&[]);
+                    pushed &= dst.push_boundary(part).is_ok();
+                }
+            }
+            if !pushed {
+                defmt::error!("probe {=str}: its window does not push", probe);
+                continue;
+            }
+            (*f1, *f2) = (t1, t2);
+        }
+        for w in PROBE_SWEEP {
+            let Some(c) = member_config(*errors, w) else {
+                defmt::error!("bad probe configuration for {=str}", probe);
+                continue;
+            };
+            processor.set_config(c);
+            let r = measure_pair(processor, f1, f2, &m);
+            let s = processor.structure();
+            defmt::info!(
+                "sweep name={=str} n={=u32} w={=u32} points={=u32} instr={=u32} processed={=bool} work_spent={=u32} over_budget={=usize}",
+                probe,
                 n,
                 w,
                 r.points,

@@ -21,7 +21,10 @@
 //!   of the adversarial family run at budgets from the smallest accepted
 //!   to 16 × the default (the `sweep` rows): per member, the instructions'
 //!   rise from its cheapest to its costliest budget over the units' rise
-//!   (members whose units move by fewer than 256 are left out).
+//!   (members whose units move by fewer than 256 are left out), and the
+//!   same over the configuration probes (`PROBES` in `src/bin/bench.rs`:
+//!   members' pairs, or windows of them, under other valid configurations),
+//!   which the firmware logs as sweep rows too.
 //! * `C_P`: the largest per-point remainder, `(I − C0 − C_B·B − C_U·u) /
 //!   points`, over every frame the bench ran (the bench pairs, the stress
 //!   pairs' are not logged with their units, the whole adversarial family

@@ -466,6 +466,59 @@ const SWEEP: [u32; 6] = [
     640,
 ];
 
+/// The pair `f` cut to its first `boundaries` boundaries, each to its
+/// points `from .. to` (fewer where a boundary is shorter), and whether
+/// every cut boundary was accepted.
+fn cut(
+    (f1, f2): (&Frame<CAP, 2>, &Frame<CAP, 2>),
+    boundaries: usize,
+    (from, to): (usize, usize),
+) -> (Frame<CAP, 2>, Frame<CAP, 2>, bool) {
+    let (mut t1, mut t2) = (
+        Frame::<CAP, 2>::new(*f1.camera()),
+        Frame::<CAP, 2>::new(*f2.camera()),
+    );
+    let mut pushed = true;
+    for (src, dst) in [(f1, &mut t1), (f2, &mut t2)] {
+        for bd in src.boundaries().iter().take(boundaries) {
+            let pts = bd.points();
+            let part = pts.get(from..to.min(pts.len())).unwrap_or(&[]);
+            pushed &= dst.push_boundary(part).is_ok();
+        }
+    }
+    (t1, t2, pushed)
+}
+
+/// One row of the worst-case sweep: the pair under error model `errors`
+/// ([`member_config`]) with budget `w`, measured and logged under `name`
+/// (the family's `n`); false when the configuration is not valid.
+fn sweep_row(
+    processor: &mut Processor<CAP, 2>,
+    (f1, f2, m): (&Frame<CAP, 2>, &Frame<CAP, 2>, &roadstereo::Motion),
+    (name, n): (&str, u32),
+    errors: u8,
+    w: u32,
+) -> bool {
+    let Some(c) = member_config(errors, w) else {
+        return false;
+    };
+    processor.set_config(c);
+    let r = measure_pair(processor, f1, f2, m);
+    let s = processor.structure();
+    defmt::info!(
+        "sweep name={=str} n={=u32} w={=u32} points={=u32} instr={=u32} processed={=bool} work_spent={=u32} over_budget={=usize}",
+        name,
+        n,
+        w,
+        r.points,
+        r.instr,
+        r.processed,
+        s.work_units().0,
+        s.status_counts().get(Status::OverBudget)
+    );
+    true
+}
+
 /// The measurements behind README's worst-case formula ("Worst case"):
 /// the fixed cost of a frame (one and two boundaries of two points each,
 /// from the N = 32 bench pair), and every 2 × 256 member of the adversarial
@@ -483,17 +536,7 @@ fn worst_case_sweep(
     if let Some((_, data)) = BENCH.first() {
         if let Some(m) = load(data, f1, f2) {
             for b in 1..=2usize {
-                let (mut t1, mut t2) = (
-                    Frame::<CAP, 2>::new(*f1.camera()),
-                    Frame::<CAP, 2>::new(*f2.camera()),
-                );
-                let mut pushed = true;
-                for (src, dst) in [(&*f1, &mut t1), (&*f2, &mut t2)] {
-                    for bd in src.boundaries().iter().take(b) {
-                        let two = bd.points().get(..2).unwrap_or(&[]);
-                        pushed &= dst.push_boundary(two).is_ok();
-                    }
-                }
+                let (t1, t2, pushed) = cut((f1, f2), b, (0, 2));
                 let r = measure_pair(processor, &t1, &t2, &m);
                 defmt::info!(
                     "fixed boundaries={=usize} points={=u32} instr={=u32} processed={=bool} pushed={=bool}",
@@ -511,23 +554,7 @@ fn worst_case_sweep(
             continue;
         };
         for w in SWEEP {
-            let Some(c) = member_config(*errors, w) else {
-                continue;
-            };
-            processor.set_config(c);
-            let r = measure_pair(processor, f1, f2, &m);
-            let s = processor.structure();
-            defmt::info!(
-                "sweep name={=str} n={=u32} w={=u32} points={=u32} instr={=u32} processed={=bool} work_spent={=u32} over_budget={=usize}",
-                name,
-                n,
-                w,
-                r.points,
-                r.instr,
-                r.processed,
-                s.work_units().0,
-                s.status_counts().get(Status::OverBudget)
-            );
+            sweep_row(processor, (f1, f2, &m), (name, *n), *errors, w);
         }
     }
     for (probe, member, n, errors, window) in PROBES {
@@ -544,18 +571,7 @@ fn worst_case_sweep(
             continue;
         };
         if let Some((off, k)) = *window {
-            let (mut t1, mut t2) = (
-                Frame::<CAP, 2>::new(*f1.camera()),
-                Frame::<CAP, 2>::new(*f2.camera()),
-            );
-            let mut pushed = true;
-            for (src, dst) in [(&*f1, &mut t1), (&*f2, &mut t2)] {
-                for bd in src.boundaries() {
-                    let pts = bd.points();
-                    let part = pts.get(off..(off + k).min(pts.len())).unwrap_or(&[]);
-                    pushed &= dst.push_boundary(part).is_ok();
-                }
-            }
+            let (t1, t2, pushed) = cut((f1, f2), 2, (off, off + k));
             if !pushed {
                 defmt::error!("probe {=str}: its window does not push", probe);
                 continue;
@@ -563,24 +579,9 @@ fn worst_case_sweep(
             (*f1, *f2) = (t1, t2);
         }
         for w in PROBE_SWEEP {
-            let Some(c) = member_config(*errors, w) else {
+            if !sweep_row(processor, (f1, f2, &m), (probe, *n), *errors, w) {
                 defmt::error!("bad probe configuration for {=str}", probe);
-                continue;
-            };
-            processor.set_config(c);
-            let r = measure_pair(processor, f1, f2, &m);
-            let s = processor.structure();
-            defmt::info!(
-                "sweep name={=str} n={=u32} w={=u32} points={=u32} instr={=u32} processed={=bool} work_spent={=u32} over_budget={=usize}",
-                probe,
-                n,
-                w,
-                r.points,
-                r.instr,
-                r.processed,
-                s.work_units().0,
-                s.status_counts().get(Status::OverBudget)
-            );
+            }
         }
     }
     processor.set_config(Config::DEFAULT);

@@ -224,16 +224,9 @@ impl Radial {
     /// rejects cost no call.
     #[inline(always)]
     pub(crate) fn by_row(&self, va: f32, vb: f32, (lo, hi): (f32, f32)) -> Row {
-        let delta = fmax(lo - self.own.1, self.own.0 - hi);
-        // (A NaN fails.)
-        if !(delta > self.h) {
+        let Some(d) = self.key_distance((lo, hi)) else {
             return Row::Keeps;
-        }
-        let dc = fmin(delta, 1.0);
-        let d = dc * (1.0 - dc * dc * (1.0 / 6.0)) * 0.999 - self.h;
-        if !(d > 0.0) {
-            return Row::Keeps;
-        }
+        };
         // A lower bound of the distance first: the distance from the row.
         let t = fmin(
             self.side * (va - self.foe[1]),
@@ -246,6 +239,59 @@ impl Radial {
             }
         }
         Row::Undecided(d)
+    }
+
+    /// The key distance `d` of [`Self::by_row`] for the key interval `(lo,
+    /// hi)`: `δ′ (1 − δ′²/6)` less `|h|` (rounded down by 0.1 %), `None`
+    /// where it is not positive (no rejection). (A NaN gives `None`.)
+    #[inline(always)]
+    fn key_distance(&self, (lo, hi): (f32, f32)) -> Option<f32> {
+        let delta = fmax(lo - self.own.1, self.own.0 - hi);
+        if !(delta > self.h) {
+            return None;
+        }
+        let dc = fmin(delta, 1.0);
+        let d = dc * (1.0 - dc * dc * (1.0 / 6.0)) * 0.999 - self.h;
+        (d > 0.0).then_some(d)
+    }
+
+    /// Whether [`Self::by_row`] rejects **every** segment of a block whose
+    /// key intervals lie in the hull `(lo, hi)` and whose end vertices'
+    /// rows lie in `[v_min, v_max]` (the block tree's radial levels,
+    /// [`crate::search`]), so that the block can be passed over whole.
+    ///
+    /// Each segment's key distance `δ_s = max(l_s − k₊, k₋ − h_s)` is at
+    /// least the hull's `δ_B` (`l_s ≥ lo`, `h_s ≤ hi`, and IEEE subtraction
+    /// and `max` are monotone, so this holds as computed), and its row
+    /// bound `t_s = min side · (v − F_v)` over its two ends is at least the
+    /// block's `t_B`, the same expression at `v_min` (below the FOE's row,
+    /// `side` +1) or at `v_max` (`side` −1), exactly. The function `d(δ)` of
+    /// [`Self::key_distance`] rises with `δ` (`x (1 − x²/6)` has the
+    /// derivative `1 − x²/2 > 0` on `[0, 1]`), but as computed it may fall
+    /// by its rounding: each value is within `5.2 · 2⁻²⁴` of the exact one
+    /// (four roundings and `1 − x²/6 ≥ 5/6`; the terms are at most 1), and
+    /// the subtraction of `|h|` adds two more, so `d_s ≥ d_B − 14 · 2⁻²⁴ >
+    /// d_B − 10⁻⁶`. The block is tested with `d_B − 2 · 10⁻⁶`. The rounded
+    /// products `d · d · t²` are monotone in each (non-negative) factor, so
+    /// the block's is at most each segment's, and it is compared with
+    /// `c₀²` taken `10⁻⁵` larger besides. So `δ_s > |h|`, `d_s > 0`, `t_s² ≥
+    /// m²` and `d_s² t_s² > c₀²` as computed for every segment of the
+    /// block: each is [`Row::Rejects`] (unit test
+    /// `a_rejected_block_holds_only_rejected_segments`).
+    #[inline(always)]
+    pub(crate) fn rejects_block(&self, hull: (f32, f32), (v_min, v_max): (f32, f32)) -> bool {
+        let Some(d) = self.key_distance(hull) else {
+            return false;
+        };
+        let d = d - 2.0e-6;
+        let v = if self.side > 0.0 { v_min } else { v_max };
+        let t = self.side * (v - self.foe[1]);
+        // (A NaN fails.)
+        if !(d > 0.0 && t > 0.0) {
+            return false;
+        }
+        let t2 = t * t;
+        t2 >= self.m2 && d * d * t2 > self.c0sq * 1.000_01
     }
 }
 
@@ -443,5 +489,107 @@ mod tests {
             }
         }
         assert!(through > 10_000 && rejected > 2_000, "{through} {rejected}");
+    }
+
+    /// [`Radial::rejects_block`] passes over a block only when
+    /// [`Radial::by_row`] rejects every segment in it: random tests and
+    /// blocks of 1–64 segments, each block built about the test's
+    /// threshold (key distances and rows that put `d t` within 10⁻³ of
+    /// `c₀`, either side, and key distances about `|h|` and past 1), so
+    /// that many blocks are decided within the margins.
+    #[test]
+    fn a_rejected_block_holds_only_rejected_segments() {
+        let mut rng = Rng(0x0b10_c4ed);
+        let (mut blocks, mut passed, mut close) = (0u32, 0u32, 0u32);
+        for _ in 0..200_000 {
+            let side = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+            let foe = [512.0 * rng.next(), 480.0 * rng.next() - 120.0];
+            let k = 2.0 * rng.next() - 1.0;
+            let m = 1.0e-6 * (1.0 + 4.0 * rng.next());
+            let (h, c0, near) = (
+                0.3 * rng.next(),
+                0.01 + 5.0 * rng.next(),
+                1.0 + 49.0 * rng.next(),
+            );
+            let rad = Radial {
+                foe,
+                side,
+                own: (k - m, k + m),
+                c0sq: c0 * c0,
+                h,
+                m2: near * near,
+            };
+            // The block's smallest key distance and row distance, about the
+            // threshold `d(δ) t = c₀` (the scale of one of them random).
+            let delta = match rng.next() {
+                x if x < 0.2 => h * (1.0 + 1.0e-3 * (rng.next() - 0.5)),
+                x if x < 0.3 => 1.0 + rng.next(),
+                _ => h + (1.5 - h) * rng.next(),
+            };
+            let Some(d) = rad.key_distance((k + m + delta, k + m + delta + 0.01)) else {
+                continue;
+            };
+            let t_min = c0 / d * (1.0 + 2.0e-3 * (rng.next() - 0.5));
+            let t_min = if rng.next() < 0.1 {
+                near * (1.0 + 1.0e-4 * (rng.next() - 0.5))
+            } else {
+                t_min
+            };
+            let len = 1 + (64.0 * rng.next()) as usize;
+            // Segments: key intervals at least `delta` from the own one
+            // (either side), end rows at least `t_min` from the FOE's row.
+            let mut segs = [((0.0f32, 0.0f32), (0.0f32, 0.0f32)); 64];
+            let binding = (64.0 * rng.next()) as usize % len;
+            // One side of the own key (a block with keys on both sides has
+            // no key distance), now and then both.
+            let (above, mixed) = (rng.next() < 0.5, rng.next() < 0.05);
+            for (i, sg) in segs.iter_mut().take(len).enumerate() {
+                let grow = if i == binding {
+                    0.0
+                } else {
+                    rng.next() * rng.next()
+                };
+                let dk = delta * (1.0 + grow);
+                let w = 0.05 * rng.next();
+                let iv = if above != (mixed && rng.next() < 0.5) {
+                    (k + m + dk, k + m + dk + w)
+                } else {
+                    (k - m - dk - w, k - m - dk)
+                };
+                let row = |rng: &mut Rng, g: f32| foe[1] + side * t_min * (1.0 + g * rng.next());
+                let va = row(&mut rng, if i == binding { 0.0 } else { 0.5 });
+                let vb = row(&mut rng, 0.5);
+                *sg = (iv, (va, vb));
+            }
+            let segs = segs.get(..len).unwrap_or(&[]);
+            let mut hull = (f32::INFINITY, f32::NEG_INFINITY);
+            let mut rows = (f32::INFINITY, f32::NEG_INFINITY);
+            for &((lo, hi), (va, vb)) in segs {
+                hull = (fmin(hull.0, lo), fmax(hull.1, hi));
+                rows = (fmin(rows.0, fmin(va, vb)), fmax(rows.1, fmax(va, vb)));
+            }
+            blocks += 1;
+            if !rad.rejects_block(hull, rows) {
+                continue;
+            }
+            passed += 1;
+            let dk = fmax(hull.0 - rad.own.1, rad.own.0 - hull.1);
+            let db = rad.key_distance(hull).unwrap_or(0.0);
+            let tb = side * (if side > 0.0 { rows.0 } else { rows.1 } - foe[1]);
+            if (db * tb) * (db * tb) < c0 * c0 * 1.001 || dk < h * 1.001 {
+                close += 1;
+            }
+            for (i, &(iv, (va, vb))) in segs.iter().enumerate() {
+                assert_eq!(
+                    rad.by_row(va, vb, iv),
+                    Row::Rejects,
+                    "segment {i} of a rejected block: {iv:?} rows {va} {vb} ({rad:?}, hull {hull:?}, rows {rows:?})"
+                );
+            }
+        }
+        assert!(
+            blocks > 150_000 && passed > 15_000 && close > 4_000,
+            "{blocks} blocks, {passed} rejected, {close} within 0.1 % of the threshold"
+        );
     }
 }

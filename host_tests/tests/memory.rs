@@ -14,9 +14,9 @@ fn processor_for_two_boundaries_of_256_points_fits_its_budget() {
         processor - frame - output
     );
     // Everything the processor keeps (state + output + scratch) is inside it.
-    // 26 888 B on the 32-bit target (asserted at compile time there); the
-    // host's `usize` fields make it 56 B more.
-    assert!(processor <= 26_944, "{processor} B");
+    // 26 892 B on the 32-bit target (asserted at compile time there); the
+    // host's `usize` fields make it 60 B more.
+    assert!(processor <= 26_952, "{processor} B");
 }
 
 /// The key-frame fusion's state and the road map beside the processor fit

@@ -20,6 +20,8 @@ impl<const N: usize> Index<N> {
         self.period = period;
         self.hint = 0;
         self.levels = 0;
+        self.tree_end = 0;
+        self.radial_levels = UNBUILT;
         self.aside.clear();
         self.near.clear();
         self.near_overflow = false;
@@ -130,6 +132,7 @@ impl<const N: usize> Index<N> {
     fn build_tree(&mut self) {
         let s = self.segments;
         self.levels = 0;
+        self.tree_end = 0;
         let (mut base, mut below_base, mut below_n, mut size) = (0usize, 0usize, s, 1usize);
         for level in 1..=LEVELS {
             size = size.saturating_mul(FAN);
@@ -162,6 +165,80 @@ impl<const N: usize> Index<N> {
                 }
             }
             self.levels = level;
+            self.tree_end = end;
+            below_base = base;
+            below_n = n;
+            base = end;
+            if n <= 1 {
+                return;
+            }
+        }
+    }
+
+    /// The block tree's radial levels (module docs) for the polyline `b`
+    /// this index was built from: after the key levels, each level `l`
+    /// has `⌈s / FAN^l⌉` blocks of four values, `(min lo, max hi)` of the
+    /// block's intervals and `(min v, max v)` of its vertices' rows (the
+    /// `FAN^l + 1` vertices of its segments), as many levels as fit in the
+    /// array, at most [`LEVELS`]. Built once until the next build of the
+    /// index; nothing when `b` is not this index's polyline. Every loop is
+    /// bounded by the array, the polyline, or the blocks of the level
+    /// below.
+    pub(super) fn build_radial(&mut self, b: &[crate::camera::Pixel]) {
+        self.radial_levels = 0;
+        let s = self.segments;
+        if s == 0 || b.len() != s + 1 {
+            return;
+        }
+        let (mut base, mut below_base, mut below_n, mut size) = (self.tree_end, 0usize, s, 1usize);
+        for level in 1..=LEVELS {
+            size = size.saturating_mul(FAN);
+            let n = s.div_ceil(size);
+            let Some(end) = base.checked_add(4 * n).filter(|&e| e <= N) else {
+                return;
+            };
+            for k in 0..n {
+                // Empty hulls; a block whose rows cannot be read gets the
+                // widest rows (no rejection).
+                let mut q = [
+                    f32::INFINITY,
+                    f32::NEG_INFINITY,
+                    f32::INFINITY,
+                    f32::NEG_INFINITY,
+                ];
+                if level == 1 {
+                    let (c0, c1) = (k * FAN, ((k + 1) * FAN).min(s));
+                    for g in self.seg.get(c0..c1).unwrap_or(&[]) {
+                        q[0] = fmin(q[0], g.lo);
+                        q[1] = fmax(q[1], g.hi);
+                    }
+                    match b.get(c0..=c1) {
+                        Some(vs) => {
+                            for p in vs {
+                                q[2] = fmin(q[2], p.v);
+                                q[3] = fmax(q[3], p.v);
+                            }
+                        }
+                        None => (q[2], q[3]) = (f32::NEG_INFINITY, f32::INFINITY),
+                    }
+                } else {
+                    for c in k * FAN..((k + 1) * FAN).min(below_n) {
+                        let i = below_base + 4 * c;
+                        let at = |i: usize, none: f32| self.tree.get(i).copied().unwrap_or(none);
+                        q[0] = fmin(q[0], at(i, f32::NEG_INFINITY));
+                        q[1] = fmax(q[1], at(i + 1, f32::INFINITY));
+                        q[2] = fmin(q[2], at(i + 2, f32::NEG_INFINITY));
+                        q[3] = fmax(q[3], at(i + 3, f32::INFINITY));
+                    }
+                }
+                if let Some(t) = self.tree.get_mut(base + 4 * k..base + 4 * k + 4) {
+                    for (t, v) in t.iter_mut().zip(q) {
+                        *t = v;
+                    }
+                }
+            }
+            // (`level` ≤ LEVELS = 4.)
+            self.radial_levels = u8::try_from(level).unwrap_or(0);
             below_base = base;
             below_n = n;
             base = end;

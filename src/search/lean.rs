@@ -3,6 +3,8 @@
 //! then bisection), shared by the wedge path and the index's own visits.
 
 use super::*;
+use crate::camera::Pixel;
+use crate::matching::Radial;
 
 /// An index's view for a caller that walks runs itself ([`Index::lean`]).
 #[derive(Clone, Copy)]
@@ -114,6 +116,62 @@ impl<const N: usize> Index<N> {
     #[inline(always)]
     pub(super) fn skip_at(&self, j: usize, meets: impl Fn(f32, f32) -> bool) -> usize {
         self.blocks().skip_at(j, meets)
+    }
+
+    /// The radial test of a band query, when it has one and the radial
+    /// levels are built ([`Self::build_radial`], on the first such query).
+    #[inline(always)]
+    pub(super) fn radial_for(&mut self, quick: Option<(Radial, &[Pixel])>) -> Option<Radial> {
+        let (rad, b) = quick?;
+        if self.radial_levels == UNBUILT {
+            self.build_radial(b);
+        }
+        (self.radial_levels > 0).then_some(rad)
+    }
+
+    /// At segment `j` of a run: how many segments from `j` on the radial
+    /// levels pass over, the largest block aligned at `j` that `rad`
+    /// rejects as a whole ([`Radial::rejects_block`]; 0: look at segment
+    /// `j` itself). At most [`LEVELS`] steps.
+    #[inline(always)]
+    pub(super) fn radial_skip_at(&self, j: usize, rad: &Radial) -> usize {
+        if j & (FAN - 1) != 0 {
+            return 0;
+        }
+        self.radial_skip_aligned(j, rad)
+    }
+
+    /// [`Self::radial_skip_at`] at an aligned `j` (out of line: one copy
+    /// for every visit that skips, 1 in 8 of its steps).
+    #[inline(never)]
+    fn radial_skip_aligned(&self, j: usize, rad: &Radial) -> usize {
+        let (mut base, mut n, mut skip) = (self.tree_end, self.segments, 0usize);
+        let mut shift = 0u32;
+        for _ in 0..usize::from(self.radial_levels).min(LEVELS) {
+            shift += FAN_BITS;
+            n = n.div_ceil(FAN);
+            // (`shift` ≤ 3 · LEVELS = 12.)
+            let size = 1usize << shift;
+            if j & (size - 1) != 0 {
+                break;
+            }
+            let i = base + 4 * (j >> shift);
+            let (Some(&lo), Some(&hi), Some(&v0), Some(&v1)) = (
+                self.tree.get(i),
+                self.tree.get(i + 1),
+                self.tree.get(i + 2),
+                self.tree.get(i + 3),
+            ) else {
+                break;
+            };
+            // A larger block holds this one: stop at the first kept.
+            if !rad.rejects_block((lo, hi), (v0, v1)) {
+                break;
+            }
+            skip = size;
+            base += 4 * n;
+        }
+        skip
     }
 
     /// The copies `[ql + 4m, qh + 4m]` of an oriented query that can meet

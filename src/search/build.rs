@@ -125,128 +125,125 @@ impl<const N: usize> Index<N> {
         }
     }
 
-    /// The block tree over the current intervals (module docs): as many
-    /// levels as fit in the `tree` array (each level `l` has
-    /// `⌈s / FAN^l⌉` blocks of two values), at most [`LEVELS`]; every loop
-    /// bounded by the array or by the blocks of the level below.
+    /// The block tree over the current intervals (module docs): the key
+    /// levels, `(min lo, max hi)` of each block ([`build_levels`]).
     fn build_tree(&mut self) {
         let s = self.segments;
-        self.levels = 0;
-        self.tree_end = 0;
-        let (mut base, mut below_base, mut below_n, mut size) = (0usize, 0usize, s, 1usize);
-        for level in 1..=LEVELS {
-            size = size.saturating_mul(FAN);
-            let n = s.div_ceil(size);
-            let Some(end) = base.checked_add(2 * n).filter(|&e| e <= N) else {
-                return;
-            };
-            for b in 0..n {
-                let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-                for c in b * FAN..((b + 1) * FAN).min(below_n) {
-                    let (l, h) = if level == 1 {
-                        self.seg
-                            .get(c)
-                            .map_or((f32::INFINITY, f32::NEG_INFINITY), |g| (g.lo, g.hi))
-                    } else {
-                        let i = below_base + 2 * c;
-                        (
-                            self.tree.get(i).copied().unwrap_or(f32::INFINITY),
-                            self.tree.get(i + 1).copied().unwrap_or(f32::NEG_INFINITY),
-                        )
-                    };
-                    lo = fmin(lo, l);
-                    hi = fmax(hi, h);
-                }
-                if let Some(t) = self.tree.get_mut(base + 2 * b) {
-                    *t = lo;
-                }
-                if let Some(t) = self.tree.get_mut(base + 2 * b + 1) {
-                    *t = hi;
-                }
+        let seg = &self.seg;
+        let leaf = |c0: usize, c1: usize| {
+            let mut q = [f32::INFINITY, f32::NEG_INFINITY];
+            for g in seg.get(c0..c1).unwrap_or(&[]) {
+                q = [fmin(q[0], g.lo), fmax(q[1], g.hi)];
             }
-            self.levels = level;
-            self.tree_end = end;
-            below_base = base;
-            below_n = n;
-            base = end;
-            if n <= 1 {
-                return;
-            }
-        }
+            q
+        };
+        (self.levels, self.tree_end) = build_levels(&mut self.tree, s, 0, leaf);
     }
 
     /// The block tree's radial levels (module docs) for the polyline `b`
-    /// this index was built from: after the key levels, each level `l`
-    /// has `⌈s / FAN^l⌉` blocks of four values, `(min lo, max hi)` of the
-    /// block's intervals and `(min v, max v)` of its vertices' rows (the
-    /// `FAN^l + 1` vertices of its segments), as many levels as fit in the
-    /// array, at most [`LEVELS`]. Built once until the next build of the
-    /// index; nothing when `b` is not this index's polyline. Every loop is
-    /// bounded by the array, the polyline, or the blocks of the level
-    /// below.
+    /// this index was built from, after the key levels: `(min lo, max hi)`
+    /// of each block's intervals and `(min v, max v)` of its vertices'
+    /// rows (the `FAN^l + 1` vertices of its segments) ([`build_levels`]).
+    /// Built once until the next build of the index; none when `b` is not
+    /// this index's polyline.
     pub(super) fn build_radial(&mut self, b: &[crate::camera::Pixel]) {
         self.radial_levels = 0;
         let s = self.segments;
         if s == 0 || b.len() != s + 1 {
             return;
         }
-        let (mut base, mut below_base, mut below_n, mut size) = (self.tree_end, 0usize, s, 1usize);
-        for level in 1..=LEVELS {
-            size = size.saturating_mul(FAN);
-            let n = s.div_ceil(size);
-            let Some(end) = base.checked_add(4 * n).filter(|&e| e <= N) else {
-                return;
-            };
-            for k in 0..n {
-                // Empty hulls; a block whose rows cannot be read gets the
-                // widest rows (no rejection).
-                let mut q = [
-                    f32::INFINITY,
-                    f32::NEG_INFINITY,
-                    f32::INFINITY,
-                    f32::NEG_INFINITY,
-                ];
-                if level == 1 {
-                    let (c0, c1) = (k * FAN, ((k + 1) * FAN).min(s));
-                    for g in self.seg.get(c0..c1).unwrap_or(&[]) {
-                        q[0] = fmin(q[0], g.lo);
-                        q[1] = fmax(q[1], g.hi);
-                    }
-                    match b.get(c0..=c1) {
-                        Some(vs) => {
-                            for p in vs {
-                                q[2] = fmin(q[2], p.v);
-                                q[3] = fmax(q[3], p.v);
-                            }
-                        }
-                        None => (q[2], q[3]) = (f32::NEG_INFINITY, f32::INFINITY),
-                    }
-                } else {
-                    for c in k * FAN..((k + 1) * FAN).min(below_n) {
-                        let i = below_base + 4 * c;
-                        let at = |i: usize, none: f32| self.tree.get(i).copied().unwrap_or(none);
-                        q[0] = fmin(q[0], at(i, f32::NEG_INFINITY));
-                        q[1] = fmax(q[1], at(i + 1, f32::INFINITY));
-                        q[2] = fmin(q[2], at(i + 2, f32::NEG_INFINITY));
-                        q[3] = fmax(q[3], at(i + 3, f32::INFINITY));
-                    }
-                }
-                if let Some(t) = self.tree.get_mut(base + 4 * k..base + 4 * k + 4) {
-                    for (t, v) in t.iter_mut().zip(q) {
-                        *t = v;
-                    }
-                }
+        let seg = &self.seg;
+        let leaf = |c0: usize, c1: usize| {
+            let mut q = [
+                f32::INFINITY,
+                f32::NEG_INFINITY,
+                f32::INFINITY,
+                f32::NEG_INFINITY,
+            ];
+            for g in seg.get(c0..c1).unwrap_or(&[]) {
+                (q[0], q[1]) = (fmin(q[0], g.lo), fmax(q[1], g.hi));
             }
-            // (`level` ≤ LEVELS = 4.)
-            self.radial_levels = u8::try_from(level).unwrap_or(0);
-            below_base = base;
-            below_n = n;
-            base = end;
-            if n <= 1 {
-                return;
+            // A block whose rows cannot be read gets the widest (no
+            // rejection).
+            match b.get(c0..=c1) {
+                Some(vs) => {
+                    for p in vs {
+                        (q[2], q[3]) = (fmin(q[2], p.v), fmax(q[3], p.v));
+                    }
+                }
+                None => (q[2], q[3]) = (f32::NEG_INFINITY, f32::INFINITY),
+            }
+            q
+        };
+        let (levels, _) = build_levels(&mut self.tree, s, self.tree_end, leaf);
+        // (`levels` ≤ LEVELS = 4.)
+        self.radial_levels = u8::try_from(levels).unwrap_or(0);
+    }
+}
+
+/// Levels of a block tree over `s` segments in `tree` from `base` on,
+/// `W` values a block: level 1's block `k` is `leaf(k·FAN, min((k + 1)·FAN,
+/// s))` (its segments' range), each higher level's block the hull of the
+/// `FAN` blocks below it (values at even places the minimum, at odd places
+/// the maximum: `(min, max)` pairs). As many levels as fit in `tree` (level
+/// `l` has `⌈s / FAN^l⌉` blocks), at most [`LEVELS`], stopping at the level
+/// of one block; returns how many were built and where the last one ends.
+/// Every loop is bounded by the array or by the blocks of the level below;
+/// an entry that cannot be read counts as the widest (`−∞` at even places,
+/// `∞` at odd ones).
+fn build_levels<const W: usize>(
+    tree: &mut [f32],
+    s: usize,
+    mut base: usize,
+    leaf: impl Fn(usize, usize) -> [f32; W],
+) -> (usize, usize) {
+    let (mut built, mut end_of) = (0usize, base);
+    let (mut below_base, mut below_n, mut size) = (0usize, s, 1usize);
+    for level in 1..=LEVELS {
+        size = size.saturating_mul(FAN);
+        let n = s.div_ceil(size);
+        let Some(end) = base.checked_add(W * n).filter(|&e| e <= tree.len()) else {
+            break;
+        };
+        for k in 0..n {
+            let q = if level == 1 {
+                leaf(k * FAN, ((k + 1) * FAN).min(s))
+            } else {
+                let mut q = [0.0f32; W];
+                for (i, v) in q.iter_mut().enumerate() {
+                    *v = if i % 2 == 0 {
+                        f32::INFINITY
+                    } else {
+                        f32::NEG_INFINITY
+                    };
+                }
+                for c in k * FAN..((k + 1) * FAN).min(below_n) {
+                    for (i, v) in q.iter_mut().enumerate() {
+                        let at = tree.get(below_base + W * c + i).copied();
+                        *v = if i % 2 == 0 {
+                            fmin(*v, at.unwrap_or(f32::NEG_INFINITY))
+                        } else {
+                            fmax(*v, at.unwrap_or(f32::INFINITY))
+                        };
+                    }
+                }
+                q
+            };
+            if let Some(t) = tree.get_mut(base + W * k..base + W * (k + 1)) {
+                for (t, v) in t.iter_mut().zip(q) {
+                    *t = v;
+                }
             }
         }
+        (built, end_of) = (level, end);
+        below_base = base;
+        below_n = n;
+        base = end;
+        if n <= 1 {
+            break;
+        }
     }
+    (built, end_of)
 }
 
 /// Whether the widened keys of a polyline's vertices, in order, each lie

@@ -33,8 +33,16 @@ use crate::structure::Status;
 /// What a walk concluded.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum Outcome {
-    /// A crossing: its `λ'` and the piece's range `[lo, hi]`.
-    Match { lam: f32, lo: f32, hi: f32 },
+    /// A crossing: its `λ'` and the piece's range `[lo, hi]`; on the
+    /// wedge path also where the piece ends, one past its last segment
+    /// (its segments' lines tighten the stick,
+    /// [`crate::wedge::Wedge::stick`]; the band path gives 0).
+    Match {
+        lam: f32,
+        lo: f32,
+        hi: f32,
+        end: usize,
+    },
     /// No depth, and why.
     Flag(Status),
 }
@@ -120,6 +128,7 @@ impl Walk {
             lam: fmin(fmax(self.best, self.lo), self.hi),
             lo: self.lo,
             hi: self.hi,
+            end: 0,
         }
     }
 }

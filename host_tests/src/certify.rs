@@ -709,6 +709,9 @@ pub struct Tally {
     pub ideal_by_status: Vec<usize>,
     /// Ideal points where the true frame-1 curve folds.
     pub ideal_folds: usize,
+    /// Relative stick widths `(z_far − z_near)/z_true` of the `Ok` points
+    /// with a correspondent.
+    pub widths: Vec<f32>,
 }
 
 impl Tally {
@@ -725,6 +728,7 @@ impl Tally {
         self.folded += o.folded;
         self.folded_spurious += o.folded_spurious;
         self.ideal_folds += o.ideal_folds;
+        self.widths.extend_from_slice(&o.widths);
         if self.ideal_by_status.len() < o.ideal_by_status.len() {
             self.ideal_by_status.resize(o.ideal_by_status.len(), 0);
         }
@@ -751,6 +755,16 @@ impl Tally {
     /// Share of the `Ok` points with a correspondent whose stick holds the truth.
     pub fn containment(&self) -> f64 {
         ratio(self.contained, self.ok_observed)
+    }
+    /// The `q`-quantile (0..1) of the relative stick widths, NaN if none.
+    pub fn width_quantile(&self, q: f64) -> f64 {
+        let mut w = self.widths.clone();
+        if w.is_empty() {
+            return f64::NAN;
+        }
+        w.sort_by(f32::total_cmp);
+        let i = ((w.len() - 1) as f64 * q).round() as usize;
+        f64::from(w[i])
     }
     /// Spurious `Folded` flags as a share of the ideal points.
     pub fn folded_loss(&self) -> f64 {
@@ -896,6 +910,7 @@ pub fn check(case: &Case, variant: Variant) -> Checked {
                 continue;
             }
             t.ok_observed += 1;
+            t.widths.push(((o.z_far - o.z_near) / tr.z_true) as f32);
             if inside {
                 t.contained += 1;
             } else {

@@ -86,6 +86,28 @@ fn print_report(rep: &Report, seconds: f64) {
             t.ok_unobserved_miss
         );
     }
+    // How wide the sticks are: (z_far − z_near)/z_true of the ok points
+    // with a correspondent, all families and the far, small-disparity one.
+    println!("\nRelative stick widths of the `ok` points with a correspondent (median / 90th percentile):\n");
+    println!("| variant | all families | far_small_disparity |");
+    println!("|---|---:|---:|");
+    for v in Variant::ALL {
+        let t = rep.variant_total(v);
+        let far = rep
+            .cells
+            .iter()
+            .find(|((f, cv), _)| *cv == v && f.name() == "far_small_disparity")
+            .map(|(_, c)| c.clone())
+            .unwrap_or_default();
+        println!(
+            "| {} | {:.4} / {:.4} | {:.4} / {:.4} |",
+            v.name(),
+            t.width_quantile(0.5),
+            t.width_quantile(0.9),
+            far.width_quantile(0.5),
+            far.width_quantile(0.9)
+        );
+    }
     // The worst miss of each scenario and variant, the worst 10 of those.
     let mut groups: Vec<(&host_tests::certify::Miss, usize)> = Vec::new();
     for m in &rep.misses {

@@ -102,19 +102,31 @@ fn match_wedge_lean<const N: usize>(
         // A loose index (the keys fold somewhere): the tree's skips too.
         for r in slots.iter_mut() {
             if r.status == Status::NoIntersection {
-                hint = walk.point_loose(r, hint, work);
+                let (h, refine) = walk.point_loose(r, hint, work);
+                hint = h;
+                if refine != 0 {
+                    walk.refine(r, refine);
+                }
             }
         }
     } else if aside.is_empty() {
         for r in slots.iter_mut() {
             if r.status == Status::NoIntersection {
-                hint = walk.point(r, hint, work);
+                let (h, refine) = walk.point(r, hint, work);
+                hint = h;
+                if refine != 0 {
+                    walk.refine(r, refine);
+                }
             }
         }
     } else {
         for r in slots.iter_mut() {
             if r.status == Status::NoIntersection {
-                hint = walk.point_aside(r, hint, work);
+                let (h, refine) = walk.point_aside(r, hint, work);
+                hint = h;
+                if refine != 0 {
+                    walk.refine(r, refine);
+                }
             }
         }
     }
@@ -170,7 +182,7 @@ fn match_wedge_angular<const N: usize>(
             work,
         );
         index.set_hint(a);
-        *r = conclude_wedge(pair, p1, iz, r1, &wedge, outcome);
+        *r = conclude_wedge(pair, (p1, iz, r1), &wedge, outcome, b2);
     }
 }
 
@@ -277,7 +289,7 @@ fn match_wedge_angular_reference<const N: usize>(
                 break;
             }
         }
-        *r = conclude_wedge(pair, p1, iz, r1, &wedge, walker.outcome());
+        *r = conclude_wedge(pair, (p1, iz, r1), &wedge, walker.outcome(), b2);
     }
 }
 
@@ -317,7 +329,7 @@ impl LeanWalk<'_> {
     /// returns where the run started. (Out of line: the walk's values stay
     /// in registers.)
     #[inline(never)]
-    fn point(&self, r: &mut PointResult, hint: usize, work: &mut Work) -> usize {
+    fn point(&self, r: &mut PointResult, hint: usize, work: &mut Work) -> (usize, usize) {
         let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
         let Ok(wedge) = Wedge::new(
             p,
@@ -326,7 +338,7 @@ impl LeanWalk<'_> {
             (key, self.key_scale, self.orient),
         ) else {
             *r = PointResult::flagged(p1, Status::AtFoe);
-            return hint;
+            return (hint, 0);
         };
         let (outcome, a) = wedge_run(
             &wedge,
@@ -336,21 +348,60 @@ impl LeanWalk<'_> {
             self.cot_twice,
             work,
         );
-        *r = conclude_wedge(self.pair, p1, iz, r1, &wedge, outcome);
-        a
+        (a, self.conclude(r, (p1, iz, r1), &wedge, outcome))
+    }
+
+    /// The point's result in `r` from its walk's outcome, or, where the
+    /// stick is to be tightened by the piece's lines ([`Wedge::refines`]),
+    /// `r` left as steps 1–2 left it and the piece's end returned for
+    /// [`Self::refine`] (0: done). (The refinement out of the walk's
+    /// function: there it cost the usual point 30 instructions.)
+    #[inline(always)]
+    fn conclude(
+        &self,
+        r: &mut PointResult,
+        (p1, iz, r1): (Pixel, f32, f32),
+        wedge: &Wedge,
+        outcome: Outcome,
+    ) -> usize {
+        if let Some(end) = wedge.refines(&outcome) {
+            return end;
+        }
+        *r = conclude_coarse(self.pair, (p1, iz, r1), wedge, outcome);
+        0
+    }
+
+    /// The result of a point whose walk ended with the piece that ends at
+    /// `end` and whose stick [`Self::conclude`] left to tighten: its
+    /// wedge again (the same arithmetic: the same bits), then the piece's
+    /// crossing and refined stick ([`Wedge::refined`]).
+    #[cold]
+    #[inline(never)]
+    fn refine(&self, r: &mut PointResult, end: usize) {
+        let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
+        *r = match Wedge::new(
+            p,
+            (self.foe, self.side),
+            (r1, self.e2, self.e2_csc),
+            (key, self.key_scale, self.orient),
+        ) {
+            Ok(wedge) => conclude_refined(self.pair, (p1, iz, r1), &wedge, self.b2, end),
+            // (Not reached: the walk had this wedge.)
+            Err(_) => PointResult::flagged(p1, Status::AtFoe),
+        };
     }
 
     /// [`Self::point`] with the index's aside entries merged into the run
     /// ([`wedge_run_aside`]).
     #[inline(never)]
-    fn point_aside(&self, r: &mut PointResult, hint: usize, work: &mut Work) -> usize {
+    fn point_aside(&self, r: &mut PointResult, hint: usize, work: &mut Work) -> (usize, usize) {
         self.aside_walk::<false>(r, hint, work)
     }
 
     /// [`Self::point_aside`] through a loose index: the run's blocks that
     /// miss the wedge's keys skipped by the tree ([`wedge_run_aside`]).
     #[inline(never)]
-    fn point_loose(&self, r: &mut PointResult, hint: usize, work: &mut Work) -> usize {
+    fn point_loose(&self, r: &mut PointResult, hint: usize, work: &mut Work) -> (usize, usize) {
         self.aside_walk::<true>(r, hint, work)
     }
 
@@ -364,7 +415,7 @@ impl LeanWalk<'_> {
         r: &mut PointResult,
         hint: usize,
         work: &mut Work,
-    ) -> usize {
+    ) -> (usize, usize) {
         let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
         let Ok(wedge) = Wedge::new(
             p,
@@ -373,7 +424,7 @@ impl LeanWalk<'_> {
             (key, self.key_scale, self.orient),
         ) else {
             *r = PointResult::flagged(p1, Status::AtFoe);
-            return hint;
+            return (hint, 0);
         };
         // When no aside entry has a part in the wedge, offered in their
         // places they would change nothing: the run is walked without
@@ -397,8 +448,7 @@ impl LeanWalk<'_> {
                     ),
                     Err(OutOfWork) => (Outcome::Flag(Status::OverBudget), hint),
                 };
-                *r = conclude_wedge(self.pair, p1, iz, r1, &wedge, outcome);
-                return a;
+                return (a, self.conclude(r, (p1, iz, r1), &wedge, outcome));
             }
         }
         let (outcome, a) = wedge_run_aside::<SKIP>(
@@ -408,8 +458,7 @@ impl LeanWalk<'_> {
             (self.segments, self.cot_twice),
             work,
         );
-        *r = conclude_wedge(self.pair, p1, iz, r1, &wedge, outcome);
-        a
+        (a, self.conclude(r, (p1, iz, r1), &wedge, outcome))
     }
 }
 
@@ -446,7 +495,7 @@ fn match_wedge_reference(
                 break;
             }
         }
-        *r = conclude_wedge(pair, p1, iz, r1, &wedge, walker.outcome());
+        *r = conclude_wedge(pair, (p1, iz, r1), &wedge, walker.outcome(), b2);
     }
 }
 
@@ -773,22 +822,54 @@ fn aside_idle(wedge: &Wedge, b2: &[Pixel], aside: &[crate::search::Aside]) -> Op
 }
 
 /// The point's result from a wedge walk's outcome: depth and stick
-/// ([`crate::wedge`]).
-fn conclude_wedge(
+/// from the piece's range ([`Wedge::depths`]), for an outcome that
+/// [`Wedge::refines`] leaves alone.
+#[inline(always)]
+fn conclude_coarse(
     pair: &Pair,
-    p1: Pixel,
-    iz: f32,
-    r1: f32,
+    (p1, iz, r1): (Pixel, f32, f32),
     wedge: &Wedge,
     outcome: Outcome,
 ) -> PointResult {
     let (lam, lo, hi) = match outcome {
-        Outcome::Match { lam, lo, hi } => (lam, lo, hi),
+        Outcome::Match { lam, lo, hi, .. } => (lam, lo, hi),
         Outcome::Flag(s) => return PointResult::flagged(p1, s),
     };
     let p2 = wedge.point_at(lam);
     let depths = wedge.depths(pair.geom.w(), r1, (lam, lo, hi));
     finish_point(pair, p1, p2, iz, depths)
+}
+
+/// The point's result from a wedge walk's outcome: depth and stick
+/// ([`crate::wedge`]), tightened by the piece's lines where
+/// [`Wedge::refines`] says.
+fn conclude_wedge(
+    pair: &Pair,
+    (p1, iz, r1): (Pixel, f32, f32),
+    wedge: &Wedge,
+    outcome: Outcome,
+    b2: &[Pixel],
+) -> PointResult {
+    match wedge.refines(&outcome) {
+        Some(end) => conclude_refined(pair, (p1, iz, r1), wedge, b2, end),
+        None => conclude_coarse(pair, (p1, iz, r1), wedge, outcome),
+    }
+}
+
+/// [`conclude_wedge`] for a walk whose piece ends at `end` and whose
+/// outcome [`Wedge::refines`] ([`Wedge::refined`]).
+fn conclude_refined(
+    pair: &Pair,
+    (p1, iz, r1): (Pixel, f32, f32),
+    wedge: &Wedge,
+    b2: &[Pixel],
+    end: usize,
+) -> PointResult {
+    match wedge.refined(b2, end, (pair.geom.w(), r1)) {
+        Some((x, depths)) => finish_point(pair, p1, wedge.point_at(x), iz, depths),
+        // (Not reached: the walk found this piece with this wedge.)
+        None => PointResult::flagged(p1, Status::NoIntersection),
+    }
 }
 
 /// Step 4 for one point left by steps 1–2 in `r`.
@@ -913,7 +994,7 @@ fn conclude(
     outcome: Outcome,
 ) -> PointResult {
     let (lam, lo, hi) = match outcome {
-        Outcome::Match { lam, lo, hi } => (lam, lo, hi),
+        Outcome::Match { lam, lo, hi, .. } => (lam, lo, hi),
         Outcome::Flag(s) => return PointResult::flagged(p1, s),
     };
     let p2 = band.point_at(lam);

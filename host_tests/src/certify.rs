@@ -135,6 +135,55 @@ impl PointTruth {
     }
 }
 
+/// Whether **any** method that guarantees its stick could bound the far
+/// end of detected frame-1 point `p` against the detected frame-2
+/// polyline `poly` with the declared errors `(e₁, e₂)`: the polyline
+/// passes farther than `r₁ + e₂` from the compensated point, `r₁` the
+/// smallest radius of the image of `p`'s `e₁` disc under the compensation
+/// (24 directions, to first order; 0.1 % taken off). If it passes nearer,
+/// a true frame-1 point within `e₁` of `p` and a true frame-2 curve within
+/// `e₂` of the polyline can meet at one image point: zero disparity,
+/// infinite depth, consistent with both detections, so no guaranteed
+/// stick is bounded.
+pub fn boundable(
+    r: &Rendered,
+    k: &Intrinsics,
+    p: Pixel,
+    poly: &[Pixel],
+    (e1, e2): (f64, f64),
+) -> bool {
+    let (u, v) = (f64::from(p.u), f64::from(p.v));
+    let c = r.compensate(k, u, v);
+    let h = 1e-3;
+    let r1 = (0..24)
+        .map(|j| {
+            let a = std::f64::consts::TAU * f64::from(j) / 24.0;
+            let q = r.compensate(k, u + h * a.cos(), v + h * a.sin());
+            norm2(sub2(q, c)) / h
+        })
+        .fold(f64::INFINITY, f64::min)
+        * e1
+        * 0.999;
+    let dist = poly
+        .windows(2)
+        .map(|w| {
+            let (a, b) = (
+                [f64::from(w[0].u), f64::from(w[0].v)],
+                [f64::from(w[1].u), f64::from(w[1].v)],
+            );
+            let (ab, ac) = (sub2(b, a), sub2(c, a));
+            let l2 = dot2(ab, ab);
+            let t = if l2 > 0.0 {
+                (dot2(ac, ab) / l2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            norm2(sub2(c, [a[0] + t * ab[0], a[1] + t * ab[1]]))
+        })
+        .fold(f64::INFINITY, f64::min);
+    dist > r1 + e2 * 0.999
+}
+
 /// A rendered scenario with its ground truth.
 #[derive(Debug, Clone)]
 pub struct Case {
@@ -712,6 +761,10 @@ pub struct Tally {
     /// Relative stick widths `(z_far − z_near)/z_true` of the `Ok` points
     /// with a correspondent.
     pub widths: Vec<f32>,
+    /// Ideal points whose far end any guaranteed stick could bound: the
+    /// frame-2 polyline passes farther than `r₁ + e₂` from the detected
+    /// compensated point ([`boundable`]).
+    pub ideal_boundable: usize,
 }
 
 impl Tally {
@@ -729,6 +782,7 @@ impl Tally {
         self.folded_spurious += o.folded_spurious;
         self.ideal_folds += o.ideal_folds;
         self.widths.extend_from_slice(&o.widths);
+        self.ideal_boundable += o.ideal_boundable;
         if self.ideal_by_status.len() < o.ideal_by_status.len() {
             self.ideal_by_status.resize(o.ideal_by_status.len(), 0);
         }
@@ -765,6 +819,10 @@ impl Tally {
         w.sort_by(f32::total_cmp);
         let i = ((w.len() - 1) as f64 * q).round() as usize;
         f64::from(w[i])
+    }
+    /// Share of the ideal points any guaranteed stick could bound.
+    pub fn boundable_share(&self) -> f64 {
+        ratio(self.ideal_boundable, self.ideal)
     }
     /// Spurious `Folded` flags as a share of the ideal points.
     pub fn folded_loss(&self) -> f64 {
@@ -888,6 +946,11 @@ pub fn check(case: &Case, variant: Variant) -> Checked {
             if ideal {
                 t.ideal += 1;
                 t.ideal_folds += usize::from(tr.folds);
+                let (d1, d2) = (&input.frame1, &input.frame2);
+                if let (Some(p), Some(poly)) = (d1.get(b).and_then(|f| f.get(i)), d2.get(b)) {
+                    t.ideal_boundable +=
+                        usize::from(boundable(&case.rendered, k, *p, poly, (input.e1, input.e2)));
+                }
                 if let Some(s) = Status::ALL.iter().position(|&s| s == o.status) {
                     t.ideal_by_status[s] += 1;
                 }

@@ -108,6 +108,21 @@ fn print_report(rep: &Report, seconds: f64) {
             far.width_quantile(0.9)
         );
     }
+    // Where the ideal itself is out of reach of a guaranteed stick.
+    println!("\nIdeal points any guaranteed stick could bound at all (the polyline farther than r₁ + e₂ from the point; `host_tests::certify::boundable`), against those `ok`:\n");
+    println!("| family | variant | boundable / ideal | ok∩ideal / ideal |");
+    println!("|---|---|---:|---:|");
+    for ((f, v), c) in &rep.cells {
+        if c.boundable_share() < 0.97 {
+            println!(
+                "| {} | {} | {:.1} % | {:.1} % |",
+                f.name(),
+                v.name(),
+                100.0 * c.boundable_share(),
+                100.0 * c.ideal_recall()
+            );
+        }
+    }
     // The worst miss of each scenario and variant, the worst 10 of those.
     let mut groups: Vec<(&host_tests::certify::Miss, usize)> = Vec::new();
     for m in &rep.misses {

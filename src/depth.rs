@@ -81,6 +81,13 @@
 //! `w/tan φ` (`w` the band's width): flatter than the configured minimum
 //! angle it is [`crate::Status::Grazing`], which keeps the sticks useful;
 //! the bound holds at every angle.
+//! The two ends bound the two distances from the FOE separately, on
+//! different rays; on the wedge path (forward motion, no translation
+//! error) the stick of a point whose disparity is a few times its error
+//! is tightened by the lines of the piece's segments, which is exact for
+//! a straight boundary (the far end is bounded exactly when the polyline
+//! passes farther than `r₁ + e₂` from `p₁'`; `src/wedge.rs`, "The stick
+//! from the piece's lines").
 //!
 //! All of this is computed in `f32`. The band is widened by the rounding of
 //! the coordinates involved, `2⁻²⁰ S` pixels for coordinates below `S`

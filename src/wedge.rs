@@ -112,6 +112,60 @@
 //! frame's scale `S` and, as distances (divided by `ρ₁`), are off by a few
 //! `2⁻²⁴ S` at most, which the slack of `2⁻²⁰ S` in `r₁` and `e₂` covers
 //! (see [`crate::depth`]).
+//!
+//! # The stick from the piece's lines
+//! The stick above bounds the two distances from the FOE apart: the true
+//! frame-1 point by the disc (`d̂·P₁ ≤ R + ρ₁ r₁`, in the wedge's frame
+//! `X = d·w`, `Y = d × w`, where `P₁' = (R, 0)`) and the true
+//! correspondent by the piece's range (`d̂·P₂ ≥ lo − ρ₁ e₂`). Both can
+//! hold only on different rays, which the truth is not: `P₁ = k P₂` on one
+//! ray from the FOE, with `k = ρ(p₁)/ρ(p₂) < 1` and `s = W'/(1 − k)`
+//! (the estimate's `k` is `R/X`). So the same bound holds with **any**
+//! direction `u` in place of `d̂`: `u·P₁ = k u·P₂`, and where `u·P₂` is
+//! positive over the true correspondent's region,
+//!
+//! `k ≤ max u·P₁ / min u·P₂`,   `k ≥ min u·P₁ / max u·P₂`,
+//!
+//! with `max u·P₁ = u·P₁' + ρ₁ r₁ |u|` over the disc and, for a
+//! correspondent within `e₂` of segment `a → b`, `min u·P₂ = min(u·a,
+//! u·b) − ρ₁ e₂ |u|` (the segment's `e₂`-neighbourhood is convex, a linear
+//! function takes its extremes at the ends). In `t = k/(1 − k)` (`s = W'
+//! (1 + t)`), `t ≤ max u·P₁ / (min u·P₂ − max u·P₁)`, whose denominator is
+//! `min(u·(a − P₁'), u·(b − P₁')) − ρ₁ (r₁ + e₂) |u|`: computed from the
+//! differences `a − P₁'`, without the cancellation of two large products.
+//! The true correspondent lies within `e₂` of one of the piece's segments
+//! (a polyline point within `e₂` of it lies in the wedge, and the piece
+//! holds every segment with a part there), so `t_far = max` over the
+//! segments of the smallest bound each of three directions gives: `d̂`
+//! (the segment's own part `[lo_j, hi_j]`, the stick above segment by
+//! segment), the segment's normal, and the normal of the piece's chord
+//! (first to last vertex; a pixel staircase's steps point every way, its
+//! chord does not); `t_near` likewise with `min` and `max` exchanged.
+//!
+//! For a straight boundary crossing the line at `φ` this is exact: the
+//! normal gives `k ≤ (ρ₁ sin φ + r₁)/((ρ₁ + D) sin φ − e₂)`, so the far end
+//! is bounded exactly when `D sin φ > r₁ + e₂`: when the polyline passes
+//! farther than `r₁ + e₂` from `p₁'`, which is also necessary (otherwise a
+//! true point and a correspondent both at `p₁'`'s nearest polyline point,
+//! at infinite depth, fit the error model). The piece's range alone
+//! needs `D > r₁ + e₂ + (r₁ + e₂) cot φ`: at 45° that is `2 (r₁ + e₂)`
+//! against `1.41 (r₁ + e₂)`, at 20° `3.75` against `2.92`; the far end's
+//! disparity error shrinks by `(r₁ + e₂)(1 + cot φ − 1/sin φ)`, up to
+//! `0.9 (r₁ + e₂)`. It matters where the disparity is a few times the
+//! error, so it is taken there only ([`Wedge::refines`]: the far end
+//! unbounded, or its disparity under [`REFINE_GAP`] `(r₁ + e₂)` by the
+//! piece's range), out of the walk's function: the walk keeps the usual
+//! point's registers, and the refinement finds the piece again from its
+//! end ([`Wedge::refined`]: back to the first segment without a part,
+//! then the range, the crossing and the bounds in one pass, bit for bit
+//! the walk's range and crossing). The band path keeps the stick from the
+//! range alone. Rounding: `|u|` is bounded above (`rsqrt_pos` with
+//! [`crate::math::RSQRT_UP`] twice), each `u·(v − P₁')` and `u_x R` is
+//! widened by four times its rounding bound, and the ends are rounded
+//! outwards by `2⁻²²`; the vertices' own rounding is the slack in `r₁` and
+//! `e₂`, as above. `refined_stick_holds_every_consistent_depth` checks the
+//! bound against `f64` configurations at the extremes of the model (and
+//! fails with any of the error terms 10 % short).
 
 use crate::camera::Pixel;
 use crate::matching::Outcome;

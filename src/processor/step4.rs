@@ -857,7 +857,10 @@ fn conclude_wedge(
 }
 
 /// [`conclude_wedge`] for a walk whose piece ends at `end` and whose
-/// outcome [`Wedge::refines`] ([`Wedge::refined`]).
+/// outcome [`Wedge::refines`] ([`Wedge::refined`]). (Out of line: the
+/// usual point does not take it.)
+#[cold]
+#[inline(never)]
 fn conclude_refined(
     pair: &Pair,
     (p1, iz, r1): (Pixel, f32, f32),

@@ -535,8 +535,10 @@ impl Wedge {
 
 /// [`Wedge::refines`] a stick whose far end's disparity (from the
 /// piece's range) is under this many times `r₁ + e₂`: there the lines can
-/// take up to about `0.9 (r₁ + e₂)` off the disparity's error (module
-/// docs), a tenth of it or more.
+/// take up to about `0.9 (r₁ + e₂)` off it (module docs), a fifth or
+/// more. (At 10 the refinement would still shorten far ends by up to a
+/// tenth, but the demo's costliest frame would refine 70 of its points,
+/// +11 %; `docs/PERFORMANCE.md`.)
 pub(crate) const REFINE_GAP: f32 = 4.0;
 
 /// A depth estimate and the stick's ends in the compensated frame, `(s,

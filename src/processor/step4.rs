@@ -153,6 +153,7 @@ fn match_wedge_angular<const N: usize>(
 ) {
     let (e2, e2_csc, cot_twice) = (pair.e2(), pair.e2_csc(), pair.config.cot_twice);
     let segments = b2.len().saturating_sub(1);
+    let mut deferred = false;
     for r in slots.iter_mut() {
         if r.status != Status::NoIntersection {
             continue;
@@ -182,7 +183,46 @@ fn match_wedge_angular<const N: usize>(
             work,
         );
         index.set_hint(a);
-        *r = conclude_wedge(pair, (p1, iz, r1), &wedge, outcome, b2);
+        match wedge.refines(&outcome) {
+            // Left for [`refine_deferred`] (out of this loop: a call here
+            // cost every point 30 instructions): the slot keeps steps
+            // 1–2's values, `z_far` (the key, no longer needed) the
+            // piece's end (exact: below 2²⁴).
+            Some(end) => {
+                r.z_far = end as f32;
+                deferred = true;
+            }
+            None => *r = conclude_coarse(pair, (p1, iz, r1), &wedge, outcome),
+        }
+    }
+    if deferred {
+        refine_deferred((pair, foe), slots, b2);
+    }
+}
+
+/// The points [`match_wedge_angular`] left to refine: still
+/// [`Status::NoIntersection`] with steps 1–2's `r₁ > 0` in `z_near` (every
+/// point it concluded or flagged has a clean result, `z_near` 0 where it
+/// is flagged) and the piece's end in `z_far`. Each gets its wedge's
+/// geometry again (the same bits; the keys are not needed) and the refined
+/// stick ([`conclude_refined`]).
+#[cold]
+#[inline(never)]
+fn refine_deferred((pair, foe): (&Pair, [f32; 2]), slots: &mut [PointResult], b2: &[Pixel]) {
+    let errors = (pair.e2(), pair.e2_csc());
+    for r in slots
+        .iter_mut()
+        .filter(|r| r.status == Status::NoIntersection && r.z_near > 0.0)
+    {
+        let (p1, p, iz, r1) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near);
+        // (Finite, integral and below 2²⁴: as the loop stored it.)
+        let end = r.z_far as usize;
+        let no_key = (crate::pencil::NO_KEY, 1.0, 1.0);
+        *r = match Wedge::new_angular(p, foe, (r1, errors.0, errors.1), no_key) {
+            Ok(wedge) => conclude_refined(pair, (p1, iz, r1), &wedge, b2, end),
+            // (Not reached: the loop had this wedge.)
+            Err(_) => PointResult::flagged(p1, Status::AtFoe),
+        };
     }
 }
 

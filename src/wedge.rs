@@ -545,9 +545,13 @@ pub(crate) const REFINE_GAP: f32 = 4.0;
 /// s_near, s_far)` ([`Wedge::depths`]).
 pub(crate) type Depths = (f32, f32, f32);
 
-/// `1 + 2⁻²²` and `1 − 2⁻²²`: the refined stick's ends rounded outwards.
-const STICK_UP: f32 = 1.0 + 2.384_185_8e-7;
-const STICK_DOWN: f32 = 1.0 - 2.384_185_8e-7;
+/// `1 + 2⁻²¹` and `1 − 2⁻²¹`: the refined stick's ends rounded outwards.
+/// The ends' own arithmetic (`t`'s quotient, then `w + w t`) rounds by at
+/// most about `3 · 2⁻²⁴` relative, and the product with this factor by
+/// `2⁻²⁴` more, so `2⁻²¹` (8 · 2⁻²⁴) covers both with room; `2⁻²²` alone
+/// was short by about `2⁻⁴⁷`, absorbed only by the other margins.
+const STICK_UP: f32 = 1.0 + 4.768_371_6e-7;
+const STICK_DOWN: f32 = 1.0 - 4.768_371_6e-7;
 
 /// A direction `u` in the wedge's frame (not unit: `|u| ≤ l`), oriented so
 /// that the segment it was made from lies on its positive side, with what
@@ -592,7 +596,7 @@ impl Direction {
 
     /// `u·(v − P₁')`, computed as `u_x (X − R) + u_y Y`, lowered (`−`) and
     /// raised (`+`) by its rounding, 4 times over (`X − R` is exact where
-    /// `X ≤ 2R`, and within `2⁻²⁴` of itself where not).
+    /// `R/2 ≤ X ≤ 2R`, Sterbenz, and within `2⁻²⁴` of itself where not).
     #[inline(always)]
     fn beyond(&self, v: &WVertex, r2: f32) -> (f32, f32) {
         let (p, q) = (self.u[0] * (v.x - r2), self.u[1] * v.y);

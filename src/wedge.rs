@@ -162,7 +162,7 @@
 //! range alone. Rounding: `|u|` is bounded above (`rsqrt_pos` with
 //! [`crate::math::RSQRT_UP`] twice), each `u·(v − P₁')` and `u_x R` is
 //! widened by four times its rounding bound, and the ends are rounded
-//! outwards by `2⁻²²`; the vertices' own rounding is the slack in `r₁` and
+//! outwards by `2⁻²¹`; the vertices' own rounding is the slack in `r₁` and
 //! `e₂`, as above. `refined_stick_holds_every_consistent_depth` checks the
 //! bound against `f64` configurations at the extremes of the model (and
 //! fails with any of the error terms 10 % short).

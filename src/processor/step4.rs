@@ -555,10 +555,11 @@ fn raw_interval(keying: &Keying, a: [f32; 2], b: [f32; 2]) -> (f32, f32) {
 }
 
 /// The wedge walk over the run of an index's lean view without aside
-/// entries or block tree (the segments [`Index::visit`] would offer, each
-/// looked at a unit, each whose interval meets the query [`CLIP_UNITS`]
-/// more, as the reference's [`WedgeWalker`] takes them), with the walk's
-/// values in locals. Returns the outcome and where the run started.
+/// entries (the segments [`Index::visit`] would offer, each looked at a
+/// unit, each whose interval meets the query [`CLIP_UNITS`] more, as the
+/// reference's [`WedgeWalker`] takes them): [`wedge_run_aside`] with no
+/// entries and no block tree. Returns the outcome and where the run
+/// started.
 #[inline(always)]
 fn wedge_run(
     wedge: &Wedge,
@@ -568,74 +569,13 @@ fn wedge_run(
     cot_twice: f32,
     work: &mut Work,
 ) -> (Outcome, usize) {
-    let (kl, kh) = (wedge.kl, wedge.kh);
-    let a = match run_start_in(segs, hint, kl, work) {
-        Ok(a) => a,
-        Err(OutOfWork) => return (Outcome::Flag(Status::OverBudget), hint),
-    };
-    let mut walk = WedgeWalk::NEW;
-    let mut c = work.credit();
-    // The vertex that starts segment `j`, when it is `va`.
-    let mut cached = usize::MAX;
-    let mut va = WVertex::NONE;
-    let mut stop = None;
-    let end = segs.len().min(b2.len().saturating_sub(1));
-    // The vertices up to the run's last end.
-    let b2 = b2.get(..end + 1).unwrap_or(&[]);
-    for j in a..end {
-        let (Some(g), Some(v1)) = (segs.get(j), b2.get(j + 1)) else {
-            break;
-        };
-        // The interval's low end decides first: below `kl` the segment
-        // reaches past the low edge, above `kh` it misses (and past the
-        // suffix minimum, at most the low end, the run ends).
-        // (A NaN fails.)
-        let lo_meets = g.lo < kl || g.lo <= kh;
-        if !lo_meets {
-            if g.sm > kh {
-                break;
-            }
-            if c == 0 {
-                stop = Some(Status::OverBudget);
-                break;
-            }
-            c -= 1;
-            continue;
-        }
-        if c == 0 {
-            stop = Some(Status::OverBudget);
-            break;
-        }
-        c -= 1;
-        let hi_meets = g.hi > kh || g.hi >= kl;
-        if !hi_meets {
-            continue;
-        }
-        if c < CLIP_UNITS {
-            c = 0;
-            stop = Some(Status::OverBudget);
-            break;
-        }
-        c -= CLIP_UNITS;
-        if cached != j {
-            if let Some(v0) = b2.get(j) {
-                va = wedge.vertex(v0.arr());
-            }
-        }
-        let vb = wedge.vertex(v1.arr());
-        if let Err(s) = walk.take_met(wedge, j, (&va, &vb), segments, cot_twice) {
-            stop = Some(s);
-            break;
-        }
-        va = vb;
-        cached = j + 1;
-    }
-    work.set_credit(c);
-    let outcome = match stop {
-        Some(s) => Outcome::Flag(s),
-        None => walk.outcome(),
-    };
-    (outcome, a)
+    wedge_run_aside::<false>(
+        wedge,
+        (segs, b2, &[]),
+        (hint, Blocks::NONE),
+        (segments, cot_twice),
+        work,
+    )
 }
 
 /// [`wedge_run`] through an index with aside entries: each one offered
@@ -719,24 +659,26 @@ pub(super) fn wedge_run_aside<const SKIP: bool>(
             }
             continue;
         }
-        if c == 0 {
-            stop = Some(Status::OverBudget);
-            break;
-        }
-        c -= 1;
         let hi_meets = g.hi > kh || g.hi >= kl;
         if !hi_meets {
+            if c == 0 {
+                stop = Some(Status::OverBudget);
+                break;
+            }
+            c -= 1;
             if SKIP {
                 at = j.saturating_add(blocks.skip_at(j, meets).max(1));
             }
             continue;
         }
-        if c < CLIP_UNITS {
+        // The look's unit and the clip's together (short of them, the
+        // walk stops with the credit spent, as a look then a clip would).
+        if c <= CLIP_UNITS {
             c = 0;
             stop = Some(Status::OverBudget);
             break;
         }
-        c -= CLIP_UNITS;
+        c -= CLIP_UNITS + 1;
         if cached != j {
             if let Some(v0) = run.get(j) {
                 va = wedge.vertex(v0.arr());
@@ -793,19 +735,20 @@ fn offer(
     (cached, va): (&mut usize, &mut WVertex),
     (segments, cot_twice): (usize, f32),
 ) -> Result<(), Status> {
-    if *c == 0 {
-        return Err(Status::OverBudget);
-    }
-    *c -= 1;
     // (A NaN fails.)
     if !(l <= wedge.kh && h >= wedge.kl) {
+        if *c == 0 {
+            return Err(Status::OverBudget);
+        }
+        *c -= 1;
         return Ok(());
     }
-    if *c < CLIP_UNITS {
+    // The look's unit and the clip's together ([`wedge_run_aside`]).
+    if *c <= CLIP_UNITS {
         *c = 0;
         return Err(Status::OverBudget);
     }
-    *c -= CLIP_UNITS;
+    *c -= CLIP_UNITS + 1;
     let Some(v1) = b2.get(k + 1) else {
         return Ok(());
     };

@@ -52,6 +52,13 @@ pub(crate) struct Blocks<'a> {
 }
 
 impl Blocks<'_> {
+    /// No tree (a walk without skips).
+    pub(crate) const NONE: Blocks<'static> = Blocks {
+        tree: &[],
+        levels: 0,
+        segments: 0,
+    };
+
     /// Whether there is a tree (a loose index).
     #[inline(always)]
     pub(crate) fn any(&self) -> bool {

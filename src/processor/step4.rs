@@ -151,6 +151,9 @@ fn match_wedge_angular<const N: usize>(
     index: &mut Index<N>,
     work: &mut Work,
 ) {
+    // A piece's end (at most `N`) is kept in an `f32` for
+    // [`refine_deferred`]: exact below 2²⁴. (At compile time, no cost.)
+    const { assert!(N < 1 << 24, "a boundary capacity below 2^24 points") };
     let (e2, e2_csc, cot_twice) = (pair.e2(), pair.e2_csc(), pair.config.cot_twice);
     let segments = b2.len().saturating_sub(1);
     let mut deferred = false;
@@ -187,7 +190,8 @@ fn match_wedge_angular<const N: usize>(
             // Left for [`refine_deferred`] (out of this loop: a call here
             // cost every point 30 instructions): the slot keeps steps
             // 1–2's values, `z_far` (the key, no longer needed) the
-            // piece's end (exact: below 2²⁴).
+            // piece's end, below `N` and so exact as an `f32` (the
+            // assertion above).
             Some(end) => {
                 r.z_far = end as f32;
                 deferred = true;
@@ -215,7 +219,7 @@ fn refine_deferred((pair, foe): (&Pair, [f32; 2]), slots: &mut [PointResult], b2
         .filter(|r| r.status == Status::NoIntersection && r.z_near > 0.0)
     {
         let (p1, p, iz, r1) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near);
-        // (Finite, integral and below 2²⁴: as the loop stored it.)
+        // (Finite, integral and below 2²⁴: the loop stored only such.)
         let end = r.z_far as usize;
         let no_key = (crate::pencil::NO_KEY, 1.0, 1.0);
         *r = match Wedge::new_angular(p, foe, (r1, errors.0, errors.1), no_key) {
@@ -743,8 +747,8 @@ fn offer(
     if !(l <= wedge.kh && h >= wedge.kl) {
         return Ok(());
     }
-    // (The look and the clip paid by one test, as in the run, measured
-    // dearer here: `foe_row` +0.6 %.)
+    // (Two tests here: the run's one test for the look and the clip
+    // together measured dearer in this function, `foe_row` +0.6 %.)
     if *c < CLIP_UNITS {
         *c = 0;
         return Err(Status::OverBudget);

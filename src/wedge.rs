@@ -163,9 +163,10 @@
 //! [`crate::math::RSQRT_UP`] twice), each `u·(v − P₁')` and `u_x R` is
 //! widened by four times its rounding bound, and the ends are rounded
 //! outwards by `2⁻²¹`; the vertices' own rounding is the slack in `r₁` and
-//! `e₂`, as above. `refined_stick_holds_every_consistent_depth` checks the
-//! bound against `f64` configurations at the extremes of the model (and
-//! fails with any of the error terms 10 % short).
+//! `e₂`, as above (see [`STICK_UP`] for what carries which rounding).
+//! `refined_stick_holds_every_consistent_depth` checks the bound against
+//! `f64` configurations near the extremes of the model (the truth at
+//! 0.999 of each error; it fails with any of the error terms 10 % short).
 
 use crate::camera::Pixel;
 use crate::matching::Outcome;
@@ -444,8 +445,8 @@ impl Wedge {
     /// The first segment of the piece that ends at `end`: the walk took
     /// every segment with a part in the wedge, and found one piece, so
     /// the piece's segments are those before `end` back to the first
-    /// without a part. At most the piece's segments and one more, each of
-    /// which the walk paid for.
+    /// without a part. At most the piece's segments, each of which the
+    /// walk paid for, and one more (which it may not have looked at).
     fn piece_start(&self, b2: &[Pixel], end: usize) -> Option<usize> {
         let mut first = end.checked_sub(1)?;
         let mut vb = self.vertex(b2.get(first)?.arr());
@@ -535,8 +536,9 @@ impl Wedge {
 
 /// [`Wedge::refines`] a stick whose far end's disparity (from the
 /// piece's range) is under this many times `r₁ + e₂`: there the lines can
-/// take up to about `0.9 (r₁ + e₂)` off it (module docs), a fifth or
-/// more. (At 10 the refinement would still shorten far ends by up to a
+/// take up to about `0.9 (r₁ + e₂)` off it near the minimum angle
+/// (module docs; `0.59 (r₁ + e₂)` at 45°, about `0.3` at 70°), a tenth or
+/// more of such a disparity below about 70°. (At 10 the refinement would still shorten far ends by up to a
 /// tenth, but the demo's costliest frame would refine 70 of its points,
 /// +11 %; `docs/PERFORMANCE.md`.)
 pub(crate) const REFINE_GAP: f32 = 4.0;
@@ -545,11 +547,21 @@ pub(crate) const REFINE_GAP: f32 = 4.0;
 /// s_near, s_far)` ([`Wedge::depths`]).
 pub(crate) type Depths = (f32, f32, f32);
 
-/// `1 + 2⁻²¹` and `1 − 2⁻²¹`: the refined stick's ends rounded outwards.
-/// The ends' own arithmetic (`t`'s quotient, then `w + w t`) rounds by at
-/// most about `3 · 2⁻²⁴` relative, and the product with this factor by
-/// `2⁻²⁴` more, so `2⁻²¹` (8 · 2⁻²⁴) covers both with room; `2⁻²²` alone
-/// was short by about `2⁻⁴⁷`, absorbed only by the other margins.
+/// `1 + 2⁻²¹` and `1 − 2⁻²¹`: the refined stick's ends rounded outwards,
+/// a margin on top of what carries the rounding. What carries it, here as
+/// in the stick from the range ([`Wedge::depths`], which has no such
+/// factor), is the slack `δ = 2⁻²⁰ S` in `r₁` and `e₂` ([`crate::depth`]):
+/// besides the coordinates' rounding it moves each end outwards by at
+/// least about `δ/D` relative (`D` the end's disparity, less its error),
+/// which grows as the cancellations in the ends' denominators do. The
+/// ends' own arithmetic (the inputs of the central ray's bound, `t`'s
+/// quotient, `w + w t`) rounds by a few `2⁻²⁴` relative, which `δ/D`
+/// covers unless `D` approaches the frame's whole scale `S`; this factor
+/// covers it there too. (An independent review found that
+/// `refined_stick_holds_every_consistent_depth`, its truth at 0.999 of
+/// each error, passes with every widening of the refinement removed, and
+/// fails at exactly the errors with them in place: the slack, not these
+/// widenings, is what that test sees.)
 const STICK_UP: f32 = 1.0 + 4.768_371_6e-7;
 const STICK_DOWN: f32 = 1.0 - 4.768_371_6e-7;
 

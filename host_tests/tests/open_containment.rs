@@ -19,6 +19,97 @@
 #![allow(clippy::all)]
 use roadstereo::{Camera, Config, Frame, Motion, Pixel, Processor, Step};
 
+/// One finding: the frames, the configuration and the truth (a 3-D curve
+/// `c(t)` in frame-1 camera coordinates, depth `z` along the optical axis,
+/// and its projections into both frames); point `i` is `c(t)`, and the
+/// polyline's ends lie near `c` over `range`.
+struct Case<'a> {
+    b1: &'a [(f32, f32)],
+    b2: &'a [(f32, f32)],
+    cams: (Camera, Camera),
+    motion: Motion,
+    config: Config,
+    c: &'a dyn Fn(f64) -> [f64; 3],
+    proj1: &'a dyn Fn([f64; 3]) -> [f64; 2],
+    proj2: &'a dyn Fn([f64; 3]) -> [f64; 2],
+    i: usize,
+    t: f64,
+    range: (f64, f64),
+    e1: f64,
+}
+
+/// Runs the case and asserts that the inputs are within the error model
+/// (the frame-1 point within `e₁` of the truth, the true curve between the
+/// polyline's ends within `e₂ = 0.5` of it) and that point `i`'s stick
+/// holds the true depth.
+fn assert_truth_in_stick(k: Case) {
+    let (b1, b2, c, proj1, proj2) = (k.b1, k.b2, k.c, k.proj1, k.proj2);
+    let mut p = Box::new(Processor::<64, 1>::new(k.config));
+    let mut f1 = Frame::<64, 1>::new(k.cams.0);
+    let px = |b: &[(f32, f32)]| b.iter().map(|&(u, v)| Pixel::new(u, v)).collect::<Vec<_>>();
+    f1.push_boundary(&px(b1)).unwrap();
+    let mut f2 = Frame::<64, 1>::new(k.cams.1);
+    f2.push_boundary(&px(b2)).unwrap();
+    assert!(matches!(p.process(&f1, None), Ok(Step::First)));
+    let Ok(Step::Structure(s)) = p.process(&f2, Some(&k.motion)) else {
+        panic!("no structure")
+    };
+    let dist = |q: [f64; 2], v: (f32, f32)| {
+        ((q[0] - v.0 as f64).powi(2) + (q[1] - v.1 as f64).powi(2)).sqrt()
+    };
+    let dist_poly = |q: [f64; 2]| -> f64 {
+        b2.windows(2)
+            .map(|w| {
+                let (a, b) = (
+                    [w[0].0 as f64, w[0].1 as f64],
+                    [w[1].0 as f64, w[1].1 as f64],
+                );
+                let ab = [b[0] - a[0], b[1] - a[1]];
+                let t = (((q[0] - a[0]) * ab[0] + (q[1] - a[1]) * ab[1])
+                    / (ab[0] * ab[0] + ab[1] * ab[1]))
+                    .clamp(0.0, 1.0);
+                ((q[0] - a[0] - t * ab[0]).powi(2) + (q[1] - a[1] - t * ab[1]).powi(2)).sqrt()
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let pt = c(k.t);
+    let e1d = dist(proj1(pt), b1[k.i]);
+    // The true boundary's stretch: from the curve point nearest the
+    // polyline's first vertex to the one nearest its last (each within e₂
+    // of its vertex), checked densely.
+    let near = |v: (f32, f32)| {
+        let mut b = (f64::INFINITY, 0.0);
+        for j in 0..=400_000 {
+            let tt = k.range.0 + (k.range.1 - k.range.0) * j as f64 / 4e5;
+            let d = dist(proj2(c(tt)), v);
+            if d < b.0 {
+                b = (d, tt);
+            }
+        }
+        b
+    };
+    let (da, ta) = near(b2[0]);
+    let (db, tb) = near(b2[b2.len() - 1]);
+    let (tlo, thi) = (ta.min(tb), ta.max(tb));
+    let mut max_d2: f64 = 0.0;
+    for j in 0..=200_000 {
+        let tt = tlo + (thi - tlo) * j as f64 / 2e5;
+        max_d2 = max_d2.max(dist_poly(proj2(c(tt))));
+    }
+    assert!(e1d < k.e1, "frame-1 error {e1d}");
+    assert!(dist_poly(proj2(pt)) < 0.5 && max_d2 < 0.5 && da < 0.5 && db < 0.5);
+    let r = s.boundaries()[0].points()[k.i];
+    let iv = r.interval().expect("an Ok point with a stick");
+    assert!(
+        iv.z_near as f64 <= pt[2] && pt[2] <= iv.z_far as f64,
+        "true depth {} outside [{}, {}] ({:?})",
+        pt[2],
+        iv.z_near,
+        iv.z_far,
+        r.status()
+    );
+}
+
 #[test]
 #[ignore = "open (issue 11): fails today"]
 fn r1_slack_scaled_by_frame1_coordinates() {
@@ -67,87 +158,26 @@ fn r1_slack_scaled_by_frame1_coordinates() {
         (-0.014757541, 22.392004),
     ];
     let f = 2705.9f32;
-    let cam1 = Camera::new(f, f, 16200.0, 16300.0, 16384, 16384).unwrap();
-    let cam2 = Camera::new(f, f, 0.0, 0.0, 64, 48).unwrap();
-    let motion = Motion::new([0.0, 0.0, 1.0], [0.0; 3]).unwrap();
-    let mut p = Box::new(Processor::<64, 1>::new(Config::DEFAULT));
-    let mut f1 = Frame::<64, 1>::new(cam1);
-    f1.push_boundary(&b1.map(|(u, v)| Pixel::new(u, v)))
-        .unwrap();
-    let mut f2 = Frame::<64, 1>::new(cam2);
-    f2.push_boundary(&b2.map(|(u, v)| Pixel::new(u, v)))
-        .unwrap();
-    assert!(matches!(p.process(&f1, None), Ok(Step::First)));
-    let Ok(Step::Structure(s)) = p.process(&f2, Some(&motion)) else {
-        panic!("no structure")
-    };
-    // The truth: the 3-D line C(t) = (0, 0.1, 13.6) + t (-2, 3, 4) (frame-1 camera coordinates,
-    // depth z along the optical axis); frame 2 is frame 1 moved by T = (0, 0, 1), no rotation.
     let fd = f as f64;
-    let c = |t: f64| [0.0 - 2.0 * t, 0.1 + 3.0 * t, 13.6 + 4.0 * t];
-    let proj1 = |p: [f64; 3]| [fd * p[0] / p[2] + 16200.0, fd * p[1] / p[2] + 16300.0];
-    let proj2 = |p: [f64; 3]| [fd * p[0] / (p[2] - 1.0), fd * p[1] / (p[2] - 1.0)];
-    let dist_poly = |q: [f64; 2]| -> f64 {
-        b2.windows(2)
-            .map(|w| {
-                let (a, b) = (
-                    [w[0].0 as f64, w[0].1 as f64],
-                    [w[1].0 as f64, w[1].1 as f64],
-                );
-                let ab = [b[0] - a[0], b[1] - a[1]];
-                let t = (((q[0] - a[0]) * ab[0] + (q[1] - a[1]) * ab[1])
-                    / (ab[0] * ab[0] + ab[1] * ab[1]))
-                    .clamp(0.0, 1.0);
-                ((q[0] - a[0] - t * ab[0]).powi(2) + (q[1] - a[1] - t * ab[1]).powi(2)).sqrt()
-            })
-            .fold(f64::INFINITY, f64::min)
-    };
-    // Frame-1 point i is C(t_i), t_i = ta + (tb - ta)(i + 0.5)/20 (the generator's spacing):
-    // recover [ta, tb] from two points' depths is not needed: point 12 is C(-0.012125).
-    let i = 12;
-    let t = -0.012125;
-    let pt = c(t);
-    let p1t = proj1(pt);
-    let pd = [b1[i].0 as f64, b1[i].1 as f64];
-    let e1d = ((p1t[0] - pd[0]).powi(2) + (p1t[1] - pd[1]).powi(2)).sqrt();
-    let p2t = proj2(pt);
-    // The true boundary's stretch: from the curve point nearest the polyline's first vertex
-    // to the one nearest its last (each within e2 of its vertex), checked densely.
-    let near = |v: (f32, f32)| {
-        let mut b = (f64::INFINITY, 0.0);
-        for k in 0..=400_000 {
-            let tt = -0.1 + 0.2 * k as f64 / 4e5;
-            let q = proj2(c(tt));
-            let d = ((q[0] - v.0 as f64).powi(2) + (q[1] - v.1 as f64).powi(2)).sqrt();
-            if d < b.0 {
-                b = (d, tt);
-            }
-        }
-        b
-    };
-    let (da, ta) = near(b2[0]);
-    let (db, tb) = near(b2[19]);
-    let (tlo, thi) = (ta.min(tb), ta.max(tb));
-    let mut max_d2: f64 = 0.0;
-    for k in 0..=200_000 {
-        let tt = tlo + (thi - tlo) * k as f64 / 2e5;
-        max_d2 = max_d2.max(dist_poly(proj2(c(tt))));
-    }
-
-    // Within the error model: the frame-1 point within e₁ of the truth,
-    // the true curve between the polyline's ends within e₂ of it.
-    assert!(e1d < 0.5, "frame-1 error {e1d}");
-    assert!(dist_poly(p2t) < 0.5 && max_d2 < 0.5 && da < 0.5 && db < 0.5);
-    let r = s.boundaries()[0].points()[i];
-    let iv = r.interval().expect("an Ok point with a stick");
-    assert!(
-        iv.z_near as f64 <= pt[2] && pt[2] <= iv.z_far as f64,
-        "true depth {} outside [{}, {}] ({:?})",
-        pt[2],
-        iv.z_near,
-        iv.z_far,
-        r.status()
-    );
+    // The truth: C(t) = (0, 0.1, 13.6) + t (-2, 3, 4); frame 2 is frame 1
+    // moved by T = (0, 0, 1), no rotation.
+    assert_truth_in_stick(Case {
+        b1: &b1,
+        b2: &b2,
+        cams: (
+            Camera::new(f, f, 16200.0, 16300.0, 16384, 16384).unwrap(),
+            Camera::new(f, f, 0.0, 0.0, 64, 48).unwrap(),
+        ),
+        motion: Motion::new([0.0, 0.0, 1.0], [0.0; 3]).unwrap(),
+        config: Config::DEFAULT,
+        c: &|t| [-2.0 * t, 0.1 + 3.0 * t, 13.6 + 4.0 * t],
+        proj1: &|p| [fd * p[0] / p[2] + 16200.0, fd * p[1] / p[2] + 16300.0],
+        proj2: &|p| [fd * p[0] / (p[2] - 1.0), fd * p[1] / (p[2] - 1.0)],
+        i: 12,
+        t: -0.012125,
+        range: (-0.1, 0.1),
+        e1: 0.5,
+    });
 }
 
 #[test]
@@ -198,100 +228,35 @@ fn r1_stretch_over_the_whole_disc() {
         (622.4072, 474.56314),
     ];
     let f = 4.0f32;
-    let cam1 = Camera::new(f, f, 500.0, 400.0, 1024, 768).unwrap();
-    let cam2 = cam1;
-    let (tr, beta) = ([-121.89009f32, 1.7263692e-14, -6.5708084], -0.06466944f32);
-    let motion = Motion::new(tr, [0.0, beta, 0.0]).unwrap();
-    let config = Config::new(12.289575, 0.5, 60.75245, 1.0e7)
-        .unwrap()
-        .with_work_budget(Config::MAX_WORK_PER_POINT)
-        .unwrap();
-    let mut p = Box::new(Processor::<64, 1>::new(config));
-    let mut f1 = Frame::<64, 1>::new(cam1);
-    f1.push_boundary(&b1.map(|(u, v)| Pixel::new(u, v)))
-        .unwrap();
-    let mut f2 = Frame::<64, 1>::new(cam2);
-    f2.push_boundary(&b2.map(|(u, v)| Pixel::new(u, v)))
-        .unwrap();
-    assert!(matches!(p.process(&f1, None), Ok(Step::First)));
-    let Ok(Step::Structure(s)) = p.process(&f2, Some(&motion)) else {
-        panic!("no structure")
-    };
-    // The truth: the 3-D line C(t) = (194, 0, 23) + t (7, 198, 2) (frame-1 camera coordinates,
-    // depth z along the optical axis); frame 2 after the motion (tr, yaw beta).
     let fd = f as f64;
-    let c = |t: f64| [194.0 + 7.0 * t, 0.0 + 198.0 * t, 23.0 + 2.0 * t];
-    let proj1 = |p: [f64; 3]| [fd * p[0] / p[2] + 500.0, fd * p[1] / p[2] + 400.0];
-    // frame 2: R^T (P - T), R = R_y(beta) (exact, in f64 from the f32 angle)
+    let cam = Camera::new(f, f, 500.0, 400.0, 1024, 768).unwrap();
+    let (tr, beta) = ([-121.89009f32, 1.7263692e-14, -6.5708084], -0.06466944f32);
+    // The truth: C(t) = (194, 0, 23) + t (7, 198, 2); frame 2 sees
+    // R^T (P - T), R = R_y(beta) (in f64 from the f32 values).
     let (sb, cb) = ((beta as f64).sin(), (beta as f64).cos());
-    let proj2 = |p: [f64; 3]| {
-        let d = [
-            p[0] - tr[0] as f64,
-            p[1] - tr[1] as f64,
-            p[2] - tr[2] as f64,
-        ];
-        let q = [cb * d[0] - sb * d[2], d[1], sb * d[0] + cb * d[2]];
-        [fd * q[0] / q[2] + 500.0, fd * q[1] / q[2] + 400.0]
-    };
-    let dist_poly = |q: [f64; 2]| -> f64 {
-        b2.windows(2)
-            .map(|w| {
-                let (a, b) = (
-                    [w[0].0 as f64, w[0].1 as f64],
-                    [w[1].0 as f64, w[1].1 as f64],
-                );
-                let ab = [b[0] - a[0], b[1] - a[1]];
-                let t = (((q[0] - a[0]) * ab[0] + (q[1] - a[1]) * ab[1])
-                    / (ab[0] * ab[0] + ab[1] * ab[1]))
-                    .clamp(0.0, 1.0);
-                ((q[0] - a[0] - t * ab[0]).powi(2) + (q[1] - a[1] - t * ab[1]).powi(2)).sqrt()
-            })
-            .fold(f64::INFINITY, f64::min)
-    };
-    // Frame-1 point i is C(t_i), t_i = ta + (tb - ta)(i + 0.5)/20 (the generator's spacing):
-    // recover [ta, tb] from two points' depths is not needed: point 12 is C(-0.012125).
-    let i = 12;
-    let t = 0.25;
-    let pt = c(t);
-    let p1t = proj1(pt);
-    let pd = [b1[i].0 as f64, b1[i].1 as f64];
-    let e1d = ((p1t[0] - pd[0]).powi(2) + (p1t[1] - pd[1]).powi(2)).sqrt();
-    let p2t = proj2(pt);
-    // The true boundary's stretch: from the curve point nearest the polyline's first vertex
-    // to the one nearest its last (each within e2 of its vertex), checked densely.
-    let near = |v: (f32, f32)| {
-        let mut b = (f64::INFINITY, 0.0);
-        for k in 0..=400_000 {
-            let tt = -1.0 + 2.0 * k as f64 / 4e5;
-            let q = proj2(c(tt));
-            let d = ((q[0] - v.0 as f64).powi(2) + (q[1] - v.1 as f64).powi(2)).sqrt();
-            if d < b.0 {
-                b = (d, tt);
-            }
-        }
-        b
-    };
-    let (da, ta) = near(b2[0]);
-    let (db, tb) = near(b2[19]);
-    let (tlo, thi) = (ta.min(tb), ta.max(tb));
-    let mut max_d2: f64 = 0.0;
-    for k in 0..=200_000 {
-        let tt = tlo + (thi - tlo) * k as f64 / 2e5;
-        max_d2 = max_d2.max(dist_poly(proj2(c(tt))));
-    }
-
-    // Within the error model: the frame-1 point within e₁ of the truth,
-    // the true curve between the polyline's ends within e₂ of it.
-    assert!(e1d < 12.289575, "frame-1 error {e1d}");
-    assert!(dist_poly(p2t) < 0.5 && max_d2 < 0.5 && da < 0.5 && db < 0.5);
-    let r = s.boundaries()[0].points()[i];
-    let iv = r.interval().expect("an Ok point with a stick");
-    assert!(
-        iv.z_near as f64 <= pt[2] && pt[2] <= iv.z_far as f64,
-        "true depth {} outside [{}, {}] ({:?})",
-        pt[2],
-        iv.z_near,
-        iv.z_far,
-        r.status()
-    );
+    assert_truth_in_stick(Case {
+        b1: &b1,
+        b2: &b2,
+        cams: (cam, cam),
+        motion: Motion::new(tr, [0.0, beta, 0.0]).unwrap(),
+        config: Config::new(12.289575, 0.5, 60.75245, 1.0e7)
+            .unwrap()
+            .with_work_budget(Config::MAX_WORK_PER_POINT)
+            .unwrap(),
+        c: &|t| [194.0 + 7.0 * t, 198.0 * t, 23.0 + 2.0 * t],
+        proj1: &|p| [fd * p[0] / p[2] + 500.0, fd * p[1] / p[2] + 400.0],
+        proj2: &|p| {
+            let d = [
+                p[0] - tr[0] as f64,
+                p[1] - tr[1] as f64,
+                p[2] - tr[2] as f64,
+            ];
+            let q = [cb * d[0] - sb * d[2], d[1], sb * d[0] + cb * d[2]];
+            [fd * q[0] / q[2] + 500.0, fd * q[1] / q[2] + 400.0]
+        },
+        i: 12,
+        t: 0.25,
+        range: (-1.0, 1.0),
+        e1: 12.289575,
+    });
 }

@@ -23,8 +23,11 @@
 //! The paper bounds the depth by a disparity error `e = e₁ + e₂` along `y`
 //! at the crossing it found. Here the model is: the true frame-1 point is
 //! within `e₁` pixels of the detected one (any direction), so after the
-//! rotation compensation within `r₁ = e₁ · stretch` of `p₁'` (plus the shift
-//! a rotation error can cause, [`crate::Config::with_rotation_error`]); the
+//! rotation compensation within `r₁` of the computed `p₁'` (`e₁` times the
+//! homography's stretch, times the change of `q_z` across the disc, plus
+//! the compensation's rounding: [`crate::epipolar`], "The error disc after
+//! compensation"; plus the shift a rotation error can cause,
+//! [`crate::Config::with_rotation_error`]); the
 //! true frame-2 boundary is within `e₂` of the polyline; each translation
 //! component may be off by `δ` ([`crate::Config::with_translation_error`]).
 //! Write the true point as `p₁' + δ₁` (`|δ₁| ≤ r₁`), the true `W'` as

@@ -363,8 +363,8 @@ impl<'c> Pair<'c> {
         };
         let scale = geom.coordinate_scale();
         let slack = scale * 9.54e-7;
-        let frame_r1 = match geom.frame_stretch() {
-            Some(st) if !rotation => Some(config.e1 * st + slack),
+        let frame_r1 = match geom.frame_disc_radius(config.e1) {
+            Some(r) if !rotation => Some(r + slack),
             _ => None,
         };
         let depth_scale_error = geom.depth_scale_error(config.e1, config.rotation_error);
@@ -457,12 +457,17 @@ fn compensate_point(
         let r1 = match pair.frame_r1 {
             Some(r1) => r1,
             None => {
-                let r1 = config.e1 * c.stretch
-                    + crate::motion_error::shift_bound(
-                        c.pixel,
-                        pair.geom.camera2_intrinsics(),
-                        config.rotation_error,
-                    )
+                // The rotation error's shift is bounded at the point of the
+                // disc farthest from the principal point along each axis
+                // (`shift_bound` grows with both distances).
+                let disc = pair.geom.point_disc_radius(&c, config.e1);
+                let k2 = pair.geom.camera2_intrinsics();
+                let far = [
+                    k2.2 + ((c.pixel[0] - k2.2).abs() + disc),
+                    k2.3 + ((c.pixel[1] - k2.3).abs() + disc),
+                ];
+                let r1 = disc
+                    + crate::motion_error::shift_bound(far, k2, config.rotation_error)
                     + pair.slack;
                 // Far off the camera's axis the rotation error's shift has
                 // no bound (`rotation_shift_bound`): such a point is out of

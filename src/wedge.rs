@@ -419,8 +419,8 @@ impl Wedge {
         }
         let rr1 = self.rho * r1;
         let s = w + w * (r2 / (x - r2));
-        let s_far = w + w * ((r2 + rr1) / den_far);
-        let s_near = w + w * ((r2 - rr1) / ((hi - r2) + self.rho_re));
+        let s_far = (w + w * ((r2 + rr1) / den_far)) * STICK_UP;
+        let s_near = (w + w * ((r2 - rr1) / ((hi - r2) + self.rho_re))) * STICK_DOWN;
         Some((s, s_near, s_far))
     }
 
@@ -547,10 +547,9 @@ pub(crate) const REFINE_GAP: f32 = 4.0;
 /// s_near, s_far)` ([`Wedge::depths`]).
 pub(crate) type Depths = (f32, f32, f32);
 
-/// `1 + 2⁻²¹` and `1 − 2⁻²¹`: the refined stick's ends rounded outwards,
-/// a margin on top of what carries the rounding. What carries it, here as
-/// in the stick from the range ([`Wedge::depths`], which has no such
-/// factor), is the slack `δ = 2⁻²⁰ S` in `r₁` and `e₂` ([`crate::depth`]):
+/// `1 + 2⁻²¹` and `1 − 2⁻²¹`: the stick's ends rounded outwards (from the
+/// piece's range, [`Wedge::depths`], and from its lines), a margin on top
+/// of what carries the rounding. What carries it is the slack `δ = 2⁻²⁰ S` in `r₁` and `e₂` ([`crate::depth`]):
 /// besides the coordinates' rounding it moves each end outwards by at
 /// least about `δ/D` relative (`D` the end's disparity, less its error),
 /// which grows as the cancellations in the ends' denominators do. The

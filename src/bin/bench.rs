@@ -392,6 +392,7 @@ fn member_config(errors: u8, w: u32) -> Option<Config> {
             .ok()?,
         6 => Config::new(0.5, 0.5, 0.1, 1000.0).ok()?,
         7 => Config::DEFAULT.with_localisation_error(0.5, 2.0).ok()?,
+        8 => Config::DEFAULT.with_localisation_error(3.0, 3.0).ok()?,
         _ => return None,
     };
     c.with_work_budget(w).ok()
@@ -406,6 +407,11 @@ fn member_config(errors: u8, w: u32) -> Option<Config> {
 /// tiny rotation error with a small minimum angle (every point checked in
 /// step 1), and a rotation error at small budgets (the fixed cost of a
 /// point, `C_P`).
+/// The `+e_3` probes (a review's ask) run forward members with shallow
+/// crossings and dense vertices under `e₁ = e₂ = 3` px: most disparities
+/// are then under `REFINE_GAP (r₁ + e₂)`, so most points take the stick
+/// from the piece's lines, whose pass over the piece's segments the work
+/// budget does not charge (it charged their clips in the walk).
 /// A probe with a window `(off, k)` takes points `off .. off + k` of each
 /// boundary in both frames (a smaller frame of the same pair).
 #[allow(clippy::type_complexity)]
@@ -444,6 +450,10 @@ const PROBES: &[(&str, &str, u32, u8, Option<(usize, usize)>)] = &[
         5,
         Some((60, 8)),
     ),
+    ("zigzag_small+e_3", "zigzag_small", 256, 8, None),
+    ("radial_stair+e_3", "radial_stair", 256, 8, None),
+    ("near_foe+e_3", "near_foe", 256, 8, None),
+    ("foe_row+e_3", "foe_row", 256, 8, None),
 ];
 
 /// Budgets of the configuration probes (the sweep's, up to twice the

@@ -335,6 +335,9 @@ struct Pair<'c> {
     spread_w: f32,
     /// `2/sin φ_min = √(4 + (2 cot φ_min)²)`, for the grazing test.
     csc_twice: f32,
+    /// `W'` with the stick's outward rounding folded in
+    /// ([`crate::wedge::stick_w`]).
+    w_stick: [f32; 3],
 }
 
 impl<'c> Pair<'c> {
@@ -380,6 +383,7 @@ impl<'c> Pair<'c> {
             translation,
             spread_w,
             csc_twice: crate::math::sqrt_pos(4.0 + config.cot_twice * config.cot_twice),
+            w_stick: crate::wedge::stick_w(geom.w()),
             geom,
         }
     }

@@ -401,13 +401,13 @@ impl Wedge {
     }
 
     /// The depth estimate and the stick's ends in the compensated frame,
-    /// `(s, s_near, s_far)` (module docs), for `w = W'`, from the
-    /// crossing's `X` and the piece's range; `None` when the far end is
+    /// `(s, s_near, s_far)` (module docs), for `w` = [`stick_w`]`(W')`, from
+    /// the crossing's `X` and the piece's range; `None` when the far end is
     /// unbounded (the disparity is not larger than its error).
     #[inline(always)]
     pub(crate) fn depths(
         &self,
-        w: f32,
+        [w, w_up, w_down]: [f32; 3],
         r1: f32,
         (x, lo, hi): (f32, f32, f32),
     ) -> Option<(f32, f32, f32)> {
@@ -419,8 +419,8 @@ impl Wedge {
         }
         let rr1 = self.rho * r1;
         let s = w + w * (r2 / (x - r2));
-        let s_far = (w + w * ((r2 + rr1) / den_far)) * STICK_UP;
-        let s_near = (w + w * ((r2 - rr1) / ((hi - r2) + self.rho_re))) * STICK_DOWN;
+        let s_far = w_up + w_up * ((r2 + rr1) / den_far);
+        let s_near = w_down + w_down * ((r2 - rr1) / ((hi - r2) + self.rho_re));
         Some((s, s_near, s_far))
     }
 
@@ -476,7 +476,7 @@ impl Wedge {
         &self,
         b2: &[Pixel],
         end: usize,
-        (w, r1): (f32, f32),
+        (w, r1): ([f32; 3], f32),
     ) -> Option<(f32, Option<Depths>)> {
         let first = self.piece_start(b2, end)?;
         let (v0, rest) = b2.get(first..=end)?.split_first()?;
@@ -526,9 +526,10 @@ impl Wedge {
         if !(t_far < f32::INFINITY) || !(t_near >= 0.0) {
             return Some((x, self.depths(w, r1, (x, lo, hi))));
         }
+        let [w, w_up, w_down] = w;
         let s = w + w * (r2 / (x - r2));
-        let s_far = (w + w * t_far) * STICK_UP;
-        let s_near = (w + w * t_near) * STICK_DOWN;
+        let s_far = w_up + w_up * t_far;
+        let s_near = w_down + w_down * t_near;
         // (Rounding aside, the estimate's own ratio `R/X` lies between.)
         Some((x, Some((s, fmin(s_near, s), fmax(s_far, s)))))
     }
@@ -549,7 +550,14 @@ pub(crate) type Depths = (f32, f32, f32);
 
 /// `1 + 2⁻²¹` and `1 − 2⁻²¹`: the stick's ends rounded outwards (from the
 /// piece's range, [`Wedge::depths`], and from its lines), a margin on top
-/// of what carries the rounding. What carries it is the slack `δ = 2⁻²⁰ S` in `r₁` and `e₂` ([`crate::depth`]):
+/// of what carries the rounding. They are folded into `W'` once a frame
+/// ([`stick_w`]): an end `s = W'(1 + t)` is computed as `W'↑ + W'↑ t`
+/// with `W'↑ = fl(W' · STICK_UP)`, at least `W'(1 + t)(1 + 2⁻²¹)(1 −
+/// 2⁻²⁴)³ > W'(1 + t)(1 + 5 · 2⁻²⁴)`, the same margin as the factor
+/// applied to the rounded end (and the reverse at the near end, where
+/// `1 + t > 0` or the end is no bound). With `W' > 0` (the wedge path)
+/// each operation stays monotone, so the ends still hold the estimate
+/// `W' + W' R/(X − R)`. What carries the rounding is the slack `δ = 2⁻²⁰ S` in `r₁` and `e₂` ([`crate::depth`]):
 /// besides the coordinates' rounding it moves each end outwards by at
 /// least about `δ/D` relative (`D` the end's disparity, less its error),
 /// which grows as the cancellations in the ends' denominators do. The
@@ -563,6 +571,14 @@ pub(crate) type Depths = (f32, f32, f32);
 /// widenings, is what that test sees.)
 const STICK_UP: f32 = 1.0 + 4.768_371_6e-7;
 const STICK_DOWN: f32 = 1.0 - 4.768_371_6e-7;
+
+/// `[W', W' · STICK_UP, W' · STICK_DOWN]`, what [`Wedge::depths`] and
+/// [`Wedge::refined`] take for `W'` (the outward rounding folded in once a
+/// frame, [`STICK_UP`]).
+#[inline(always)]
+pub(crate) fn stick_w(w: f32) -> [f32; 3] {
+    [w, w * STICK_UP, w * STICK_DOWN]
+}
 
 /// A direction `u` in the wedge's frame (not unit: `|u| ≤ l`), oriented so
 /// that the segment it was made from lies on its positive side, with what
@@ -1172,14 +1188,16 @@ mod tests {
                 continue;
             };
             let piece = (start, end);
-            let coarse = wedge.depths(w, r1, (lam, lo, hi));
+            let coarse = wedge.depths(stick_w(w), r1, (lam, lo, hi));
             let outcome = Outcome::Match { lam, lo, hi, end };
             let Some(stick) = (match wedge.refines(&outcome) {
                 Some(e) => {
                     refined += 1;
                     // The crossing from the piece alone is the walk's, bit
                     // for bit.
-                    let (x, stick) = wedge.refined(&poly, e, (w, r1)).expect("the piece again");
+                    let (x, stick) = wedge
+                        .refined(&poly, e, (stick_w(w), r1))
+                        .expect("the piece again");
                     assert_eq!(x.to_bits(), lam.to_bits(), "case {case}: crossing");
                     stick
                 }

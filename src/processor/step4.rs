@@ -824,7 +824,7 @@ fn conclude_coarse(
         Outcome::Flag(s) => return PointResult::flagged(p1, s),
     };
     let p2 = wedge.point_at(lam);
-    let depths = wedge.depths(pair.geom.w(), r1, (lam, lo, hi));
+    let depths = wedge.depths(pair.w_stick, r1, (lam, lo, hi));
     finish_point(pair, p1, p2, iz, depths)
 }
 
@@ -856,7 +856,7 @@ fn conclude_refined(
     b2: &[Pixel],
     end: usize,
 ) -> PointResult {
-    match wedge.refined(b2, end, (pair.geom.w(), r1)) {
+    match wedge.refined(b2, end, (pair.w_stick, r1)) {
         Some((x, depths)) => finish_point(pair, p1, wedge.point_at(x), iz, depths),
         // (Not reached: the walk found this piece with this wedge.)
         None => PointResult::flagged(p1, Status::NoIntersection),

@@ -345,11 +345,18 @@ impl<'c> Pair<'c> {
         let geom = PairGeometry::new(cam1, cam2, motion);
         let [ex, ey, ez] = config.rotation_error;
         let rotation = ex + ey + ez > 0.0;
-        // A rotation error turns the compensated translation by up to
-        // |T| Σε (5 % added for the second order).
-        let translation = config.translation_error
+        // A rotation error turns the true compensated translation
+        // `R_tᵀ T_t` away from `Rᵀ T_t` by up to `θ |T_t|` (`θ ≤ Σε`, 5 %
+        // added for the second order), and `|T_t| ≤ |T| + √3 δ` for a true
+        // translation within the box `±δ`: that much more on each frame-1
+        // component covers it (`Rᵀ` of the wider box holds `Rᵀ` of the
+        // box plus any vector that long). (An adversary found the turn of
+        // `δ` missing: `|T|` alone fell 5.7 % short of `W'`'s spread with
+        // `δ = 0.3 |T|`, `ε = 0.1`; no stick missed.)
+        let delta = config.translation_error;
+        let translation = delta
             + if rotation {
-                1.05 * geom.translation_norm() * (ex + ey + ez)
+                1.05 * (geom.translation_norm() + 1.7321 * delta) * (ex + ey + ez)
             } else {
                 0.0
             };
@@ -616,6 +623,75 @@ const _: () = assert!(core::mem::size_of::<Processor<256, 2>>() <= 26_892);
 
 #[cfg(test)]
 mod tests {
+    /// The translation box `Pair::new` widens for a rotation error holds
+    /// the true compensated translation `R_tᵀ T_t` mapped back by `R`, for
+    /// every corner of the rotation and translation error boxes (`f64`,
+    /// `R_t = R Exp(ω)`), including the case an adversary found short when
+    /// the turn of the translation error was left out.
+    #[test]
+    fn translation_box_holds_the_turned_true_translation() {
+        use crate::test_rng::Rng;
+        let exp = |w: [f64; 3]| -> [[f64; 3]; 3] {
+            let t = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+            let k = if t > 0.0 { w.map(|x| x / t) } else { [0.0; 3] };
+            let (s, c) = (t.sin(), 1.0 - t.cos());
+            let kx = [[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]];
+            let mut m = [[0.0; 3]; 3];
+            for i in 0..3 {
+                for j in 0..3 {
+                    let kk: f64 = (0..3).map(|l| kx[i][l] * kx[l][j]).sum();
+                    m[i][j] = f64::from(u8::from(i == j)) + s * kx[i][j] + c * kk;
+                }
+            }
+            m
+        };
+        let mv = |m: &[[f64; 3]; 3], v: [f64; 3]| {
+            [0, 1, 2].map(|i| (0..3).map(|j| m[i][j] * v[j]).sum::<f64>())
+        };
+        let mtv = |m: &[[f64; 3]; 3], v: [f64; 3]| {
+            [0, 1, 2].map(|i| (0..3).map(|j| m[j][i] * v[j]).sum::<f64>())
+        };
+        let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).expect("camera");
+        let mut rng = Rng(0x7ea5_0001);
+        let mut worst = 0.0f64;
+        for case in 0..400 {
+            let (t, a, eps, delta) = if case == 0 {
+                ([1.0f32, 0.0, 0.0], [0.0f32; 3], [0.0f32, 0.1, 0.0], 0.3f32)
+            } else {
+                let t = [0.0; 3].map(|_: f32| rng.next() * 2.0 - 1.0);
+                let a = [0.0; 3].map(|_: f32| (rng.next() - 0.5) * 0.6);
+                let eps = [0.0; 3].map(|_: f32| rng.next() * 0.033);
+                (t, a, eps, rng.next() * 0.5)
+            };
+            let Ok(m) = Motion::new(t, a) else { continue };
+            let config = Config::DEFAULT
+                .with_translation_error(delta)
+                .and_then(|c| c.with_rotation_error(eps))
+                .expect("config");
+            let pair = Pair::new(&config, &cam, &cam, &m);
+            let r = m.rotation_matrix().map(|row| row.map(f64::from));
+            let t = m.translation().map(f64::from);
+            for k in 0..64 {
+                let s = |b: usize| if k >> b & 1 == 1 { 1.0 } else { -1.0 };
+                let w = [0, 1, 2].map(|i| s(i) * f64::from(eps[i]));
+                let d = [3, 4, 5].map(|i| s(i) * f64::from(delta));
+                let tt = [t[0] + d[0], t[1] + d[1], t[2] + d[2]];
+                let e = exp(w);
+                // R_t = R Exp(ω); R (R_tᵀ T_t) against T.
+                let rt_t = mtv(&e, mtv(&r, tt));
+                let back = mv(&r, rt_t);
+                let off = (0..3).map(|i| (back[i] - t[i]).abs()).fold(0.0, f64::max);
+                assert!(
+                    off <= f64::from(pair.translation),
+                    "case {case}: {off} > {}",
+                    pair.translation
+                );
+                worst = worst.max(off / f64::from(pair.translation));
+            }
+        }
+        assert!(worst > 0.8, "the corners come near the bound: {worst}");
+    }
+
     use super::step4::wedge_run_aside;
     use super::*;
     extern crate std;

@@ -321,6 +321,9 @@ struct Pair<'c> {
     scale: f32,
     /// The rounding slack added to `r₁` and `e₂` (see [`crate::depth`]).
     slack: f32,
+    /// What `r₁` adds to the disc: the slack, and moving forwards the
+    /// focus of expansion's rounding.
+    slack_r1: f32,
     /// `r₁` for every point when the stretch bound is frame-wide and no
     /// rotation error is configured.
     frame_r1: Option<f32>,
@@ -373,8 +376,16 @@ impl<'c> Pair<'c> {
         };
         let scale = geom.coordinate_scale();
         let slack = scale * 9.54e-7;
+        // Moving forwards, the focus's rounding as a shift of the frame-1
+        // point (`PairGeometry::foe_rounding`).
+        let slack_r1 = slack
+            + if geom.w() > 0.0 {
+                geom.foe_shift()
+            } else {
+                0.0
+            };
         let frame_r1 = match geom.frame_disc_radius(config.e1) {
-            Some(r) if !rotation => Some(r + slack),
+            Some(r) if !rotation => Some(r + slack_r1).filter(|r| r.is_finite()),
             _ => None,
         };
         let depth_scale_error = geom.depth_scale_error(config.e1, config.rotation_error);
@@ -384,6 +395,7 @@ impl<'c> Pair<'c> {
             reach: crate::math::sqrt(cam2.reach2()),
             scale,
             slack,
+            slack_r1,
             frame_r1,
             certified_r1: frame_r1.filter(|_| geom.certifies_image(cam1, depth_scale_error)),
             depth_scale_error,
@@ -479,7 +491,7 @@ fn compensate_point(
                 ];
                 let r1 = disc
                     + crate::motion_error::shift_bound(far, k2, config.rotation_error)
-                    + pair.slack;
+                    + pair.slack_r1;
                 // Far off the camera's axis the rotation error's shift has
                 // no bound (`rotation_shift_bound`): such a point is out of
                 // the view the stick can be certified in, and must not set

@@ -101,7 +101,7 @@
 //! **The focus of expansion** is computed from `T' = Rᵀ T` in `f32`
 //! too. Moving forwards its rounding `ε` is the geometry of the computed
 //! focus with the frame-1 point moved by `(1 − 1/k) ε`
-//! ([`PairGeometry::foe_rounding`]), at most `|ε| min(1, 4L/|e − c₂|)`
+//! (`PairGeometry::foe_rounding`), at most `|ε| min(1, 4L/|e − c₂|)`
 //! (`PairGeometry::foe_shift`), which `r₁` adds (an adversary found a far
 //! focus on a long focal length off by 4·10⁻³ px, 30 times the old slack,
 //! though no stick missed). Moving backwards or sideways (`W' ≤ 0`) the

@@ -209,53 +209,22 @@ impl PairGeometry {
         let rt = mat3_transpose(&motion.rotation_matrix());
         let tp = mat3_vec(&rt, motion.translation());
         // `|Rᵀ| |T|`, which scales the rounding of `T'` (`γ₃` of it).
-        let tp_abs = mat3_vec(
-            &rt.map(|r| r.map(f32::abs)),
-            motion.translation().map(f32::abs),
-        );
+        let rt_abs = rt.map(|r| r.map(f32::abs));
+        let tp_abs = mat3_vec(&rt_abs, motion.translation().map(f32::abs));
         // Camera::new guarantees fx, fy >= 1: the divisions are safe.
         let (ifx, ify) = (1.0 / cam1.fx(), 1.0 / cam1.fy());
         let (kx, ky) = (-cam1.cx() * ifx, -cam1.cy() * ify);
         // H = K₂ Rᵀ K₁⁻¹ with the zeros of the intrinsic matrices skipped.
-        let m = rt.map(|[r0, r1, r2]| [r0 * ifx, r1 * ify, r0 * kx + r1 * ky + r2]);
-        let [[a0, a1, a2], [b0, b1, b2], m2] = m;
-        let [c0, c1, c2] = m2;
         let (fx2, fy2, cx2, cy2) = (cam2.fx(), cam2.fy(), cam2.cx(), cam2.cy());
-        let h = [
-            [
-                fx2 * a0 + cx2 * c0,
-                fx2 * a1 + cx2 * c1,
-                fx2 * a2 + cx2 * c2,
-            ],
-            [
-                fy2 * b0 + cy2 * c0,
-                fy2 * b1 + cy2 * c1,
-                fy2 * b2 + cy2 * c2,
-            ],
-            m2,
-        ];
+        let h = homography(&rt, (ifx, ify, kx, ky), (fx2, fy2, cx2, cy2));
         // The same sums with every term made positive: each entry of `h`
         // is within `γ₇` of these of the exact entry of
         // `K₂ Rᵀ K₁⁻¹` (module docs, "The error disc after compensation").
-        let ma = rt.map(|[r0, r1, r2]| {
-            let [r0, r1, r2] = [r0.abs(), r1.abs(), r2.abs()];
-            [r0 * ifx, r1 * ify, r0 * kx.abs() + r1 * ky.abs() + r2]
-        });
-        let ([a0, a1, a2], [b0, b1, b2], [c0, c1, c2]) = (ma[0], ma[1], ma[2]);
-        let (ax2, ay2) = (cx2.abs(), cy2.abs());
-        let habs = [
-            [
-                fx2 * a0 + ax2 * c0,
-                fx2 * a1 + ax2 * c1,
-                fx2 * a2 + ax2 * c2,
-            ],
-            [
-                fy2 * b0 + ay2 * c0,
-                fy2 * b1 + ay2 * c1,
-                fy2 * b2 + ay2 * c2,
-            ],
-            ma[2],
-        ];
+        let habs = homography(
+            &rt_abs,
+            (ifx, ify, kx.abs(), ky.abs()),
+            (fx2, fy2, cx2.abs(), cy2.abs()),
+        );
         let (w2, h2) = (f32::from(cam2.width()), f32::from(cam2.height()));
         let grow = fmax(w2, h2);
         let rows = row_bounds(&habs, cam1);
@@ -271,7 +240,7 @@ impl PairGeometry {
             stretch_bound,
             view: [-grow, w2 - 1.0 + grow, -grow, h2 - 1.0 + grow],
             // (|h₂₀| + |h₂₁| of the exact H: one rounding each.)
-            qz_per_px: (c0 + c1) * (1.0 + 9.6e-7),
+            qz_per_px: (habs[2][0] + habs[2][1]) * (1.0 + 9.6e-7),
             ray_max: ray_max(cam1),
             foe_round: foe_rounding(tp, tp_abs, [fx2, fy2], [cx2, cy2]),
             rows,
@@ -602,6 +571,27 @@ impl PairGeometry {
         let grow = 1.0 + 2.0 * x;
         e1 * jac * (grow * (1.0 + 9.6e-7)) + self.rounding(u, iz) * (1.0 + 1.2 * x * grow)
     }
+}
+
+/// `K₂ Rᵀ K₁⁻¹` from `Rᵀ`, `K₁⁻¹`'s entries `(1/f_x, 1/f_y, −c_x/f_x,
+/// −c_y/f_y)` and `K₂`'s `(f_x, f_y, c_x, c_y)`, with the zeros of the
+/// intrinsic matrices skipped (or the same sums of positive terms, from
+/// their magnitudes).
+fn homography(
+    rt: &Mat3,
+    (ifx, ify, kx, ky): (f32, f32, f32, f32),
+    k2: (f32, f32, f32, f32),
+) -> Mat3 {
+    let (fx2, fy2, cx2, cy2) = k2;
+    let [a, b, c] = rt.map(|[r0, r1, r2]| [r0 * ifx, r1 * ify, r0 * kx + r1 * ky + r2]);
+    let row = |f: f32, r: [f32; 3], k: f32| {
+        [
+            f * r[0] + k * c[0],
+            f * r[1] + k * c[1],
+            f * r[2] + k * c[2],
+        ]
+    };
+    [row(fx2, a, cx2), row(fy2, b, cy2), c]
 }
 
 /// [`PairGeometry::foe_rounding`] from `T'` (computed), `|Rᵀ| |T|` and

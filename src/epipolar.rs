@@ -98,14 +98,25 @@
 //! smaller terms' margins (a review found that halving `ρ` or dropping
 //! `ζ` passes it): those rest on the argument above.
 //!
-//! **The focus of expansion** is computed from `T' = Rᵀ T` in `f32`
-//! too. Moving forwards its rounding `ε` is the geometry of the computed
-//! focus with the frame-1 point moved by `(1 − 1/k) ε`
-//! (`PairGeometry::foe_rounding`), at most `|ε| min(1, 4L/|e − c₂|)`
-//! (`PairGeometry::foe_shift`), which `r₁` adds (an adversary found a far
-//! focus on a long focal length off by 4·10⁻³ px, 30 times the old slack,
-//! though no stick missed). Moving backwards or sideways (`W' ≤ 0`) the
-//! focus's rounding rests on the slack: open.
+//! **The focus of expansion** comes from `T' = Rᵀ T`. Its components
+//! cancel when the rotation turns against the translation (`U' = r₀₀ T_x
+//! + r₂₀ T_z` with both terms about 0.11 and the result 10⁻⁵), and a plain
+//! `f32` sum, within `γ₃ |Rᵀ| |T|`, then put the focus of a 10⁵ px
+//! focal length 7.6·10⁻⁴ px off, six times the slack: moving backwards, an
+//! adversary found an `ok` point whose truth lay 14 % below its stick
+//! (`host_tests/tests/adversarial_containment.rs`). `T'` is now rounded
+//! about once (`math::dot3_accurate`, twice the precision without
+//! `f64`), so the focus is within a few roundings of its own coordinates
+//! and its offset `d` from `c₂` (`ε`, `PairGeometry::foe_rounding`).
+//! * Moving forwards, the geometry with the computed focus is the true one
+//!   with the frame-1 point moved by `(1 − 1/k) ε` (`k ≥ 1`), at most
+//!   `|ε| min(1, 4L/|e − c₂|)` (`PairGeometry::foe_shift`), which `r₁`
+//!   adds.
+//! * Moving backwards the correspondent, seen from the computed focus,
+//!   is moved in frame 2 by `(1 − k) ε` (`0 < k < 1`), `(1 − k) = d/|p₁'
+//!   − e|`: the same bound, which `e₂` adds.
+//! * Sideways (`W' = 0`) there is no focus: `a = −(f U', f V')` rounds
+//!   once a component, relative to itself, which the slack covers.
 //!
 //! The exact geometry is that of the motion's matrix
 //! ([`Motion::rotation_matrix`]); how closely that matrix follows the
@@ -120,7 +131,7 @@
 //! in `crate::pencil`.
 
 use crate::camera::{Camera, Pixel};
-use crate::math::{fmax, fmin, mat3_transpose, mat3_vec, Mat3};
+use crate::math::{dot3_accurate, fmax, fmin, mat3_transpose, mat3_vec, Mat3};
 use crate::motion::Motion;
 
 /// The epipolar geometry of one frame pair, computed once per frame.
@@ -207,7 +218,12 @@ impl PairGeometry {
     /// Geometry for frame 1 seen by `cam1`, frame 2 by `cam2`, and `motion`.
     pub fn new(cam1: &Camera, cam2: &Camera, motion: &Motion) -> Self {
         let rt = mat3_transpose(&motion.rotation_matrix());
-        let tp = mat3_vec(&rt, motion.translation());
+        // `T' = Rᵀ T` rounded about once ([`dot3_accurate`]): its
+        // components cancel when the motion is turned against the
+        // translation, and a plain sum then puts the focus of expansion
+        // far off (module docs, "The focus of expansion").
+        let t = motion.translation();
+        let tp = rt.map(|r| dot3_accurate(r, t));
         // `|Rᵀ| |T|`, which scales the rounding of `T'` (`γ₃` of it).
         let rt_abs = rt.map(|r| r.map(f32::abs));
         let tp_abs = mat3_vec(&rt_abs, motion.translation().map(f32::abs));
@@ -263,9 +279,9 @@ impl PairGeometry {
     }
 
     /// A bound on the distance, pixels, of the computed focus of
-    /// expansion from the exact one (`T' = Rᵀ T` is computed within `γ₃
-    /// |Rᵀ| |T|` per component, then `f U'`, the quotient and the sum round
-    /// once each); 0 when `W' = 0` (no focus).
+    /// expansion from the exact one (`T' = Rᵀ T` is computed within about
+    /// one rounding of each component, [`dot3_accurate`], then `f U'`, the
+    /// quotient and the sum round once each); 0 when `W' = 0` (no focus).
     ///
     /// For `W' > 0` it is added to `r₁` (`crate::processor`): with the true
     /// focus `e` and the computed `e' = e + ε`, a correspondent `p₂ − e =
@@ -273,17 +289,19 @@ impl PairGeometry {
     /// is `p₂ − e' = k (p₁' + (1 − 1/k) ε − e')`: the geometry of the
     /// computed focus with the frame-1 point moved by `(1 − 1/k) ε`, at
     /// most `|ε|`. (Moving backwards `0 < k < 1` and the shift is not
-    /// bounded so; the band path there relies on the slack, an open
-    /// point.)
+    /// bounded so; there the slack covers the focus's rounding in frame 2,
+    /// module docs.)
     pub(crate) fn foe_rounding(&self) -> f32 {
         self.foe_round
     }
 
-    /// The shift of the frame-1 point that [`Self::foe_rounding`] stands
-    /// for, moving forwards: `(1 − 1/k) |ε| = d |ε| / |p₂ − e|` with `d`
-    /// the disparity. With `L` the largest distance from the principal
-    /// point of anything in view ([`Self::in_view`]), `d ≤ 2L`; and for a
-    /// focus farther than `2L` from the principal point `|p₂ − e| ≥ |e −
+    /// The shift that [`Self::foe_rounding`] stands for: moving forwards
+    /// of the frame-1 point, `(1 − 1/k) |ε| = d |ε| / |p₂ − e|`; moving
+    /// backwards of the correspondent in frame 2, `(1 − k) |ε| = d |ε| /
+    /// |p₁' − e|` (`d` the disparity; module docs). With `L` the largest
+    /// distance from the principal point of anything in view
+    /// ([`Self::in_view`]), `d ≤ 2L`; and for a focus farther than `2L`
+    /// from the principal point both distances from it are at least `|e −
     /// c₂| − L ≥ |e − c₂|/2`, so the shift is at most `|ε| min(1, 4L/|e −
     /// c₂|)`. (A far focus rounds by many pixels, but its lines barely
     /// turn.)
@@ -596,7 +614,8 @@ fn homography(
 
 /// [`PairGeometry::foe_rounding`] from `T'` (computed), `|Rᵀ| |T|` and
 /// frame 2's focal lengths and principal point: per axis, with `δ =
-/// 3.0001 · 2⁻²⁴ |Rᵀ| |T|` bounding `T'`'s rounding and `d` the focus's
+/// 1.0001 · 2⁻²⁴ |T'| + 10 · 2⁻⁴⁸ |Rᵀ| |T|` bounding `T'`'s rounding
+/// ([`dot3_accurate`]) and `d` the focus's
 /// offset from the principal point, `(f δ_U + |d| δ_W)/|W'|` for `T'`,
 /// `2 · 2⁻²⁴ |d|` for `f U'` and the quotient and `2⁻²⁴ |e|` for the sum,
 /// doubled (the second order, and this function's own rounding); the two
@@ -607,7 +626,13 @@ fn foe_rounding(tp: [f32; 3], tp_abs: [f32; 3], f: [f32; 2], c: [f32; 2]) -> f32
     if !(w > 0.0) {
         return 0.0;
     }
-    let [du, dv, dw] = tp_abs.map(|x| 1.79e-7 * x);
+    let [du, dv, dw] = [0, 1, 2].map(|i| {
+        let (t, a) = (
+            tp.get(i).copied().unwrap_or(0.0),
+            tp_abs.get(i).copied().unwrap_or(0.0),
+        );
+        6.0e-8 * t.abs() + 4.0e-14 * a
+    });
     let axis = |fi: f32, ti: f32, dt: f32, ci: f32| {
         let d = (fi * ti / tp[2]).abs();
         ((fi * dt + d * dw) / w + 1.2e-7 * d + 6.0e-8 * (ci.abs() + d)) * 2.0

@@ -354,11 +354,83 @@ pub(crate) fn mat3_vec(a: &Mat3, v: [f32; 3]) -> [f32; 3] {
     a.map(|[x, y, z]| x * v[0] + y * v[1] + z * v[2])
 }
 
+/// `a · b` for three terms, computed as if in twice the precision and
+/// rounded once (Ogita, Rump and Oishi's `Dot2`, with Dekker's split
+/// product and Knuth's two-sum, no fused multiply-add): within `2⁻²⁴
+/// |a · b| + 10 · 2⁻⁴⁸ Σ |aᵢ bᵢ|` of the exact value, where the plain
+/// sum is only within `γ₃ Σ |aᵢ bᵢ|` (all of it lost when the terms
+/// cancel). Exact splitting needs `|aᵢ|, |bᵢ| < 2¹¹³` and products far
+/// from the underflow range: for the translation (`|T| ≤ 10⁶`) against a
+/// rotation's entries it holds.
+pub(crate) fn dot3_accurate(a: [f32; 3], b: [f32; 3]) -> f32 {
+    // Dekker: x = hi + lo with hi on the upper 12 bits.
+    let split = |x: f32| {
+        let c = 4097.0 * x;
+        let hi = c - (c - x);
+        (hi, x - hi)
+    };
+    // The product and its exact error.
+    let two_prod = |x: f32, y: f32| {
+        let p = x * y;
+        let ((xh, xl), (yh, yl)) = (split(x), split(y));
+        (p, ((xh * yh - p) + xh * yl + xl * yh) + xl * yl)
+    };
+    // The sum and its exact error.
+    let two_sum = |x: f32, y: f32| {
+        let s = x + y;
+        let z = s - x;
+        (s, (x - (s - z)) + (y - z))
+    };
+    let (p0, e0) = two_prod(a[0], b[0]);
+    let (p1, e1) = two_prod(a[1], b[1]);
+    let (p2, e2) = two_prod(a[2], b[2]);
+    let (s1, f1) = two_sum(p0, p1);
+    let (s2, f2) = two_sum(s1, p2);
+    s2 + (((e0 + e1) + e2) + (f1 + f2))
+}
+
 /// Largest finite magnitude accepted for translations, in the caller's unit.
 pub(crate) const MAX_TRANSLATION: f32 = 1.0e6;
 
 #[cfg(test)]
 mod tests {
+    /// [`dot3_accurate`] against `f64`, on cancelling rotation-like terms:
+    /// within its bound, and nearly always the correctly rounded value.
+    #[test]
+    fn dot3_accurate_rounds_about_once() {
+        let mut rng = crate::test_rng::Rng(0xd072_0001);
+        let (mut worst, mut worst_plain) = (0.0f64, 0.0f64);
+        for case in 0..200_000 {
+            let a = [0.0; 3].map(|_: f32| (rng.next() - 0.5) * 2.0);
+            let scale = [1.0e-6f32, 1.0, 1.0e6][case % 3];
+            let mut b = [0.0; 3].map(|_: f32| (rng.next() - 0.5) * 2.0 * scale);
+            // Make the first two terms cancel (`a₀ b₀ ≈ −a₁ b₁`).
+            if case % 2 == 0 && a[0] != 0.0 {
+                b[0] = -a[1] * b[1] / a[0] * (1.0 + (rng.next() - 0.5) * 1.0e-4);
+                b[2] *= 1.0e-4;
+            }
+            let exact: f64 = (0..3).map(|i| f64::from(a[i]) * f64::from(b[i])).sum();
+            let mag: f64 = (0..3)
+                .map(|i| (f64::from(a[i]) * f64::from(b[i])).abs())
+                .sum();
+            let got = f64::from(dot3_accurate(a, b));
+            let bound = exact.abs() * 2f64.powi(-24) + 10.0 * 2f64.powi(-48) * mag;
+            assert!(
+                (got - exact).abs() <= bound,
+                "case {case}: {got} vs {exact}"
+            );
+            if case % 2 == 0 && exact != 0.0 {
+                let plain: f64 = f64::from(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
+                worst = worst.max((got - exact).abs() / exact.abs());
+                worst_plain = worst_plain.max((plain - exact).abs() / exact.abs());
+            }
+        }
+        // Relative to the cancelled result (cancellations to 10⁻⁸ of the
+        // terms): within a few roundings (4·10⁻⁷, the bound's second
+        // term), where the plain sum is off by 10 times the result.
+        assert!(worst < 1.0e-6 && worst_plain > 1.0, "{worst} {worst_plain}");
+    }
+
     use super::*;
 
     #[test]

@@ -319,11 +319,13 @@ struct Pair<'c> {
     foe: Option<[f32; 2]>,
     reach: f32,
     scale: f32,
-    /// The rounding slack added to `r₁` and `e₂` (see [`crate::depth`]).
-    slack: f32,
-    /// What `r₁` adds to the disc: the slack, and moving forwards the
+    /// What `r₁` adds to the disc: the rounding slack (see
+    /// [`crate::depth`]), and moving forwards the
     /// focus of expansion's rounding.
     slack_r1: f32,
+    /// What `e₂` adds: the slack, and moving backwards the focus's
+    /// rounding (as a frame-2 shift, [`PairGeometry::foe_shift`]).
+    slack_e2: f32,
     /// `r₁` for every point when the stretch bound is frame-wide and no
     /// rotation error is configured.
     frame_r1: Option<f32>,
@@ -376,14 +378,15 @@ impl<'c> Pair<'c> {
         };
         let scale = geom.coordinate_scale();
         let slack = scale * 9.54e-7;
-        // Moving forwards, the focus's rounding as a shift of the frame-1
-        // point (`PairGeometry::foe_rounding`).
-        let slack_r1 = slack
-            + if geom.w() > 0.0 {
-                geom.foe_shift()
-            } else {
-                0.0
-            };
+        // The focus's rounding (`PairGeometry::foe_shift`): moving
+        // forwards as a shift of the frame-1 point, backwards as one of
+        // the correspondent in frame 2.
+        let foe = geom.foe_shift();
+        let (slack_r1, slack_e2) = if geom.w() > 0.0 {
+            (slack + foe, slack)
+        } else {
+            (slack, slack + foe)
+        };
         let frame_r1 = match geom.frame_disc_radius(config.e1) {
             Some(r) if !rotation => Some(r + slack_r1).filter(|r| r.is_finite()),
             _ => None,
@@ -394,8 +397,8 @@ impl<'c> Pair<'c> {
             foe: geom.focus_of_expansion().map(Pixel::arr),
             reach: crate::math::sqrt(cam2.reach2()),
             scale,
-            slack,
             slack_r1,
+            slack_e2,
             frame_r1,
             certified_r1: frame_r1.filter(|_| geom.certifies_image(cam1, depth_scale_error)),
             depth_scale_error,
@@ -431,7 +434,7 @@ impl<'c> Pair<'c> {
     }
 
     fn e2(&self) -> f32 {
-        self.config.e2 + self.slack
+        self.config.e2 + self.slack_e2
     }
 
     /// The grazing test's allowance for the polyline's error: `e₂ · 2/sin

@@ -283,14 +283,14 @@ impl PairGeometry {
     /// one rounding of each component, [`dot3_accurate`], then `f U'`, the
     /// quotient and the sum round once each); 0 when `W' = 0` (no focus).
     ///
-    /// For `W' > 0` it is added to `r₁` (`crate::processor`): with the true
-    /// focus `e` and the computed `e' = e + ε`, a correspondent `p₂ − e =
-    /// k (p₁' − e)` (`k ≥ 1` the ratio of the distances from the focus)
-    /// is `p₂ − e' = k (p₁' + (1 − 1/k) ε − e')`: the geometry of the
-    /// computed focus with the frame-1 point moved by `(1 − 1/k) ε`, at
-    /// most `|ε|`. (Moving backwards `0 < k < 1` and the shift is not
-    /// bounded so; there the slack covers the focus's rounding in frame 2,
-    /// module docs.)
+    /// With the true focus `e` and the computed `e' = e + ε`, a
+    /// correspondent `p₂ − e = k (p₁' − e)` (`k` the ratio of the
+    /// distances from the focus) is `p₂ − e' = k (p₁' + (1 − 1/k) ε − e')
+    /// = k (p₁' − e') + (1 − k) ε`: moving forwards (`k ≥ 1`) the computed
+    /// focus's geometry with the frame-1 point moved by `(1 − 1/k) ε`,
+    /// moving backwards (`0 < k < 1`) with the correspondent moved by `(1 −
+    /// k) ε`, each at most `|ε|` and bounded by [`Self::foe_shift`], which
+    /// `crate::processor` adds to `r₁` or to `e₂`.
     pub(crate) fn foe_rounding(&self) -> f32 {
         self.foe_round
     }

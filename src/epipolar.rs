@@ -626,13 +626,9 @@ fn foe_rounding(tp: [f32; 3], tp_abs: [f32; 3], f: [f32; 2], c: [f32; 2]) -> f32
     if !(w > 0.0) {
         return 0.0;
     }
-    let [du, dv, dw] = [0, 1, 2].map(|i| {
-        let (t, a) = (
-            tp.get(i).copied().unwrap_or(0.0),
-            tp_abs.get(i).copied().unwrap_or(0.0),
-        );
-        6.0e-8 * t.abs() + 4.0e-14 * a
-    });
+    let dt = |t: f32, a: f32| 6.0e-8 * t.abs() + 4.0e-14 * a;
+    let ([tu, tv, tw], [au, av, aw]) = (tp, tp_abs);
+    let (du, dv, dw) = (dt(tu, au), dt(tv, av), dt(tw, aw));
     let axis = |fi: f32, ti: f32, dt: f32, ci: f32| {
         let d = (fi * ti / tp[2]).abs();
         ((fi * dt + d * dw) / w + 1.2e-7 * d + 6.0e-8 * (ci.abs() + d)) * 2.0
@@ -882,72 +878,38 @@ mod tests {
         let mut per_kind = [0usize; 5];
         for case in 0..1500 {
             let kind = case % 5;
+            // A camera with focal lengths `f₀ + f₁ ρ` and principal point
+            // `c₀ + c₁ ρ` per axis (`ρ` uniform in [0, 1)).
+            let mut cam = |f: [f32; 2], c: [[f32; 2]; 2], (w, h): (u16, u16)| {
+                let mut draw = |[a, b]: [f32; 2]| a + b * rng.next();
+                let (fx, fy) = (draw(f), draw(f));
+                let (cx, cy) = (draw(c[0]), draw(c[1]));
+                Camera::new(fx, fy, cx, cy, w, h).expect("camera")
+            };
             let (cam1, cam2) = match kind {
                 0 => {
-                    let c = Camera::new(
-                        500.0 + 600.0 * rng.next(),
-                        500.0 + 600.0 * rng.next(),
-                        240.0 + 30.0 * rng.next(),
-                        220.0 + 30.0 * rng.next(),
-                        512,
-                        480,
-                    );
-                    (c.expect("camera"), c.expect("camera"))
+                    let c = cam([500.0, 600.0], [[240.0, 30.0], [220.0, 30.0]], (512, 480));
+                    (c, c)
                 }
                 1 => (
-                    Camera::new(
-                        2705.9,
-                        2705.9,
-                        16000.0 + 383.0 * rng.next(),
-                        16000.0 + 383.0 * rng.next(),
-                        16384,
-                        16384,
-                    )
-                    .expect("camera"),
-                    Camera::new(2705.9, 2705.9, 63.0 * rng.next(), 47.0 * rng.next(), 64, 48)
-                        .expect("camera"),
+                    cam(
+                        [2705.9, 0.0],
+                        [[16000.0, 383.0], [16000.0, 383.0]],
+                        (16384, 16384),
+                    ),
+                    cam([2705.9, 0.0], [[0.0, 63.0], [0.0, 47.0]], (64, 48)),
                 ),
                 2 => {
-                    let c = Camera::new(
-                        1.0 + 8.0 * rng.next(),
-                        1.0 + 8.0 * rng.next(),
-                        500.0,
-                        400.0,
-                        1024,
-                        768,
-                    );
-                    (c.expect("camera"), c.expect("camera"))
+                    let c = cam([1.0, 8.0], [[500.0, 0.0], [400.0, 0.0]], (1024, 768));
+                    (c, c)
                 }
                 3 => {
-                    let c = Camera::new(
-                        20_000.0 * rng.next() + 1.0,
-                        20_000.0 * rng.next() + 1.0,
-                        16383.0 * rng.next(),
-                        63.0 * rng.next(),
-                        16384,
-                        64,
-                    );
-                    (c.expect("camera"), c.expect("camera"))
+                    let c = cam([1.0, 20_000.0], [[0.0, 16383.0], [0.0, 63.0]], (16384, 64));
+                    (c, c)
                 }
                 _ => (
-                    Camera::new(
-                        100.0 + 900.0 * rng.next(),
-                        100.0 + 900.0 * rng.next(),
-                        3999.0 * rng.next(),
-                        2999.0 * rng.next(),
-                        4000,
-                        3000,
-                    )
-                    .expect("camera"),
-                    Camera::new(
-                        100.0 + 900.0 * rng.next(),
-                        100.0 + 900.0 * rng.next(),
-                        319.0 * rng.next(),
-                        239.0 * rng.next(),
-                        320,
-                        240,
-                    )
-                    .expect("camera"),
+                    cam([100.0, 900.0], [[0.0, 3999.0], [0.0, 2999.0]], (4000, 3000)),
+                    cam([100.0, 900.0], [[0.0, 319.0], [0.0, 239.0]], (320, 240)),
                 ),
             };
             let deg = [0.0f32, 1.0, 5.0, 30.0, 60.0][(case / 5) % 5];

@@ -209,8 +209,11 @@ impl Config {
     /// points of the frame), and a point whose search would need more than
     /// the budget holds is flagged [`crate::Status::OverBudget`] instead
     /// of the frame running late. One unit is one segment looked at in a
-    /// search (or one bisection step); README ("Worst case") gives the
-    /// instructions per unit and per point, which bound a frame's cost.
+    /// search (or one bisection step); a segment clipped costs two more,
+    /// and one whose lines tighten a stick four more (a stick the budget
+    /// cannot tighten keeps its looser, still guaranteed, bound). README
+    /// ("Worst case") gives the instructions per unit and per point, which
+    /// bound a frame's cost.
     ///
     /// ```
     /// use roadstereo::Config;

@@ -33,7 +33,8 @@
 //! # Worst case
 //! Every loop of the per-frame call is bounded by a slice length (the
 //! points of a boundary, its segments), a capacity or a constant, except
-//! the searches' walks and bisections, which are paid from the frame's
+//! the searches' walks and bisections and the refinement of a stick by the
+//! piece's lines (`src/wedge.rs`), which are paid from the frame's
 //! work budget: each point brings [`Config::work_per_point`] units, unused
 //! units carry over, and a point that would need more than there are is
 //! flagged [`Status::OverBudget`]. So the cost of a frame is at most a

@@ -62,8 +62,9 @@ pub enum Status {
     /// frame 2 detected, so no stick can be guaranteed.
     BoundaryEnd,
     /// The frame's work budget ([`crate::Config::with_work_budget`]) was
-    /// spent before this point's search could finish: no depth, and the
-    /// frame did not run late.
+    /// spent before this point's search could finish, or before the
+    /// piece's lines could bound a stick that its range leaves unbounded:
+    /// no depth, and the frame did not run late.
     OverBudget,
 }
 

@@ -158,8 +158,18 @@
 //! point's registers, and the refinement finds the piece again from its
 //! end ([`Wedge::refined`]: back to the first segment without a part,
 //! then the range, the crossing and the bounds in one pass, bit for bit
-//! the walk's range and crossing). The band path keeps the stick from the
-//! range alone. Rounding: `|u|` is bounded above (`rsqrt_pos` with
+//! the walk's range and crossing). Its dear part, a segment's two
+//! directions' bounds (two divisions each and a reciprocal square root),
+//! is paid from the frame's work budget, [`REFINE_UNITS`] a segment; a
+//! segment the credit left cannot pay for keeps only its `d̂` bound, the
+//! stick from its range: `t_far` is still a maximum over the segments of
+//! bounds each valid for its segment, so the stick still holds, only less
+//! tight (with no credit it is the stick from the piece's range, bit for
+//! bit; one left unbounded for want of credit is flagged
+//! [`Status::OverBudget`]). The rest of the pass (the piece found again,
+//! each segment's part and crossing, as the walk computed them) is bounded
+//! by the segments the walk paid for. The band path keeps the stick from
+//! the range alone. Rounding: `|u|` is bounded above (`rsqrt_pos` with
 //! [`crate::math::RSQRT_UP`] twice), each `u·(v − P₁')` and `u_x R` is
 //! widened by four times its rounding bound, and the ends are rounded
 //! outwards by `2⁻²¹`; the vertices' own rounding is the slack in `r₁` and
@@ -470,14 +480,21 @@ impl Wedge {
     /// only when the piece is not found again (not reached: the walk found
     /// it with this wedge). Out of line: the usual point does not take it.
     /// Two passes over the piece's segments (and one more), each of which
-    /// the walk paid for.
+    /// the walk paid for; the lines' bounds of a segment (its normal's and
+    /// the chord's, the dear part) cost [`REFINE_UNITS`] more from
+    /// `credit`, and a segment the credit cannot pay for keeps the bound
+    /// from its range (the stick of [`Self::depths`] over that segment):
+    /// valid, only less tight. The third value says whether a segment went
+    /// unpaid (then an unbounded stick is the budget's doing, not the
+    /// geometry's).
     #[inline(never)]
     pub(crate) fn refined(
         &self,
         b2: &[Pixel],
         end: usize,
         (w, r1): ([f32; 3], f32),
-    ) -> Option<(f32, Option<Depths>)> {
+        credit: &mut u32,
+    ) -> Option<(f32, Option<Depths>, bool)> {
         let first = self.piece_start(b2, end)?;
         let (v0, rest) = b2.get(first..=end)?.split_first()?;
         let last = rest.last()?;
@@ -491,6 +508,10 @@ impl Wedge {
         // The largest and the smallest `t = k/(1 − k)` (`k = ρ(p₁)/ρ(p₂)`)
         // any segment allows: `s = W' (1 + t)`.
         let (mut t_far, mut t_near) = (0.0f32, f32::INFINITY);
+        // The segments the credit pays for, from the first.
+        let segments = u32::try_from(rest.len()).unwrap_or(u32::MAX);
+        let paid = (*credit / REFINE_UNITS).min(segments);
+        *credit -= paid * REFINE_UNITS;
         for (i, v) in rest.iter().enumerate() {
             let vb = self.vertex(v.arr());
             let (lo_j, hi_j) = self.part(&va, &vb)?;
@@ -508,11 +529,14 @@ impl Wedge {
                 f32::INFINITY
             };
             let mut near = (r2 - pr1) / ((hi_j - r2) + self.rho_re);
-            // The segment's own normal, and the chord's.
-            for dir in [Direction::normal_of(&va, &vb, p1), chord].iter().flatten() {
-                let (f, n) = dir.bounds(&va, &vb, r2);
-                far = fmin(far, f);
-                near = fmax(near, n);
+            // The segment's own normal, and the chord's, where the credit
+            // pays for them.
+            if (i as u64) < u64::from(paid) {
+                for dir in [Direction::normal_of(&va, &vb, p1), chord].iter().flatten() {
+                    let (f, n) = dir.bounds(&va, &vb, r2);
+                    far = fmin(far, f);
+                    near = fmax(near, n);
+                }
             }
             t_far = fmax(t_far, far);
             t_near = fmin(t_near, near);
@@ -524,14 +548,18 @@ impl Wedge {
         let x = fmin(fmax(best, lo), hi);
         // (A NaN fails.)
         if !(t_far < f32::INFINITY) || !(t_near >= 0.0) {
-            return Some((x, self.depths(w, r1, (x, lo, hi))));
+            return Some((x, self.depths(w, r1, (x, lo, hi)), paid < segments));
         }
         let [w, w_up, w_down] = w;
         let s = w + w * (r2 / (x - r2));
         let s_far = w_up + w_up * t_far;
         let s_near = w_down + w_down * t_near;
         // (Rounding aside, the estimate's own ratio `R/X` lies between.)
-        Some((x, Some((s, fmin(s_near, s), fmax(s_far, s)))))
+        Some((
+            x,
+            Some((s, fmin(s_near, s), fmax(s_far, s))),
+            paid < segments,
+        ))
     }
 }
 
@@ -543,6 +571,14 @@ impl Wedge {
 /// tenth, but the demo's costliest frame would refine 70 of its points,
 /// +11 %; `docs/PERFORMANCE.md`.)
 pub(crate) const REFINE_GAP: f32 = 4.0;
+
+/// Work units [`Wedge::refined`] pays for a segment's lines (its normal
+/// and the chord's bounds: two divisions each, a reciprocal square root),
+/// on top of what the walk paid to clip it. The loop that computes them is
+/// about 270 instructions of code run up to twice, so at four units a unit
+/// of it costs less than the band path's (README, "Worst case": `C_U`); at
+/// two it would cost more.
+pub(crate) const REFINE_UNITS: u32 = 4;
 
 /// A depth estimate and the stick's ends in the compensated frame, `(s,
 /// s_near, s_far)` ([`Wedge::depths`]).
@@ -1195,10 +1231,43 @@ mod tests {
                     refined += 1;
                     // The crossing from the piece alone is the walk's, bit
                     // for bit.
-                    let (x, stick) = wedge
-                        .refined(&poly, e, (stick_w(w), r1))
+                    let mut unlimited = u32::MAX;
+                    let (x, stick, unpaid) = wedge
+                        .refined(&poly, e, (stick_w(w), r1), &mut unlimited)
                         .expect("the piece again");
+                    assert!(!unpaid, "case {case}: unlimited credit");
                     assert_eq!(x.to_bits(), lam.to_bits(), "case {case}: crossing");
+                    // A short credit: each segment it pays costs
+                    // REFINE_UNITS, an unpaid one keeps its range's bound,
+                    // so the stick lies between the full refinement's and
+                    // the coarse one, and with no credit it is the coarse.
+                    let segs = (e - piece.0) as u32;
+                    let paid = (rng.next() * (segs + 1) as f32) as u32;
+                    for give in [0, paid.min(segs) * REFINE_UNITS + REFINE_UNITS - 1] {
+                        let mut credit = give;
+                        let (xs, short, unpaid) = wedge
+                            .refined(&poly, e, (stick_w(w), r1), &mut credit)
+                            .expect("the piece again");
+                        assert_eq!(xs.to_bits(), lam.to_bits(), "case {case}: crossing");
+                        let paid_now = give / REFINE_UNITS;
+                        assert_eq!(credit, give - paid_now.min(segs) * REFINE_UNITS);
+                        assert_eq!(unpaid, paid_now < segs, "case {case}: {give} for {segs}");
+                        if give == 0 {
+                            assert_eq!(short, coarse, "case {case}: no credit, the coarse stick");
+                        }
+                        if let (Some((_, fnr, ffr)), Some((_, pn, pf))) = (stick, short) {
+                            assert!(
+                                pn <= fnr && pf >= ffr,
+                                "case {case}: [{pn}, {pf}] inside the refined [{fnr}, {ffr}]"
+                            );
+                        }
+                        if let (Some((_, cn, cf)), Some((_, pn, pf))) = (coarse, short) {
+                            assert!(
+                                pf <= cf * (1.0 + 4e-6) && pn >= cn * (1.0 - 4e-6),
+                                "case {case}: [{pn}, {pf}] wider than the coarse [{cn}, {cf}]"
+                            );
+                        }
+                    }
                     stick
                 }
                 None => coarse,

@@ -105,7 +105,7 @@ fn match_wedge_lean<const N: usize>(
                 let (h, refine) = walk.point_loose(r, hint, work);
                 hint = h;
                 if refine != 0 {
-                    walk.refine(r, refine);
+                    walk.refine(r, refine, work);
                 }
             }
         }
@@ -115,7 +115,7 @@ fn match_wedge_lean<const N: usize>(
                 let (h, refine) = walk.point(r, hint, work);
                 hint = h;
                 if refine != 0 {
-                    walk.refine(r, refine);
+                    walk.refine(r, refine, work);
                 }
             }
         }
@@ -125,7 +125,7 @@ fn match_wedge_lean<const N: usize>(
                 let (h, refine) = walk.point_aside(r, hint, work);
                 hint = h;
                 if refine != 0 {
-                    walk.refine(r, refine);
+                    walk.refine(r, refine, work);
                 }
             }
         }
@@ -200,7 +200,9 @@ fn match_wedge_angular<const N: usize>(
         }
     }
     if deferred {
-        refine_deferred((pair, foe), slots, b2);
+        let mut credit = work.credit();
+        refine_deferred((pair, foe), slots, b2, &mut credit);
+        work.set_credit(credit);
     }
 }
 
@@ -209,10 +211,16 @@ fn match_wedge_angular<const N: usize>(
 /// point it concluded or flagged has a clean result, `z_near` 0 where it
 /// is flagged) and the piece's end in `z_far`. Each gets its wedge's
 /// geometry again (the same bits; the keys are not needed) and the refined
-/// stick ([`conclude_refined`]).
+/// stick ([`conclude_refined`]), its lines paid from `credit`, what the
+/// walks left of the frame's work budget.
 #[cold]
 #[inline(never)]
-fn refine_deferred((pair, foe): (&Pair, [f32; 2]), slots: &mut [PointResult], b2: &[Pixel]) {
+fn refine_deferred(
+    (pair, foe): (&Pair, [f32; 2]),
+    slots: &mut [PointResult],
+    b2: &[Pixel],
+    credit: &mut u32,
+) {
     let errors = (pair.e2(), pair.e2_csc());
     for r in slots
         .iter_mut()
@@ -223,7 +231,7 @@ fn refine_deferred((pair, foe): (&Pair, [f32; 2]), slots: &mut [PointResult], b2
         let end = r.z_far as usize;
         let no_key = (crate::pencil::NO_KEY, 1.0, 1.0);
         *r = match Wedge::new_angular(p, foe, (r1, errors.0, errors.1), no_key) {
-            Ok(wedge) => conclude_refined(pair, (p1, iz, r1), &wedge, b2, end),
+            Ok(wedge) => conclude_refined(pair, (p1, iz, r1), &wedge, b2, end, credit),
             // (Not reached: the loop had this wedge.)
             Err(_) => PointResult::flagged(p1, Status::AtFoe),
         };
@@ -418,10 +426,12 @@ impl LeanWalk<'_> {
     /// The result of a point whose walk ended with the piece that ends at
     /// `end` and whose stick [`Self::conclude`] left to tighten: its
     /// wedge again (the same arithmetic: the same bits), then the piece's
-    /// crossing and refined stick ([`Wedge::refined`]).
+    /// crossing and refined stick ([`Wedge::refined`], its lines paid from
+    /// `work`).
     #[cold]
     #[inline(never)]
-    fn refine(&self, r: &mut PointResult, end: usize) {
+    fn refine(&self, r: &mut PointResult, end: usize, work: &mut Work) {
+        let mut credit = work.credit();
         let (p1, p, iz, r1, key) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near, r.z_far);
         *r = match Wedge::new(
             p,
@@ -429,10 +439,13 @@ impl LeanWalk<'_> {
             (r1, self.e2, self.e2_csc),
             (key, self.key_scale, self.orient),
         ) {
-            Ok(wedge) => conclude_refined(self.pair, (p1, iz, r1), &wedge, self.b2, end),
+            Ok(wedge) => {
+                conclude_refined(self.pair, (p1, iz, r1), &wedge, self.b2, end, &mut credit)
+            }
             // (Not reached: the walk had this wedge.)
             Err(_) => PointResult::flagged(p1, Status::AtFoe),
         };
+        work.set_credit(credit);
     }
 
     /// [`Self::point`] with the index's aside entries merged into the run
@@ -830,7 +843,7 @@ fn conclude_coarse(
 
 /// The point's result from a wedge walk's outcome: depth and stick
 /// ([`crate::wedge`]), tightened by the piece's lines where
-/// [`Wedge::refines`] says.
+/// [`Wedge::refines`] says (the references' conclusion: no work budget).
 fn conclude_wedge(
     pair: &Pair,
     (p1, iz, r1): (Pixel, f32, f32),
@@ -839,14 +852,19 @@ fn conclude_wedge(
     b2: &[Pixel],
 ) -> PointResult {
     match wedge.refines(&outcome) {
-        Some(end) => conclude_refined(pair, (p1, iz, r1), wedge, b2, end),
+        Some(end) => {
+            let mut unlimited = u32::MAX;
+            conclude_refined(pair, (p1, iz, r1), wedge, b2, end, &mut unlimited)
+        }
         None => conclude_coarse(pair, (p1, iz, r1), wedge, outcome),
     }
 }
 
 /// [`conclude_wedge`] for a walk whose piece ends at `end` and whose
-/// outcome [`Wedge::refines`] ([`Wedge::refined`]). (Out of line: the
-/// usual point does not take it.)
+/// outcome [`Wedge::refines`] ([`Wedge::refined`], its lines paid from
+/// `credit`; a stick left unbounded because the credit fell short is
+/// flagged [`Status::OverBudget`]). (Out of line: the usual point does not
+/// take it.)
 #[cold]
 #[inline(never)]
 fn conclude_refined(
@@ -855,9 +873,12 @@ fn conclude_refined(
     wedge: &Wedge,
     b2: &[Pixel],
     end: usize,
+    credit: &mut u32,
 ) -> PointResult {
-    match wedge.refined(b2, end, (pair.w_stick, r1)) {
-        Some((x, depths)) => finish_point(pair, p1, wedge.point_at(x), iz, depths),
+    match wedge.refined(b2, end, (pair.w_stick, r1), credit) {
+        // Unbounded only because the credit fell short: the budget's flag.
+        Some((_, None, true)) => PointResult::flagged(p1, Status::OverBudget),
+        Some((x, depths, _)) => finish_point(pair, p1, wedge.point_at(x), iz, depths),
         // (Not reached: the walk found this piece with this wedge.)
         None => PointResult::flagged(p1, Status::NoIntersection),
     }

@@ -32,7 +32,7 @@
 use roadstereo::geometry::{samples, Sample};
 use roadstereo::{
     BoundaryError, Camera, CameraError, Config, ConfigError, Frame, Motion, MotionError, Pixel,
-    ProcessError, Processor, Status, Step, Structure, IMAGE_MARGIN_PX,
+    PointResult, ProcessError, Processor, Status, Step, Structure, IMAGE_MARGIN_PX,
 };
 
 use super::{Outcome, Source};
@@ -598,6 +598,7 @@ mod bit {
     pub const RESET: u32 = 60;
     pub const SAMPLES: u32 = 61;
     pub const CAMERA_CHANGE: u32 = 62;
+    pub const LOOSER_STICK: u32 = 63;
 }
 
 fn set(f: &mut u128, b: u32) {
@@ -948,7 +949,9 @@ pub const RECONSTRUCTED: u32 = 124;
 
 /// `got` (the case's budget) against the indexed matcher with the largest
 /// budget (which equals the reference, see [`matchers`]): each point
-/// equal, or over budget; with the largest budget, equal.
+/// equal, over budget, or `ok` with the same match and a stick holding the
+/// largest budget's (a stick the budget could not tighten by the piece's
+/// lines keeps the bound from its range); with the largest budget, equal.
 fn against_reference<const N: usize, const B: usize>(
     got: &Structure<N, B>,
     reference: &Structure<N, B>,
@@ -963,7 +966,13 @@ fn against_reference<const N: usize, const B: usize>(
         .enumerate()
     {
         for (i, (p, q)) in x.points().iter().zip(y.points()).enumerate() {
-            if p != q {
+            if p != q && looser_stick(p, q) {
+                assert!(
+                    !largest,
+                    "largest budget: boundary {k} point {i}: {p:?}, reference {q:?}"
+                );
+                set(features, bit::LOOSER_STICK);
+            } else if p != q {
                 assert_eq!(
                     p.status(),
                     Status::OverBudget,
@@ -979,6 +988,24 @@ fn against_reference<const N: usize, const B: usize>(
                 set(features, bit::OVER_BUDGET_ONLY);
             }
         }
+    }
+}
+
+/// Whether `p` is `q` with a stick that holds `q`'s: both `ok`, the same
+/// pixels and depth, `p`'s ends at or beyond `q`'s.
+fn looser_stick(p: &PointResult, q: &PointResult) -> bool {
+    let bits = |r: &PointResult| r.depth().map(f32::to_bits);
+    match (p.interval(), q.interval()) {
+        (Some(a), Some(b)) => {
+            p.status() == Status::Ok
+                && q.status() == Status::Ok
+                && p.pixel1() == q.pixel1()
+                && p.pixel2() == q.pixel2()
+                && bits(p) == bits(q)
+                && a.z_near <= b.z_near
+                && a.z_far >= b.z_far
+        }
+        _ => false,
     }
 }
 

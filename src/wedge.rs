@@ -574,10 +574,11 @@ pub(crate) const REFINE_GAP: f32 = 4.0;
 
 /// Work units [`Wedge::refined`] pays for a segment's lines (its normal
 /// and the chord's bounds: two divisions each, a reciprocal square root),
-/// on top of what the walk paid to clip it. The loop that computes them is
-/// about 270 instructions of code run up to twice, so at four units a unit
-/// of it costs less than the band path's (README, "Worst case": `C_U`); at
-/// two it would cost more.
+/// on top of what the walk paid to clip it. A paid segment costs about 245
+/// instructions more than an unpaid one (measured on the bench's `+e_3`
+/// probes against a build that charges but skips the bounds), so at four
+/// units a unit of it costs about 61, less than the band path's (README,
+/// "Worst case": `C_U` 105); at two it would cost about 122.
 pub(crate) const REFINE_UNITS: u32 = 4;
 
 /// A depth estimate and the stick's ends in the compensated frame, `(s,
@@ -1226,6 +1227,9 @@ mod tests {
             let piece = (start, end);
             let coarse = wedge.depths(stick_w(w), r1, (lam, lo, hi));
             let outcome = Outcome::Match { lam, lo, hi, end };
+            // Every stick a partial credit gave (the truth is checked in
+            // each below).
+            let mut partials = std::vec::Vec::new();
             let Some(stick) = (match wedge.refines(&outcome) {
                 Some(e) => {
                     refined += 1;
@@ -1242,8 +1246,9 @@ mod tests {
                     // so the stick lies between the full refinement's and
                     // the coarse one, and with no credit it is the coarse.
                     let segs = (e - piece.0) as u32;
-                    let paid = (rng.next() * (segs + 1) as f32) as u32;
-                    for give in [0, paid.min(segs) * REFINE_UNITS + REFINE_UNITS - 1] {
+                    let credits = (0..=segs + 1)
+                        .flat_map(|k| [k * REFINE_UNITS, k * REFINE_UNITS + REFINE_UNITS - 1]);
+                    for give in credits {
                         let mut credit = give;
                         let (xs, short, unpaid) = wedge
                             .refined(&poly, e, (stick_w(w), r1), &mut credit)
@@ -1266,6 +1271,9 @@ mod tests {
                                 pf <= cf * (1.0 + 4e-6) && pn >= cn * (1.0 - 4e-6),
                                 "case {case}: [{pn}, {pf}] wider than the coarse [{cn}, {cf}]"
                             );
+                        }
+                        if let Some((_, pn, pf)) = short {
+                            partials.push((pn, pf));
                         }
                     }
                     stick
@@ -1330,6 +1338,12 @@ mod tests {
                         "case {case}: true s {s} (k {k}) outside [{s_near}, {s_far}] \
                          (p {p:?}, foe {foe:?}, r1 {r1}, e2 {e2}, piece {piece:?} of {poly:?})"
                     );
+                    for &(pn, pf) in &partials {
+                        assert!(
+                            s >= f64::from(pn) && s <= f64::from(pf),
+                            "case {case}: true s {s} outside the partial [{pn}, {pf}]"
+                        );
+                    }
                     checked += 1;
                 }
             }

@@ -230,3 +230,84 @@ fn angular_wedge_equals_reference_near_and_round_the_foe() {
     }
     assert!(oks > 100, "the wedges matched {oks} points");
 }
+
+/// Whether `p` is `q` with a stick that holds `q`'s (both `ok`, the same
+/// match and depth): what a budget too small to tighten a stick by the
+/// piece's lines gives.
+fn looser_stick(p: &PointResult, q: &PointResult) -> bool {
+    match (p.interval(), q.interval()) {
+        (Some(a), Some(b)) => {
+            p.status() == Status::Ok
+                && q.status() == Status::Ok
+                && p.pixel2() == q.pixel2()
+                && p.depth().map(f32::to_bits) == q.depth().map(f32::to_bits)
+                && a.z_near <= b.z_near
+                && a.z_far >= b.z_far
+        }
+        _ => false,
+    }
+}
+
+/// The adversarial family's pairs under localisation errors of 1.5–10 px,
+/// where most sticks are refined by the piece's lines (from a review of
+/// the refinement's charge): with the largest budget the indexed search
+/// equals the reference, and at 16 budgets from 8 to 160 every point is
+/// equal, `over_budget`, or `ok` with the same match and a looser stick.
+#[test]
+fn refinement_under_every_budget_on_the_adversarial_family() {
+    use host_tests::drive::adversarial::{family, library_pair, render};
+    let (mut equal, mut over, mut looser, mut bad) = (0usize, 0usize, 0usize, 0usize);
+    for m in family() {
+        for n in [64usize, 256] {
+            let Ok((k, frames)) = render(&m.params, n) else {
+                continue;
+            };
+            let (f1, f2, motion) = library_pair(&k, &frames);
+            for e in [1.5f32, 3.0, 6.0, 10.0] {
+                let base = m.errors.config().with_localisation_error(e, e).unwrap();
+                let largest = base.with_work_budget(Config::MAX_WORK_PER_POINT).unwrap();
+                let mut p = Box::new(Processor::<512, 2>::new(largest));
+                let _ = p.process(&f1, None);
+                let Ok(fast) = p.process_against_kept(&f2, &motion) else {
+                    continue;
+                };
+                let fast = Box::new(fast.clone());
+                let reference = Box::new(p.reference_against_kept(&f2, &motion).unwrap().clone());
+                assert!(
+                    fast == reference,
+                    "{} at N = {n}, e = {e}: the indexed search differs from the reference",
+                    m.name
+                );
+                for w in [
+                    8u32, 9, 10, 11, 12, 14, 16, 20, 24, 32, 40, 48, 64, 80, 120, 160,
+                ] {
+                    p.set_config(base.with_work_budget(w).unwrap());
+                    let got = p.process_against_kept(&f2, &motion).unwrap();
+                    for (x, y) in got.boundaries().iter().zip(fast.boundaries()) {
+                        for (a, b) in x.points().iter().zip(y.points()) {
+                            if a == b {
+                                equal += 1;
+                            } else if looser_stick(a, b) {
+                                looser += 1;
+                            } else if a.status() == Status::OverBudget {
+                                over += 1;
+                            } else {
+                                bad += 1;
+                                eprintln!(
+                                    "{} N = {n} e = {e} w = {w}: {a:?}, largest {b:?}",
+                                    m.name
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    eprintln!("equal {equal}, over_budget {over}, ok with a looser stick {looser}, other {bad}");
+    assert_eq!(bad, 0);
+    assert!(
+        looser > 0,
+        "no budget loosened a stick: the test does not reach the refinement"
+    );
+}

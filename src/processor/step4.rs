@@ -212,7 +212,10 @@ fn match_wedge_angular<const N: usize>(
 /// is flagged) and the piece's end in `z_far`. Each gets its wedge's
 /// geometry again (the same bits; the keys are not needed) and the refined
 /// stick ([`conclude_refined`]), its lines paid from `credit`, what the
-/// walks left of the frame's work budget.
+/// walks left of the frame's work budget. (So under a tight budget this
+/// path keeps its walks and loses tightening, where the half-plane path,
+/// which refines each point as it goes, may spend on a refinement what a
+/// later point's walk needed: both valid, the sticks held either way.)
 #[cold]
 #[inline(never)]
 fn refine_deferred(

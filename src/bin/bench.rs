@@ -410,8 +410,9 @@ fn member_config(errors: u8, w: u32) -> Option<Config> {
 /// The `+e_3` probes (a review's ask) run forward members with shallow
 /// crossings and dense vertices under `e₁ = e₂ = 3` px: most disparities
 /// are then under `REFINE_GAP (r₁ + e₂)`, so most points take the stick
-/// from the piece's lines, whose pass over the piece's segments the work
-/// budget does not charge (it charged their clips in the walk).
+/// from the piece's lines, whose bounds the work budget charges
+/// `REFINE_UNITS` a segment (before it did, these probes measured 134
+/// instructions a unit: the pass was paid only by the walk's clips).
 /// A probe with a window `(off, k)` takes points `off .. off + k` of each
 /// boundary in both frames (a smaller frame of the same pair).
 #[allow(clippy::type_complexity)]

@@ -502,16 +502,21 @@ impl Wedge {
         let pr1 = self.rho * r1;
         let p1 = (r2, pr1, self.rho_re);
         let mut va = self.vertex(v0.arr());
-        // The normal of the piece's chord, one direction for every segment.
-        let chord = Direction::normal_of(&va, &self.vertex(last.arr()), p1);
-        let (mut lo, mut hi, mut best) = (0.0, 0.0, f32::INFINITY);
-        // The largest and the smallest `t = k/(1 − k)` (`k = ρ(p₁)/ρ(p₂)`)
-        // any segment allows: `s = W' (1 + t)`.
-        let (mut t_far, mut t_near) = (0.0f32, f32::INFINITY);
         // The segments the credit pays for, from the first.
         let segments = u32::try_from(rest.len()).unwrap_or(u32::MAX);
         let paid = (*credit / REFINE_UNITS).min(segments);
         *credit -= paid * REFINE_UNITS;
+        // The normal of the piece's chord, one direction for every paid
+        // segment (none: not needed).
+        let chord = if paid > 0 {
+            Direction::normal_of(&va, &self.vertex(last.arr()), p1)
+        } else {
+            None
+        };
+        let (mut lo, mut hi, mut best) = (0.0, 0.0, f32::INFINITY);
+        // The largest and the smallest `t = k/(1 − k)` (`k = ρ(p₁)/ρ(p₂)`)
+        // any segment allows: `s = W' (1 + t)`.
+        let (mut t_far, mut t_near) = (0.0f32, f32::INFINITY);
         for (i, v) in rest.iter().enumerate() {
             let vb = self.vertex(v.arr());
             let (lo_j, hi_j) = self.part(&va, &vb)?;

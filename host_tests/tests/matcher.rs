@@ -231,23 +231,6 @@ fn angular_wedge_equals_reference_near_and_round_the_foe() {
     assert!(oks > 100, "the wedges matched {oks} points");
 }
 
-/// Whether `p` is `q` with a stick that holds `q`'s (both `ok`, the same
-/// match and depth): what a budget too small to tighten a stick by the
-/// piece's lines gives.
-fn looser_stick(p: &PointResult, q: &PointResult) -> bool {
-    match (p.interval(), q.interval()) {
-        (Some(a), Some(b)) => {
-            p.status() == Status::Ok
-                && q.status() == Status::Ok
-                && p.pixel2() == q.pixel2()
-                && p.depth().map(f32::to_bits) == q.depth().map(f32::to_bits)
-                && a.z_near <= b.z_near
-                && a.z_far >= b.z_far
-        }
-        _ => false,
-    }
-}
-
 /// The adversarial family's pairs under localisation errors of 1.5–10 px,
 /// where most sticks are refined by the piece's lines (from a review of
 /// the refinement's charge): with the largest budget the indexed search
@@ -256,6 +239,7 @@ fn looser_stick(p: &PointResult, q: &PointResult) -> bool {
 #[test]
 fn refinement_under_every_budget_on_the_adversarial_family() {
     use host_tests::drive::adversarial::{family, library_pair, render};
+    use host_tests::fuzz::frame::looser_stick;
     let (mut equal, mut over, mut looser, mut bad) = (0usize, 0usize, 0usize, 0usize);
     for m in family() {
         for n in [64usize, 256] {

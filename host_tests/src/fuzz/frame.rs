@@ -992,8 +992,9 @@ fn against_reference<const N: usize, const B: usize>(
 }
 
 /// Whether `p` is `q` with a stick that holds `q`'s: both `ok`, the same
-/// pixels and depth, `p`'s ends at or beyond `q`'s.
-fn looser_stick(p: &PointResult, q: &PointResult) -> bool {
+/// pixels and depth, `p`'s ends at or beyond `q`'s (what a budget too small
+/// to tighten a stick by the piece's lines gives).
+pub fn looser_stick(p: &PointResult, q: &PointResult) -> bool {
     let bits = |r: &PointResult| r.depth().map(f32::to_bits);
     match (p.interval(), q.interval()) {
         (Some(a), Some(b)) => {

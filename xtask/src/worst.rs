@@ -50,6 +50,14 @@ impl Formula {
     pub fn bound(&self, b: u64, n: u64, w: u64) -> u64 {
         self.c0 + self.cb * b + (self.cp + self.cu * w) * b * n
     }
+
+    /// The largest `n` whose [`Self::bound`] for `b` boundaries at `w`
+    /// units a point is within `deadline` (0 when none is).
+    pub fn fits(&self, b: u64, w: u64, deadline: u64) -> u64 {
+        let fixed = self.c0 + self.cb * b;
+        let per = (self.cp + self.cu * w) * b;
+        deadline.saturating_sub(fixed) / per.max(1)
+    }
 }
 
 /// The constants from the log, or why they cannot be measured.
@@ -172,6 +180,11 @@ pub fn worst_case(
         "  at B = 2, N = 256, w = {default_w} (the default): {bound} instructions, {} % of the deadline {deadline}; at w = 8 (the smallest): {}",
         bound * 100 / deadline.max(1),
         f.bound(2, 256, 8)
+    );
+    println!(
+        "  what the bound fits in the deadline today (B = 2): N ≤ {} a boundary at w = {default_w}, N ≤ {} at w = 8 (an integration limit until issue 11's budgets are met, not a budget)",
+        f.fits(2, default_w, deadline),
+        f.fits(2, 8, deadline)
     );
     if bound > deadline {
         misses.push(format!(

@@ -95,6 +95,11 @@ pub struct Processor<const N: usize, const B: usize> {
     config: Config,
     previous: Frame<N, B>,
     has_previous: bool,
+    /// Whether step 2's fold test runs: always, but in the tests of
+    /// [`Self::without_fold_test_against_kept`] (no room taken: it sits in
+    /// `has_previous`'s padding).
+    #[cfg(any(test, feature = "_reference"))]
+    fold_test: bool,
     index: Index<N>,
     output: Structure<N, B>,
 }
@@ -106,6 +111,8 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             config,
             previous: Frame::new(Camera::PLACEHOLDER),
             has_previous: false,
+            #[cfg(any(test, feature = "_reference"))]
+            fold_test: true,
             index: Index::new(),
             output: Structure::EMPTY,
         }
@@ -211,8 +218,43 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         Ok(&self.output)
     }
 
+    /// [`Processor::process_against_kept`] with step 2's fold test switched
+    /// off (with the reference matcher of [`Self::reference_against_kept`]
+    /// when `reference`): no point is flagged [`Status::Folded`], every
+    /// point goes to the search. For the tests only, behind the private
+    /// `_reference` feature: the containment guarantee does not rest on
+    /// the fold test (a point whose correspondent exists has its true
+    /// crossing in the band, where one piece is that crossing's and two
+    /// separate ones make the point ambiguous), and without it the search
+    /// meets every fold. The fold test protects the points whose
+    /// correspondent is *not* in frame 2 (README, "What the fold test
+    /// buys").
+    #[cfg(any(test, feature = "_reference"))]
+    #[doc(hidden)]
+    pub fn without_fold_test_against_kept(
+        &mut self,
+        frame: &Frame<N, B>,
+        motion: &Motion,
+        reference: bool,
+    ) -> Result<&Structure<N, B>, ProcessError> {
+        if !self.has_previous {
+            return Err(ProcessError::NoKeptFrame);
+        }
+        let matcher = if reference {
+            Matcher::Reference
+        } else {
+            Matcher::Indexed
+        };
+        self.fold_test = false;
+        self.reconstruct(frame, motion, matcher);
+        self.fold_test = true;
+        Ok(&self.output)
+    }
+
     /// Steps 1–4 of the module docs for every boundary of the kept frame.
     fn reconstruct(&mut self, frame: &Frame<N, B>, motion: &Motion, matcher: Matcher) {
+        #[cfg(any(test, feature = "_reference"))]
+        let fold_test = self.fold_test;
         let Self {
             config,
             previous,
@@ -276,6 +318,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                     }
                 }
             }
+            #[cfg(not(any(test, feature = "_reference")))]
             crate::fold::step(
                 index,
                 slots,
@@ -283,6 +326,21 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 config.work_per_point,
                 &mut work,
             );
+            // (The tests' switch, `without_fold_test_against_kept`: without
+            // the test, the points' allowances as its shortcuts grant them.)
+            #[cfg(any(test, feature = "_reference"))]
+            if fold_test {
+                crate::fold::step(
+                    index,
+                    slots,
+                    (&order, keying.period, orient),
+                    config.work_per_point,
+                    &mut work,
+                );
+            } else {
+                let n = u32::try_from(slots.len()).unwrap_or(u32::MAX);
+                work.grant(config.work_per_point.saturating_mul(n));
+            }
             let Some(b2) = b2 else {
                 unmatched(slots);
                 continue;

@@ -687,8 +687,29 @@ pub fn run(
     motion: &roadstereo::Motion,
     input: &Input,
 ) -> Result<Vec<Vec<Outcome>>, String> {
+    run_with(k, motion, input, Fold::Tested)
+}
+
+/// Whether the library runs its fold test (step 2) on a case.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fold {
+    /// As shipped.
+    Tested,
+    /// Switched off (`Processor::without_fold_test_against_kept`): every
+    /// folded point searched, for the check that the search alone holds
+    /// the containment guarantee.
+    Untested,
+}
+
+/// [`run`] with or without the fold test.
+pub fn run_with(
+    k: &Intrinsics,
+    motion: &roadstereo::Motion,
+    input: &Input,
+    fold: Fold,
+) -> Result<Vec<Vec<Outcome>>, String> {
     let (f1, f2) = input.frames(k)?;
-    run_frames(&f1, &f2, motion, input.config())
+    run_frames(&f1, &f2, motion, input.config(), fold)
 }
 
 fn run_frames(
@@ -696,15 +717,22 @@ fn run_frames(
     f2: &Frame<N, B>,
     motion: &roadstereo::Motion,
     config: Config,
+    fold: Fold,
 ) -> Result<Vec<Vec<Outcome>>, String> {
     let mut p = Box::new(Processor::<N, B>::new(config));
     match p.process(f1, None) {
         Ok(Step::First) => {}
         other => return Err(format!("first frame: {other:?}")),
     }
-    let s = match p.process(f2, Some(motion)) {
-        Ok(Step::Structure(s)) => s,
-        other => return Err(format!("second frame: {other:?}")),
+    let s = match fold {
+        Fold::Tested => match p.process(f2, Some(motion)) {
+            Ok(Step::Structure(s)) => s,
+            other => return Err(format!("second frame: {other:?}")),
+        },
+        Fold::Untested => match p.without_fold_test_against_kept(f2, motion, false) {
+            Ok(s) => s,
+            other => return Err(format!("second frame: {other:?}")),
+        },
     };
     Ok(s.boundaries()
         .iter()
@@ -908,6 +936,11 @@ pub struct Checked {
 
 /// Run one case in one variant and check every point.
 pub fn check(case: &Case, variant: Variant) -> Checked {
+    check_with(case, variant, Fold::Tested)
+}
+
+/// [`check`] with or without the library's fold test.
+pub fn check_with(case: &Case, variant: Variant, fold: Fold) -> Checked {
     let input = case.input(variant);
     let mut model_errors = Vec::new();
     let name = format!("{}/{} {}", case.family.name(), case.seed, variant.name());
@@ -924,7 +957,7 @@ pub fn check(case: &Case, variant: Variant) -> Checked {
         ));
     }
     let k = &case.scenario.intrinsics;
-    let out = match run(k, &case.rendered.motion(), &input) {
+    let out = match run_with(k, &case.rendered.motion(), &input, fold) {
         Ok(o) => o,
         Err(e) => {
             model_errors.push(format!("{name}: {e}"));
@@ -1063,7 +1096,7 @@ pub fn replay_for(case: &Case, miss: &Miss) -> Option<String> {
         let (Ok(a), Ok(c)) = (make_frame(k, f1), make_frame(k, f2)) else {
             return false;
         };
-        run_frames(&a, &c, &m, config).is_ok_and(|o| {
+        run_frames(&a, &c, &m, config, Fold::Tested).is_ok_and(|o| {
             o.get(b)
                 .and_then(|ob| ob.get(i))
                 .is_some_and(|o| o.status == Status::Ok && !o.contains(miss.z_true))
@@ -1270,6 +1303,11 @@ fn containment(t: &Tally) -> String {
 
 /// Run `per_family` seeds of every family in every variant, on all cores.
 pub fn certify(families: &[Family], seeds: std::ops::Range<u64>) -> Report {
+    certify_with(families, seeds, Fold::Tested)
+}
+
+/// [`certify`] with or without the library's fold test.
+pub fn certify_with(families: &[Family], seeds: std::ops::Range<u64>, fold: Fold) -> Report {
     let jobs: Vec<(Family, u64)> = families
         .iter()
         .flat_map(|&f| seeds.clone().map(move |s| (f, s)))
@@ -1291,7 +1329,10 @@ pub fn certify(families: &[Family], seeds: std::ops::Range<u64>) -> Report {
                         };
                         let r = Case::new(f, seed).map(|c| {
                             (
-                                Variant::ALL.iter().map(|&v| check(&c, v)).collect(),
+                                Variant::ALL
+                                    .iter()
+                                    .map(|&v| check_with(&c, v, fold))
+                                    .collect(),
                                 c.allowance(),
                             )
                         });

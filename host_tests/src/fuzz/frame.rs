@@ -936,6 +936,29 @@ fn matchers<const N: usize, const B: usize>(
         }
         panic!("matcher: the indexed and reference structures differ");
     }
+    // The same with the fold test switched off, where every point on a
+    // fold reaches the search too.
+    let fast_all = Box::new(
+        r.without_fold_test_against_kept(frame, m, false)
+            .expect("kept")
+            .clone(),
+    );
+    let slow_all = r
+        .without_fold_test_against_kept(frame, m, true)
+        .expect("kept");
+    for (k, (x, y)) in fast_all
+        .boundaries()
+        .iter()
+        .zip(slow_all.boundaries())
+        .enumerate()
+    {
+        for (i, (p, q)) in x.points().iter().zip(y.points()).enumerate() {
+            assert!(
+                p == q,
+                "matcher without the fold test: boundary {k} point {i}: indexed {p:?}, reference {q:?} (largest budget)"
+            );
+        }
+    }
     assert_eq!(
         r.previous(),
         Some(kept),

@@ -28,6 +28,7 @@
 //!    is queried, each segment looked at paid from the frame's work budget
 //!    ([`Status::OverBudget`] when it runs out).
 
+use crate::deadline::{Deadline, Guard};
 use crate::math::{fmax, fmin};
 use crate::pencil::NO_KEY;
 use crate::search::{Index, KeyOrder, OutOfWork, Unkeyed, Work};
@@ -37,13 +38,16 @@ use crate::structure::{PointResult, Status, FOLD_WINDOW};
 /// still to be matched holds its raw key in `z_far`, its margin in the
 /// index's margins), whose key order step 1 tracked in `order`, keys of
 /// the given `period` and likely orientation `orient`; each point brings
-/// `allowance` units to `work`. Flags the points that fold.
-pub(crate) fn step<const N: usize>(
+/// `allowance` units to `work`. Flags the points that fold; a point rule 3
+/// would query once `guard`'s deadline has expired is
+/// [`Status::OverBudget`].
+pub(crate) fn step<const N: usize, D: Deadline>(
     index: &mut Index<N>,
     slots: &mut [PointResult],
     (order, period, orient): (&KeyOrder, f32, f32),
     allowance: u32,
     work: &mut Work,
+    guard: &mut Guard<'_, D>,
 ) {
     let n = u32::try_from(slots.len()).unwrap_or(u32::MAX);
     if order.strict(period) {
@@ -63,18 +67,24 @@ pub(crate) fn step<const N: usize>(
             NO_KEY
         }
     }));
+    if guard.check() {
+        // Out of time before the index is built: the caller flags the
+        // points left.
+        return;
+    }
     fold_index.finish(None);
-    by_index(index, slots, allowance, work);
+    by_index(index, slots, allowance, work, guard);
 }
 
 /// Rule 3: the query on the index of the compensated frame-1 polyline
 /// built from step 1's keys (points flagged there have none). Each point
 /// brings its allowance to the frame's work budget here.
-fn by_index<const N: usize>(
+fn by_index<const N: usize, D: Deadline>(
     index: &mut Index<N>,
     slots: &mut [PointResult],
     allowance: u32,
     work: &mut Work,
+    guard: &mut Guard<'_, D>,
 ) {
     if index.strict() {
         // No key meets a segment but its own two: nothing folds.
@@ -86,6 +96,7 @@ fn by_index<const N: usize>(
         slots,
         (FOLD_WINDOW, allowance),
         work,
+        |w| guard.proceed(w),
         |r| (r.status == Status::NoIntersection && r.z_far.is_finite()).then_some(r.z_far),
         |r, folds| match folds {
             Err(OutOfWork) => *r = PointResult::flagged(r.pixel1, Status::OverBudget),

@@ -45,20 +45,21 @@
 use crate::boundary::Frame;
 use crate::camera::{Camera, Pixel};
 use crate::config::Config;
+use crate::deadline::{Deadline, Guard, NoDeadline};
 use crate::depth::{interval, Band, PointErrors};
 use crate::epipolar::PairGeometry;
 use crate::matching::{Outcome, Radial, Walker};
 use crate::motion::Motion;
 use crate::pencil::{half_key, Keying, Pencil, NO_KEY};
 use crate::search::{
-    run_start_in, Blocks, Flow, Index, KeyOrder, Lean, OutOfWork, Query, Unkeyed, Visitor, Work,
-    CLIP_UNITS,
+    run_start_in, Blocks, Builder, Flow, Index, KeyOrder, Lean, OutOfWork, Query, Unkeyed, Visitor,
+    Work, CLIP_UNITS,
 };
 use crate::structure::{PointResult, ProcessError, Status, Step, Structure};
 use crate::wedge::{WVertex, Wedge, WedgeWalk, WedgeWalker};
 
 mod step4;
-use step4::{match_boundary, unmatched};
+use step4::{expire, match_boundary, unmatched};
 
 /// The per-frame motion-stereo processor for up to `B` boundaries of up to
 /// `N` points. No heap: everything lives inside this value, so it can be a
@@ -100,6 +101,9 @@ pub struct Processor<const N: usize, const B: usize> {
     /// `has_previous`'s padding).
     #[cfg(any(test, feature = "_reference"))]
     fold_test: bool,
+    /// Whether the deadline of the last reconstruction expired before it
+    /// finished (in the same padding).
+    expired: bool,
     index: Index<N>,
     output: Structure<N, B>,
 }
@@ -113,6 +117,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             has_previous: false,
             #[cfg(any(test, feature = "_reference"))]
             fold_test: true,
+            expired: false,
             index: Index::new(),
             output: Structure::EMPTY,
         }
@@ -160,15 +165,44 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         frame: &Frame<N, B>,
         motion: Option<&Motion>,
     ) -> Result<Step<'_, N, B>, ProcessError> {
+        self.process_within(frame, motion, &mut NoDeadline)
+    }
+
+    /// [`Self::process`] within the caller's `deadline`
+    /// ([`crate::deadline`]): asked before each point's search, and once
+    /// it has expired every point not yet matched is flagged
+    /// [`Status::OverBudget`] and the call returns
+    /// ([`Self::deadline_expired`] then says so). The frame becomes the
+    /// previous one either way, as with [`Self::process`]; the points done
+    /// before the deadline are complete results. Under a deadline a point's
+    /// search may spend at most [`crate::deadline::CARRY`] times its
+    /// allowance (what it leaves still carries over), so the point in
+    /// progress when the time is up ends within a bounded cost.
+    pub fn process_within<D: Deadline>(
+        &mut self,
+        frame: &Frame<N, B>,
+        motion: Option<&Motion>,
+        deadline: &mut D,
+    ) -> Result<Step<'_, N, B>, ProcessError> {
         if !self.has_previous {
             self.previous.assign(frame);
             self.has_previous = true;
+            self.expired = false;
             return Ok(Step::First);
         }
         let motion = motion.ok_or(ProcessError::MissingMotion)?;
-        self.reconstruct(frame, motion, Matcher::Indexed);
+        self.expired = self.reconstruct(frame, motion, Matcher::Indexed, deadline);
         self.previous.assign(frame);
         Ok(Step::Structure(&self.output))
+    }
+
+    /// Whether the deadline given to the last reconstruction
+    /// ([`Self::process_within`], [`Self::process_against_kept_within`])
+    /// expired before it finished: its points not matched by then are
+    /// [`Status::OverBudget`]. Always `false` after [`Self::process`] and
+    /// [`Self::process_against_kept`].
+    pub fn deadline_expired(&self) -> bool {
+        self.expired
     }
 
     /// Reconstruct `frame` against the kept frame *without replacing it*,
@@ -185,10 +219,21 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         frame: &Frame<N, B>,
         motion: &Motion,
     ) -> Result<&Structure<N, B>, ProcessError> {
+        self.process_against_kept_within(frame, motion, &mut NoDeadline)
+    }
+
+    /// [`Self::process_against_kept`] within the caller's `deadline`, as
+    /// [`Self::process_within`].
+    pub fn process_against_kept_within<D: Deadline>(
+        &mut self,
+        frame: &Frame<N, B>,
+        motion: &Motion,
+        deadline: &mut D,
+    ) -> Result<&Structure<N, B>, ProcessError> {
         if !self.has_previous {
             return Err(ProcessError::NoKeptFrame);
         }
-        self.reconstruct(frame, motion, Matcher::Indexed);
+        self.expired = self.reconstruct(frame, motion, Matcher::Indexed, deadline);
         Ok(&self.output)
     }
 
@@ -214,7 +259,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         if !self.has_previous {
             return Err(ProcessError::NoKeptFrame);
         }
-        self.reconstruct(frame, motion, Matcher::Reference);
+        self.expired = self.reconstruct(frame, motion, Matcher::Reference, &mut NoDeadline);
         Ok(&self.output)
     }
 
@@ -246,13 +291,20 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             Matcher::Indexed
         };
         self.fold_test = false;
-        self.reconstruct(frame, motion, matcher);
+        self.expired = self.reconstruct(frame, motion, matcher, &mut NoDeadline);
         self.fold_test = true;
         Ok(&self.output)
     }
 
-    /// Steps 1–4 of the module docs for every boundary of the kept frame.
-    fn reconstruct(&mut self, frame: &Frame<N, B>, motion: &Motion, matcher: Matcher) {
+    /// Steps 1–4 of the module docs for every boundary of the kept frame;
+    /// whether `deadline` expired before they were done.
+    fn reconstruct<D: Deadline>(
+        &mut self,
+        frame: &Frame<N, B>,
+        motion: &Motion,
+        matcher: Matcher,
+        deadline: &mut D,
+    ) -> bool {
         #[cfg(any(test, feature = "_reference"))]
         let fold_test = self.fold_test;
         let Self {
@@ -266,6 +318,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         output.camera1 = *previous.camera();
         output.count = previous.boundaries().len();
         let mut work = Work::new();
+        let mut guard = Guard::new(deadline, config.work_per_point);
         for (k, (b1, out)) in previous
             .boundaries()
             .iter()
@@ -277,6 +330,14 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             let b1 = b1.points();
             out.points.set_len(b1.len());
             let slots = out.points.as_mut_slice();
+            if guard.check() {
+                // The time is up: the boundary's points flagged, its steps
+                // skipped.
+                for (slot, &p1) in slots.iter_mut().zip(b1) {
+                    *slot = PointResult::flagged(p1, Status::OverBudget);
+                }
+                continue;
+            }
             let mut r1_max = 0.0f32;
             // The keys' orientation along frame 2's boundary, a good guess
             // for frame 1's too (the same curve seen from nearby).
@@ -303,6 +364,14 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 }
                 (None, _) => {
                     for ((slot, &p1), m) in slots.iter_mut().zip(b1).zip(margins.iter_mut()) {
+                        // (The point-by-point path is the dear one: the
+                        // caller's deadline is asked at each point.)
+                        if guard.check() {
+                            *slot = PointResult::flagged(p1, Status::OverBudget);
+                            *m = 0.0;
+                            order.push(NO_KEY, 0.0);
+                            continue;
+                        }
                         let (k, e) = match compensate_point(&pair, &keying, p1, &mut r1_max) {
                             Ok((r, key)) => {
                                 *slot = r;
@@ -318,6 +387,11 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                     }
                 }
             }
+            if guard.check() {
+                // The time ran out in step 1: no fold test, no search.
+                expire(slots);
+                continue;
+            }
             #[cfg(not(any(test, feature = "_reference")))]
             crate::fold::step(
                 index,
@@ -325,6 +399,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 (&order, keying.period, orient),
                 config.work_per_point,
                 &mut work,
+                &mut guard,
             );
             // (The tests' switch, `without_fold_test_against_kept`: without
             // the test, the points' allowances as its shortcuts grant them.)
@@ -336,29 +411,43 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                     (&order, keying.period, orient),
                     config.work_per_point,
                     &mut work,
+                    &mut guard,
                 );
             } else {
                 let n = u32::try_from(slots.len()).unwrap_or(u32::MAX);
                 work.grant(config.work_per_point.saturating_mul(n));
+            }
+            if guard.check() {
+                // The time ran out in the fold test: no index, no search.
+                expire(slots);
+                continue;
             }
             let Some(b2) = b2 else {
                 unmatched(slots);
                 continue;
             };
             let near_foe = pair.near_foe(r1_max);
-            index_frame2(
-                index,
+            let builder = frame2_keys(index, &keying, b2, orient);
+            if guard.check() {
+                // The time ran out in the keys: the index left unbuilt.
+                expire(slots);
+                continue;
+            }
+            let radius = near_foe + 2.0 * (r1_max + pair.e2());
+            frame2_index(builder, &pair, &keying, b2, radius);
+            match_boundary(
                 &pair,
                 &keying,
-                b2,
-                orient,
-                near_foe + 2.0 * (r1_max + pair.e2()),
-            );
-            match_boundary(
-                &pair, &keying, near_foe, slots, b2, index, &mut work, matcher,
+                near_foe,
+                (slots, b2),
+                index,
+                (&mut work, &mut guard),
+                matcher,
             );
         }
+        guard.settle(&mut work);
         output.work = work.usage();
+        guard.has_expired()
     }
 }
 
@@ -627,14 +716,14 @@ fn compensate_all_certified(
 /// 2 max(r₁ + e₂)` the list holds every segment the part of a band closer
 /// to the FOE than `m` can meet: that part spans at most `r₁ + e₂` beyond
 /// the FOE along the line and `2 (r₁ + e₂)` across it ([`crate::depth`]).
-fn index_frame2<const N: usize>(
-    index: &mut Index<N>,
-    pair: &Pair,
+/// In two parts, the keys ([`frame2_keys`]) and the index from them
+/// ([`frame2_index`]), so that a deadline can be asked in between.
+fn frame2_keys<'a, const N: usize>(
+    index: &'a mut Index<N>,
     keying: &Keying,
     b2: &[Pixel],
     orient: f32,
-    radius: f32,
-) {
+) -> Builder<'a, N> {
     let mut builder = index.builder((keying.period, orient), Unkeyed::MeetAll);
     match keying.pencil {
         Pencil::Half { foe, side, min_t } => {
@@ -643,6 +732,17 @@ fn index_frame2<const N: usize>(
         }
         _ => builder.push_all(b2.iter().map(|p| keying.key(p.arr()))),
     }
+    builder
+}
+
+/// The second part of step 3 ([`frame2_keys`]).
+fn frame2_index<const N: usize>(
+    builder: Builder<'_, N>,
+    pair: &Pair,
+    keying: &Keying,
+    b2: &[Pixel],
+    radius: f32,
+) {
     let foe = pair.foe.filter(|_| pair.geom.w() < 0.0 && keying.angular());
     match foe {
         Some(f) => {

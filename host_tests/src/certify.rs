@@ -699,6 +699,10 @@ pub enum Fold {
     /// folded point searched, for the check that the search alone holds
     /// the containment guarantee.
     Untested,
+    /// As shipped, within a deadline (`Processor::process_within`) whose
+    /// clock says the time is up from its `k`-th question on: the points
+    /// not done by then `over_budget`, the rest complete results.
+    Within(usize),
 }
 
 /// [`run`] with or without the fold test.
@@ -733,6 +737,17 @@ fn run_frames(
             Ok(s) => s,
             other => return Err(format!("second frame: {other:?}")),
         },
+        Fold::Within(k) => {
+            let mut asked = 0usize;
+            let mut clock = || {
+                asked += 1;
+                asked > k
+            };
+            match p.process_within(f2, Some(motion), &mut clock) {
+                Ok(Step::Structure(s)) => s,
+                other => return Err(format!("second frame: {other:?}")),
+            }
+        }
     };
     Ok(s.boundaries()
         .iter()

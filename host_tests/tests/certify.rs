@@ -280,6 +280,52 @@ fn containment_without_the_fold_test() {
     }
 }
 
+/// The guarantee holds for a frame a deadline cuts short
+/// (`Processor::process_within`): each point done before the clock said
+/// the time was up is a complete result, the rest `over_budget`. The
+/// certification with a clock that says so from its 200th question on
+/// (a frame asks one to three a point: step 1 point by point where the
+/// pair is not certified, the fold queries, step 4; about a quarter of
+/// the ideal points are then done),
+/// 100 % containment required; the deadline must cut (ideal points lost
+/// to `over_budget` in every variant), and the report shows the yield
+/// that is left.
+#[test]
+fn containment_within_a_deadline() {
+    let (families, per, full) = families_from_env();
+    let t0 = std::time::Instant::now();
+    let rep = certify_with(&families, 0..per, Fold::Within(200));
+    print_report(&rep, t0.elapsed().as_secs_f64());
+    let (guarantee, _) = requirements(&rep, full);
+    assert!(
+        guarantee.is_empty(),
+        "{} requirements not met within a deadline:\n{}",
+        guarantee.len(),
+        guarantee.join("\n")
+    );
+    let over = Status::ALL
+        .iter()
+        .position(|&s| s == Status::OverBudget)
+        .expect("a status");
+    for v in Variant::ALL {
+        let t = rep.variant_total(v);
+        let cut = t.ideal_by_status.get(over).copied().unwrap_or(0);
+        println!(
+            "{}: {} of {} ideal points over_budget, {:.1} % of the ideal points ok",
+            v.name(),
+            cut,
+            t.ideal,
+            100.0 * t.ideal_recall()
+        );
+        assert!(
+            cut * 10 > t.ideal,
+            "{}: the deadline cut only {cut} of {} ideal points",
+            v.name(),
+            t.ideal
+        );
+    }
+}
+
 /// The indexed search equals its reference with the fold test switched
 /// off as well, where every point on a fold reaches the search (issue 11:
 /// the reference follows the rule and equals the fast path on every

@@ -346,6 +346,7 @@ fn main() -> ! {
         );
     }
     worst_case_sweep(processor, &mut f1, &mut f2);
+    deadline_sweep(processor, &mut f1, &mut f2);
     wire_cost();
     if !fusion_bench() {
         defmt::error!("fusion bench failed");
@@ -371,6 +372,111 @@ fn main() -> ! {
         p - f - s
     );
     fw::exit(true)
+}
+
+/// Limits of the deadline sweep, instructions from the call's start.
+const DEADLINE_LIMITS: [u32; 15] = [
+    0, 20_000, 40_000, 60_000, 80_000, 100_000, 120_000, 140_000, 160_000, 180_000, 200_000,
+    220_000, 240_000, 260_000, 280_000,
+];
+
+/// Core-clock ticks of `instructions` instructions under `-icount shift=5`
+/// (the inverse of [`fw::instructions`]).
+fn ticks_of(instructions: u32) -> u64 {
+    let ns = u128::from(instructions) * 32;
+    u64::try_from(ns * u128::from(fw::board::CORE_HZ) / 1_000_000_000).unwrap_or(u64::MAX)
+}
+
+/// The per-frame call of frame pair `(f1, f2)` within a deadline of
+/// `limit` instructions, by SysTick (what a firmware's cycle counter
+/// would be): the measured call, and when the clock first said the time
+/// was up (instructions from the call's start).
+fn measure_within(
+    processor: &mut Processor<CAP, 2>,
+    (f1, f2, m): (&Frame<CAP, 2>, &Frame<CAP, 2>, &roadstereo::Motion),
+    limit: u32,
+) -> (Measured, Option<u32>) {
+    processor.reset();
+    let _ = processor.process(f1, None);
+    let budget = ticks_of(limit);
+    let mut first = None;
+    let t0 = fw::ticks();
+    let mut clock = || {
+        let t = fw::ticks();
+        let up = t.saturating_sub(t0) >= budget;
+        if up && first.is_none() {
+            first = Some(t);
+        }
+        up
+    };
+    let (processed, instr) = fw::measure(|| {
+        processor
+            .process_within(black_box(f2), Some(m), &mut clock)
+            .is_ok()
+    });
+    let points: usize = processor
+        .structure()
+        .boundaries()
+        .iter()
+        .map(|b| b.points().len())
+        .sum();
+    let ok = processor.structure().status_counts().get(Status::Ok);
+    let at = first.map(|t| fw::instructions(t.saturating_sub(t0)));
+    (
+        Measured {
+            processed,
+            instr,
+            points: points as u32,
+            ok: ok as u32,
+        },
+        at,
+    )
+}
+
+/// The deadline sweep: the representative pair and every adversarial
+/// member at 2 × 256, each within every limit of [`DEADLINE_LIMITS`]: the
+/// call's instructions, when the clock said the time was up, and the
+/// points still `ok`. (`xtask/src/bench.rs` reports the overrun, the
+/// call's instructions past the clock's first yes.)
+fn deadline_sweep(
+    processor: &mut Processor<CAP, 2>,
+    f1: &mut Frame<CAP, 2>,
+    f2: &mut Frame<CAP, 2>,
+) {
+    let bench = BENCH
+        .iter()
+        .filter(|b| b.0 == 256)
+        .map(|b| ("representative", 0u8, b.1));
+    let members = ADVERSARIAL
+        .iter()
+        .filter(|a| a.1 == 256)
+        .map(|a| (a.0, a.2, a.3));
+    for (name, errors, data) in bench.chain(members) {
+        let (Some(m), Some(c)) = (
+            load(data, f1, f2),
+            member_config(errors, Config::DEFAULT_WORK_PER_POINT),
+        ) else {
+            defmt::error!("bad deadline data for {=str}", name);
+            continue;
+        };
+        processor.set_config(c);
+        for limit in DEADLINE_LIMITS {
+            let (r, at) = measure_within(processor, (f1, f2, &m), limit);
+            defmt::info!(
+                "deadline name={=str} limit={=u32} instr={=u32} expired={=bool} expired_at={=u32} reported={=bool} points={=u32} ok={=u32} processed={=bool}",
+                name,
+                limit,
+                r.instr,
+                at.is_some(),
+                at.unwrap_or(0),
+                processor.deadline_expired(),
+                r.points,
+                r.ok,
+                r.processed
+            );
+        }
+    }
+    processor.set_config(Config::DEFAULT);
 }
 
 /// An adversarial member's configuration: its error model (the id in

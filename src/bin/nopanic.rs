@@ -112,6 +112,32 @@ fn main() -> ! {
                 }
             }
         }
+        // Within a deadline: a clock whose answers the linker cannot know.
+        let mut asked = 0u32;
+        let mut clock = || {
+            asked = asked.wrapping_add(1);
+            black_box(asked) > black_box(100)
+        };
+        if let Some(m) = motion.as_ref().filter(|_| black_box(true)) {
+            match processor.process_against_kept_within(black_box(&frame), m, &mut clock) {
+                Ok(s) => {
+                    black_box(s.digest());
+                }
+                Err(e) => {
+                    black_box(e);
+                }
+            }
+        }
+        match processor.process_within(black_box(&frame), motion.as_ref(), &mut clock) {
+            Ok(Step::Structure(s)) => {
+                black_box(s.digest());
+            }
+            Ok(Step::First) => {}
+            Err(e) => {
+                black_box(e);
+            }
+        }
+        black_box(processor.deadline_expired());
         if black_box(false) {
             processor.reset();
         }

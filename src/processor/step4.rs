@@ -14,19 +14,19 @@
 //! and all end in the same depth and stick ([`finish_point`]).
 
 use super::*;
+use crate::deadline::{Deadline, Guard};
 
 /// Step 4 for every point of a boundary left by steps 1–2. (Out of line,
 /// with the loop inside: the frame's constants stay in registers.)
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-pub(super) fn match_boundary<const N: usize>(
+pub(super) fn match_boundary<const N: usize, D: Deadline>(
     pair: &Pair,
     keying: &Keying,
     near_foe: f32,
-    slots: &mut [PointResult],
-    b2: &[Pixel],
+    (slots, b2): (&mut [PointResult], &[Pixel]),
     index: &mut Index<N>,
-    work: &mut Work,
+    (work, guard): (&mut Work, &mut Guard<'_, D>),
     matcher: Matcher,
 ) {
     let mut credit = *work;
@@ -34,9 +34,14 @@ pub(super) fn match_boundary<const N: usize>(
     match (keying.pencil, wedge) {
         (Pencil::Half { foe, side, .. }, true) => {
             match matcher {
-                Matcher::Indexed => {
-                    match_wedge_lean(pair, keying, (foe, side), slots, b2, index, &mut credit)
-                }
+                Matcher::Indexed => match_wedge_lean(
+                    pair,
+                    keying,
+                    (foe, side),
+                    (slots, b2),
+                    index,
+                    (&mut credit, guard),
+                ),
                 Matcher::Reference => match_wedge_reference(pair, keying, (foe, side), slots, b2),
             }
             *work = credit;
@@ -45,7 +50,9 @@ pub(super) fn match_boundary<const N: usize>(
         (Pencil::Angular { foe }, true) => {
             let args = (pair, keying, near_foe, foe);
             match matcher {
-                Matcher::Indexed => match_wedge_angular(args, slots, b2, index, &mut credit),
+                Matcher::Indexed => {
+                    match_wedge_angular(args, (slots, b2), index, (&mut credit, guard))
+                }
                 Matcher::Reference => match_wedge_angular_reference(args, slots, b2, index),
             }
             *work = credit;
@@ -55,10 +62,27 @@ pub(super) fn match_boundary<const N: usize>(
     }
     for r in slots.iter_mut() {
         if r.status == Status::NoIntersection {
-            *r = match_point(pair, keying, near_foe, r, b2, index, &mut credit, matcher);
+            *r = if matcher == Matcher::Reference || guard.proceed(&mut credit) {
+                match_point(pair, keying, near_foe, r, b2, index, &mut credit, matcher)
+            } else {
+                PointResult::flagged(r.pixel1, Status::OverBudget)
+            };
         }
     }
     *work = credit;
+}
+
+/// Every point still to be matched flagged [`Status::OverBudget`]: the
+/// caller's deadline has expired ([`crate::deadline`]).
+#[cold]
+#[inline(never)]
+pub(super) fn expire(slots: &mut [PointResult]) {
+    for r in slots
+        .iter_mut()
+        .filter(|r| r.status == Status::NoIntersection)
+    {
+        *r = PointResult::flagged(r.pixel1, Status::OverBudget);
+    }
 }
 
 /// The wedge path through an index's lean view ([`Index::lean`]): every
@@ -66,14 +90,13 @@ pub(super) fn match_boundary<const N: usize>(
 /// if any, merged in by index ([`LeanWalk::point_aside`]), and on a loose
 /// index the block tree's skips taken too ([`LeanWalk::point_loose`]).
 #[inline(never)]
-fn match_wedge_lean<const N: usize>(
+fn match_wedge_lean<const N: usize, D: Deadline>(
     pair: &Pair,
     keying: &Keying,
     (foe, side): ([f32; 2], f32),
-    slots: &mut [PointResult],
-    b2: &[Pixel],
+    (slots, b2): (&mut [PointResult], &[Pixel]),
     index: &mut Index<N>,
-    work: &mut Work,
+    (work, guard): (&mut Work, &mut Guard<'_, D>),
 ) {
     let mut hint = index.hint();
     let Lean {
@@ -102,6 +125,10 @@ fn match_wedge_lean<const N: usize>(
         // A loose index (the keys fold somewhere): the tree's skips too.
         for r in slots.iter_mut() {
             if r.status == Status::NoIntersection {
+                if !guard.proceed(work) {
+                    *r = PointResult::flagged(r.pixel1, Status::OverBudget);
+                    continue;
+                }
                 let (h, refine) = walk.point_loose(r, hint, work);
                 hint = h;
                 if refine != 0 {
@@ -112,6 +139,10 @@ fn match_wedge_lean<const N: usize>(
     } else if aside.is_empty() {
         for r in slots.iter_mut() {
             if r.status == Status::NoIntersection {
+                if !guard.proceed(work) {
+                    *r = PointResult::flagged(r.pixel1, Status::OverBudget);
+                    continue;
+                }
                 let (h, refine) = walk.point(r, hint, work);
                 hint = h;
                 if refine != 0 {
@@ -122,6 +153,10 @@ fn match_wedge_lean<const N: usize>(
     } else {
         for r in slots.iter_mut() {
             if r.status == Status::NoIntersection {
+                if !guard.proceed(work) {
+                    *r = PointResult::flagged(r.pixel1, Status::OverBudget);
+                    continue;
+                }
                 let (h, refine) = walk.point_aside(r, hint, work);
                 hint = h;
                 if refine != 0 {
@@ -144,12 +179,11 @@ fn match_wedge_lean<const N: usize>(
 /// point has no key) takes the band path ([`match_point`]), as every point
 /// of these boundaries did before.
 #[inline(never)]
-fn match_wedge_angular<const N: usize>(
+fn match_wedge_angular<const N: usize, D: Deadline>(
     (pair, keying, near_foe, foe): (&Pair, &Keying, f32, [f32; 2]),
-    slots: &mut [PointResult],
-    b2: &[Pixel],
+    (slots, b2): (&mut [PointResult], &[Pixel]),
     index: &mut Index<N>,
-    work: &mut Work,
+    (work, guard): (&mut Work, &mut Guard<'_, D>),
 ) {
     // A piece's end (at most `N`) is kept in an `f32` for
     // [`refine_deferred`]: exact below 2²⁴. (At compile time, no cost.)
@@ -162,6 +196,10 @@ fn match_wedge_angular<const N: usize>(
             continue;
         }
         let (p1, iz, r1) = (r.pixel1, r.z, r.z_near);
+        if !guard.proceed(work) {
+            *r = PointResult::flagged(p1, Status::OverBudget);
+            continue;
+        }
         let lean = index.lean();
         let wedge = match angular_wedge(r, (foe, e2, e2_csc), keying, &lean) {
             AngularPoint::Walk(w) => w,
@@ -200,9 +238,7 @@ fn match_wedge_angular<const N: usize>(
         }
     }
     if deferred {
-        let mut credit = work.credit();
-        refine_deferred((pair, foe), slots, b2, &mut credit);
-        work.set_credit(credit);
+        refine_deferred((pair, foe), slots, b2, (work, guard));
     }
 }
 
@@ -216,13 +252,15 @@ fn match_wedge_angular<const N: usize>(
 /// path keeps its walks and loses tightening, where the half-plane path,
 /// which refines each point as it goes, may spend on a refinement what a
 /// later point's walk needed: both valid, the sticks held either way.)
+/// Each asks the caller's deadline first (`guard`): once it has expired,
+/// the points left are [`Status::OverBudget`].
 #[cold]
 #[inline(never)]
-fn refine_deferred(
+fn refine_deferred<D: Deadline>(
     (pair, foe): (&Pair, [f32; 2]),
     slots: &mut [PointResult],
     b2: &[Pixel],
-    credit: &mut u32,
+    (work, guard): (&mut Work, &mut Guard<'_, D>),
 ) {
     let errors = (pair.e2(), pair.e2_csc());
     for r in slots
@@ -230,14 +268,20 @@ fn refine_deferred(
         .filter(|r| r.status == Status::NoIntersection && r.z_near > 0.0)
     {
         let (p1, p, iz, r1) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near);
+        if !guard.proceed(work) {
+            *r = PointResult::flagged(p1, Status::OverBudget);
+            continue;
+        }
         // (Finite, integral and below 2²⁴: the loop stored only such.)
         let end = r.z_far as usize;
         let no_key = (crate::pencil::NO_KEY, 1.0, 1.0);
+        let mut credit = work.credit();
         *r = match Wedge::new_angular(p, foe, (r1, errors.0, errors.1), no_key) {
-            Ok(wedge) => conclude_refined(pair, (p1, iz, r1), &wedge, b2, end, credit),
+            Ok(wedge) => conclude_refined(pair, (p1, iz, r1), &wedge, b2, end, &mut credit),
             // (Not reached: the loop had this wedge.)
             Err(_) => PointResult::flagged(p1, Status::AtFoe),
         };
+        work.set_credit(credit);
     }
 }
 

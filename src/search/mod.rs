@@ -85,7 +85,7 @@ mod build;
 mod lean;
 mod visit;
 
-pub(crate) use build::KeyOrder;
+pub(crate) use build::{Builder, KeyOrder};
 pub(crate) use lean::{run_start_in, Blocks, Lean};
 
 /// Segments kept aside (see the module docs).

@@ -46,13 +46,17 @@ impl<const N: usize> Index<N> {
     /// `allowance` to `work` first; `flag` gets the answer of each tested
     /// one. Without a period and with nothing aside, the envelopes' `O(1)`
     /// answer ([`Self::may_fold`]) is taken in the loop itself, and only the
-    /// vertices it cannot clear go through [`Self::folds`].
+    /// vertices it cannot clear go through [`Self::folds`]. Before each
+    /// query `proceed` is asked (the caller's deadline,
+    /// [`crate::deadline::Guard::proceed`]): `false` answers
+    /// [`OutOfWork`] without a query.
     #[inline(always)]
     pub(crate) fn folds_all<T>(
         &mut self,
         items: &mut [T],
         (w, allowance): (usize, u32),
         work: &mut Work,
+        mut proceed: impl FnMut(&mut Work) -> bool,
         key: impl Fn(&T) -> Option<f32>,
         mut flag: impl FnMut(&mut T, Result<bool, OutOfWork>),
     ) {
@@ -63,7 +67,11 @@ impl<const N: usize> Index<N> {
                 let Some(k) = key(it) else {
                     continue;
                 };
-                let r = self.folds(i, k, w, work);
+                let r = if proceed(work) {
+                    self.folds(i, k, w, work)
+                } else {
+                    Err(OutOfWork)
+                };
                 flag(it, r);
             }
             return;
@@ -89,7 +97,9 @@ impl<const N: usize> Index<N> {
             }
             work.grant(owed);
             owed = 0;
-            let r = if self.strict {
+            let r = if !proceed(work) {
+                Err(OutOfWork)
+            } else if self.strict {
                 self.folds(i, k, w, work)
             } else {
                 self.folds_query(i, k, w, work)

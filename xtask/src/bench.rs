@@ -123,6 +123,7 @@ pub fn bench(b: &Budget) -> Result<(), String> {
     scaling_and_deadline(&per, b, &mut misses);
     adversarial(&log, b, &mut misses);
     crate::worst::worst_case(&log, b.deadline(), OPEN, &mut misses);
+    deadline_table(&log, b.deadline(), &mut misses);
     fusion_table(&log, &per, b, &mut misses);
     memory_table(&log, &demo_elf, b, &mut misses)?;
     wire_table(&log, &mut misses);
@@ -279,6 +280,126 @@ impl Adv {
             .map(|s| s.1)
             .sum()
     }
+}
+
+/// The deadline sweep (`Processor::process_within` with SysTick as the
+/// clock, firmware `deadline_sweep`): per pair, the call's instructions
+/// past the clock's first yes (the overrun: the point or step in
+/// progress, then the flags) and past the limit (the lateness: the
+/// overrun and the time from the limit to the next time the clock is
+/// asked), and the largest limit of the sweep at which every pair ends
+/// within the deadline, with the `ok` points each keeps there (and
+/// without a deadline, from the adversarial rows). Hard checks: the processor reports an expired
+/// deadline exactly when the clock said yes, and a deadline already passed
+/// leaves no point `ok`. The overrun and the limit are reported, not
+/// budgeted (the argument for the overrun's bound is in `src/deadline.rs`).
+fn deadline_table(log: &str, deadline: u64, misses: &mut Vec<String>) {
+    let rows = records(log, "deadline name=");
+    if rows.is_empty() {
+        misses.push("no deadline rows in the bench log".into());
+        return;
+    }
+    // By pair in log order: (limit, instr, expired, expired_at, ok).
+    let mut pairs: Vec<(String, Vec<(u64, u64, bool, u64, u64)>)> = Vec::new();
+    for r in &rows {
+        let name = field(r, "name").unwrap_or("?").to_string();
+        let expired = field(r, "expired") == Some("true");
+        if (field(r, "reported") == Some("true")) != expired {
+            misses.push(format!(
+                "deadline {name} at {}: the processor's expiry flag disagrees with the clock",
+                num(r, "limit")
+            ));
+        }
+        if field(r, "processed") != Some("true") {
+            misses.push(format!("deadline {name}: frame 2 not processed"));
+        }
+        if num(r, "limit") == 0 && num(r, "ok") != 0 {
+            misses.push(format!("deadline {name}: a passed deadline left points ok"));
+        }
+        let row = (
+            num(r, "limit"),
+            num(r, "instr"),
+            expired,
+            num(r, "expired_at"),
+            num(r, "ok"),
+        );
+        match pairs.iter_mut().find(|p| p.0 == name) {
+            Some(p) => p.1.push(row),
+            None => pairs.push((name, vec![row])),
+        }
+    }
+    let limits: Vec<u64> = pairs
+        .first()
+        .map(|p| p.1.iter().map(|r| r.0).collect())
+        .unwrap_or_default();
+    // The largest limit at which every pair ends within the deadline.
+    let fits = limits
+        .iter()
+        .copied()
+        .filter(|&l| {
+            pairs
+                .iter()
+                .all(|p| p.1.iter().filter(|r| r.0 == l).all(|r| r.1 <= deadline))
+        })
+        .max();
+    println!(
+        "
+within a deadline (`Processor::process_within`, SysTick as the clock; 2 × 256, each pair's own configuration,
+limits {} … {} instructions): the overrun is the call's instructions past the clock's first yes",
+        limits.first().unwrap_or(&0),
+        limits.last().unwrap_or(&0)
+    );
+    let at = fits.unwrap_or(0);
+    // `ok` without a deadline: the representative pair's bench row and
+    // the members' adversarial rows at N = 256.
+    let mut full: BTreeMap<String, u64> = BTreeMap::new();
+    for r in records(log, "bench n=256 ") {
+        full.insert("representative".into(), num(&r, "ok"));
+    }
+    for r in records(log, "adversarial name=") {
+        if num(&r, "n") == 256 {
+            let name = field(&r, "name").unwrap_or("?").to_string();
+            full.insert(name, num(&r, "status.ok"));
+        }
+    }
+    println!(
+        "| pair | ok without a deadline | limit 0: instructions | largest overrun | largest lateness | at limit {at}: instructions | ok |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|");
+    let (mut worst, mut late) = ((0u64, String::new()), (0u64, String::new()));
+    for (name, r) in &pairs {
+        let expired = || r.iter().filter(|x| x.2);
+        let over = expired()
+            .map(|x| x.1.saturating_sub(x.3))
+            .max()
+            .unwrap_or(0);
+        let lateness = expired()
+            .map(|x| x.1.saturating_sub(x.0))
+            .max()
+            .unwrap_or(0);
+        if over > worst.0 {
+            worst = (over, name.clone());
+        }
+        if lateness > late.0 {
+            late = (lateness, name.clone());
+        }
+        let floor = r.iter().find(|x| x.0 == 0).map_or(0, |x| x.1);
+        let here = r.iter().find(|x| x.0 == at);
+        println!(
+            "| {name} | {} | {floor} | {over} | {lateness} | {} | {} |",
+            full.get(name).map_or("?".to_string(), |o| o.to_string()),
+            here.map_or(0, |x| x.1),
+            here.map_or(0, |x| x.4)
+        );
+    }
+    println!(
+        "largest overrun {} instructions ({}), largest lateness {} ({}); every pair ends within the deadline {deadline} at limits up to {}",
+        worst.0,
+        worst.1,
+        late.0,
+        late.1,
+        fits.map_or("none of the sweep".to_string(), |l| l.to_string())
+    );
 }
 
 /// The adversarial family from the log, by member in log order.

@@ -1,0 +1,257 @@
+//! The caller's deadline (`Processor::process_within`,
+//! `roadstereo::deadline`): once the clock says the time is up, every point
+//! not done is `over_budget` and the call returns; the points done before
+//! are complete results. Here the clock is a count of the questions it is
+//! asked, so every cut is reproducible; the firmware bench measures the
+//! same with SysTick as the clock (README, "Within a deadline").
+//!
+//! The results are compared with the same configuration's with the
+//! largest work budget and no deadline (whose sticks the certification
+//! holds to the `f64` truth, `tests/certify.rs`, which also runs the
+//! certification within a deadline), as the fuzzer's budget oracle does:
+//! every point is equal to that result, `over_budget`, or `ok` with the
+//! same match and a looser stick (its refinement paid less), never
+//! anything else. (Under a deadline a point's search may spend at most
+//! `CARRY` allowances, so the credit goes round differently: a point may
+//! come out `over_budget` before the time is up, and one that was
+//! `over_budget` without a deadline may be done.)
+
+use host_tests::drive::adversarial::{family, library_pair, render};
+use host_tests::fuzz::frame::looser_stick;
+use host_tests::{frame, scenarios, synth, B, N};
+use roadstereo::deadline::CARRY;
+use roadstereo::{Config, Frame, Motion, Processor, Status, Step, Structure};
+
+/// A clock that says the time is up from its `k`-th question on, and
+/// counts the questions.
+struct Clock {
+    k: usize,
+    asked: usize,
+}
+
+impl roadstereo::Deadline for Clock {
+    fn expired(&mut self) -> bool {
+        self.asked += 1;
+        self.asked > self.k
+    }
+}
+
+#[derive(Default, Debug)]
+struct Counts {
+    equal: usize,
+    over_budget: usize,
+    looser: usize,
+    cut_frames: usize,
+}
+
+/// Every point of `got` (within a deadline) against `full` (the largest
+/// budget, no deadline).
+fn compare(got: &Structure<N, B>, full: &Structure<N, B>, what: &str, c: &mut Counts) {
+    assert_eq!(got.boundaries().len(), full.boundaries().len(), "{what}");
+    for (x, y) in got.boundaries().iter().zip(full.boundaries()) {
+        assert_eq!(
+            x.points().len(),
+            y.points().len(),
+            "{what}: one result per point"
+        );
+        for (a, b) in x.points().iter().zip(y.points()) {
+            if a == b {
+                c.equal += 1;
+            } else if a.status() == Status::OverBudget {
+                assert!(
+                    a.depth().is_none() && a.interval().is_none() && a.pixel2().is_none(),
+                    "{what}: an over_budget point with a result: {a:?}"
+                );
+                c.over_budget += 1;
+            } else if looser_stick(a, b) {
+                c.looser += 1;
+            } else {
+                panic!("{what}: within the deadline {a:?}, without {b:?}");
+            }
+        }
+    }
+}
+
+/// The pair `(f1, f2)` within clocks that say yes from their `k`-th
+/// question on, for every `k` from 0 to past the frame's last question.
+fn sweep(config: Config, (f1, f2, m): (&Frame<N, B>, &Frame<N, B>, &Motion), what: &str) -> Counts {
+    let largest = config
+        .with_work_budget(Config::MAX_WORK_PER_POINT)
+        .expect("the largest budget");
+    let mut p = Box::new(Processor::<N, B>::new(largest));
+    assert!(matches!(p.process(f1, None), Ok(Step::First)));
+    let Ok(full) = p.process_against_kept(f2, m) else {
+        panic!("{what}: no structure");
+    };
+    let full = Box::new(full.clone());
+    p.set_config(config);
+    let default = Box::new(p.process_against_kept(f2, m).expect("kept").clone());
+    assert!(!p.deadline_expired());
+    let points: usize = full.boundaries().iter().map(|b| b.points().len()).sum();
+    // The questions a frame asks without expiring: at most one a point
+    // in step 1, the fold queries and step 4, and a few a boundary.
+    let mut never = Clock {
+        k: usize::MAX,
+        asked: 0,
+    };
+    let uncut = Box::new(
+        p.process_against_kept_within(f2, m, &mut never)
+            .expect("kept")
+            .clone(),
+    );
+    assert!(!p.deadline_expired(), "{what}: a clock that never says yes");
+    let asked = never.asked;
+    assert!(
+        asked <= 3 * points + 8 * B,
+        "{what}: {asked} questions for {points} points"
+    );
+    let mut c = Counts::default();
+    compare(&uncut, &full, what, &mut c);
+    let mut ks: Vec<usize> = (0..8).collect();
+    ks.extend((1..=16).map(|i| i * asked / 16));
+    ks.push(asked + 1);
+    for k in ks {
+        let mut clock = Clock { k, asked: 0 };
+        let got = Box::new(
+            p.process_against_kept_within(f2, m, &mut clock)
+                .expect("kept")
+                .clone(),
+        );
+        let expired = clock.asked > k;
+        assert_eq!(p.deadline_expired(), expired, "{what}, k = {k}");
+        // Once it has said yes the clock is not asked again.
+        assert!(
+            clock.asked <= k + 1,
+            "{what}, k = {k}: asked {}",
+            clock.asked
+        );
+        compare(&got, &full, &format!("{what}, k = {k}"), &mut c);
+        if expired {
+            c.cut_frames += 1;
+        }
+        if k == 0 {
+            // A deadline already passed: nothing is done.
+            for b in got.boundaries() {
+                assert!(
+                    b.points().iter().all(|r| r.status() == Status::OverBudget),
+                    "{what}: a passed deadline left a point done"
+                );
+            }
+            assert_eq!(
+                got.work_units().0,
+                0,
+                "{what}: a passed deadline spent work"
+            );
+        }
+    }
+    // The processor without a deadline afterwards: as before.
+    assert!(p.process_against_kept(f2, m).expect("kept") == &*default);
+    assert!(!p.deadline_expired());
+    c
+}
+
+/// The adversarial family (the bench's pairs, each member's own
+/// configuration) at 64 and 256 points a boundary.
+#[test]
+fn every_cut_of_the_adversarial_family_is_complete_or_flagged() {
+    let mut total = Counts::default();
+    let mut pairs = 0;
+    for m in family() {
+        for n in [64usize, 256] {
+            let Ok((k, frames)) = render(&m.params, n) else {
+                continue;
+            };
+            let (f1, f2, motion) = library_pair(&k, &frames);
+            let c = sweep(
+                m.errors.config(),
+                (&f1, &f2, &motion),
+                &format!("{} N = {n}", m.name),
+            );
+            total.equal += c.equal;
+            total.over_budget += c.over_budget;
+            total.looser += c.looser;
+            total.cut_frames += c.cut_frames;
+            pairs += 1;
+        }
+    }
+    eprintln!("{pairs} pairs: {total:?}");
+    assert!(pairs >= 40, "{pairs} pairs");
+    assert!(
+        total.cut_frames > 10 * pairs,
+        "the clocks cut {} frames",
+        total.cut_frames
+    );
+    assert!(total.over_budget > 0 && total.equal > 0);
+}
+
+/// The named synthetic scenarios and 20 random ones, exact and rounded to
+/// the pixel grid.
+#[test]
+fn every_cut_of_the_synthetic_scenarios_is_complete_or_flagged() {
+    let mut total = Counts::default();
+    let mut all = scenarios::named();
+    all.extend((0..20).map(scenarios::random));
+    for s in all {
+        let r = s.render();
+        let cam = s.intrinsics.camera();
+        for quantised in [false, true] {
+            let f1 = frame(cam, &synth::Rendered::pixels(&r.frame1, quantised));
+            let f2 = frame(cam, &synth::Rendered::pixels(&r.frame2, quantised));
+            let c = sweep(
+                Config::DEFAULT,
+                (&f1, &f2, &r.motion()),
+                &format!("{} q={quantised}", s.name),
+            );
+            total.equal += c.equal;
+            total.over_budget += c.over_budget;
+            total.looser += c.looser;
+        }
+    }
+    eprintln!("{total:?}");
+    assert!(total.equal > 0 && total.over_budget > 0);
+}
+
+/// `process_within` keeps the frame as `process` does, cut short or not,
+/// and the first frame needs no clock.
+#[test]
+fn a_cut_frame_still_becomes_the_previous_one() {
+    let s = scenarios::named().into_iter().next().expect("a scenario");
+    let r = s.render();
+    let cam = s.intrinsics.camera();
+    let f1 = frame(cam, &synth::Rendered::pixels(&r.frame1, false));
+    let f2 = frame(cam, &synth::Rendered::pixels(&r.frame2, false));
+    let mut p = Box::new(Processor::<N, B>::new(Config::DEFAULT));
+    let mut clock = Clock { k: 0, asked: 0 };
+    assert!(matches!(
+        p.process_within(&f1, None, &mut clock),
+        Ok(Step::First)
+    ));
+    assert_eq!(clock.asked, 0, "the first frame asks nothing");
+    assert!(!p.deadline_expired());
+    let mut clock = Clock { k: 3, asked: 0 };
+    let Ok(Step::Structure(st)) = p.process_within(&f2, Some(&r.motion()), &mut clock) else {
+        panic!("no structure");
+    };
+    let flagged = st
+        .boundaries()
+        .iter()
+        .flat_map(|b| b.points())
+        .filter(|r| r.status() == Status::OverBudget)
+        .count();
+    assert!(flagged > 0);
+    assert!(p.deadline_expired());
+    assert!(
+        p.previous() == Some(&f2),
+        "the cut frame is the previous one"
+    );
+    // A missing motion is an error, and changes nothing.
+    let mut clock = Clock {
+        k: usize::MAX,
+        asked: 0,
+    };
+    assert!(p.process_within(&f1, None, &mut clock).is_err());
+    assert!(p.previous() == Some(&f2));
+    assert!(p.deadline_expired(), "an error leaves the last flag");
+    // CARRY is what the docs say it is.
+    assert_eq!(CARRY, 2);
+}

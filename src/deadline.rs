@@ -1,0 +1,194 @@
+//! A caller's **deadline** for one per-frame call
+//! ([`crate::Processor::process_within`]).
+//!
+//! The work budget ([`crate::Config::with_work_budget`]) bounds what the
+//! searches spend, in units, but not what a point costs outside them, so
+//! the worst case it gives is far past the frame period (README, "Worst
+//! case"). A deadline bounds the call by the caller's own clock instead:
+//! before each point's search (step 4), and before each point's fold query
+//! where the fold test needs the index (step 2), the processor asks
+//! [`Deadline::expired`]; once it says yes, every point not yet matched is
+//! flagged [`crate::Status::OverBudget`], the rest of the frame's steps are
+//! skipped and the call returns. The points done before keep their
+//! results, and the output says the deadline cut the frame short
+//! ([`crate::Processor::deadline_expired`]).
+//!
+//! What the caller can count on, after the clock says yes:
+//! - **The point in progress ends within a bounded cost.** A point's search
+//!   may spend at most [`CARRY`] times the configured allowance
+//!   (`work_per_point`) under a deadline: the units cheap points leave
+//!   still carry over to later points, but no single point can spend the
+//!   whole frame's savings at once, which is what makes its cost bounded
+//!   by a constant (`C_P + C_U · CARRY · w` instructions in the terms of
+//!   README's "Worst case") rather than by the frame's size.
+//! - **Every other point costs a flag**: a store of a flagged result.
+//! - **Nothing is left half done**: every point is either a complete
+//!   result (the same checks as without a deadline: a stick that holds) or
+//!   flagged. Without a deadline ([`NoDeadline`], what
+//!   [`crate::Processor::process`] uses) nothing of this runs: the checks
+//!   are compiled out.
+//!
+//! Not checked: steps 1–3 of a boundary already started (compensation,
+//! the fold test's `O(1)` rules, the frame-2 index), each linear in the
+//! boundary's points; the bench measures them with the deadline already
+//! passed (README, "Worst case").
+
+use crate::search::Work;
+
+/// A point's search may spend at most this many times the configured
+/// allowance per point under a deadline (see the module docs).
+pub const CARRY: u32 = 2;
+
+/// The caller's clock: whether the frame's time is up. Asked once before
+/// each point's search, so it should be cheap (a cycle counter's read and
+/// a comparison); it may also rate-limit itself. Any `FnMut() -> bool` is
+/// one.
+pub trait Deadline {
+    /// A deadline that never expires: the checks are compiled out.
+    #[doc(hidden)]
+    const NEVER: bool = false;
+
+    /// Whether the time is up.
+    fn expired(&mut self) -> bool;
+}
+
+impl<F: FnMut() -> bool> Deadline for F {
+    #[inline(always)]
+    fn expired(&mut self) -> bool {
+        self()
+    }
+}
+
+/// No deadline: [`crate::Processor::process`]'s.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct NoDeadline;
+
+impl Deadline for NoDeadline {
+    const NEVER: bool = true;
+
+    #[inline(always)]
+    fn expired(&mut self) -> bool {
+        false
+    }
+}
+
+/// The deadline of one per-frame call, with what it keeps of the carried
+/// credit while a point's search is capped.
+pub(crate) struct Guard<'d, D: Deadline> {
+    deadline: &'d mut D,
+    expired: bool,
+    /// The most a point may spend ([`CARRY`] allowances).
+    cap: u32,
+    /// The carried units above the cap, held back from the point.
+    reserve: u32,
+}
+
+impl<'d, D: Deadline> Guard<'d, D> {
+    pub(crate) fn new(deadline: &'d mut D, allowance: u32) -> Self {
+        Self {
+            deadline,
+            expired: false,
+            cap: allowance.saturating_mul(CARRY),
+            reserve: 0,
+        }
+    }
+
+    /// Whether the next point may be worked on: `false` once the deadline
+    /// has expired (asked now, remembered after). On `true`, `work`'s
+    /// credit is capped for the point, the rest held back.
+    #[inline(always)]
+    pub(crate) fn proceed(&mut self, work: &mut Work) -> bool {
+        if D::NEVER {
+            return true;
+        }
+        if self.expired || self.deadline.expired() {
+            self.expired = true;
+            return false;
+        }
+        let total = work.credit().saturating_add(self.reserve);
+        let now = total.min(self.cap);
+        self.reserve = total.saturating_sub(now);
+        work.set_credit(now);
+        true
+    }
+
+    /// Whether the deadline has expired (asking the clock once more if it
+    /// had not yet).
+    #[inline(always)]
+    pub(crate) fn check(&mut self) -> bool {
+        if D::NEVER {
+            return false;
+        }
+        self.expired = self.expired || self.deadline.expired();
+        self.expired
+    }
+
+    /// Whether the deadline was seen to expire.
+    #[inline(always)]
+    pub(crate) fn has_expired(&self) -> bool {
+        !D::NEVER && self.expired
+    }
+
+    /// The units held back given back to `work` (before it reports its
+    /// usage).
+    #[inline(always)]
+    pub(crate) fn settle(&mut self, work: &mut Work) {
+        if D::NEVER {
+            return;
+        }
+        work.set_credit(work.credit().saturating_add(self.reserve));
+        self.reserve = 0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cap holds a point to `CARRY` allowances, what it holds back
+    /// comes back to later points and to the usage, and a clock that has
+    /// said yes is not asked again.
+    #[test]
+    fn the_cap_holds_back_and_gives_back() {
+        let mut asked = 0u32;
+        let mut clock = || {
+            asked += 1;
+            asked > 3
+        };
+        let mut g = Guard::new(&mut clock, 10);
+        let mut w = Work::new();
+        w.grant(100);
+        assert!(g.proceed(&mut w));
+        assert_eq!((w.credit(), g.reserve), (20, 80));
+        // The point spends 5; the next gets 20 of the 95 left.
+        w.set_credit(15);
+        assert!(g.proceed(&mut w));
+        assert_eq!((w.credit(), g.reserve), (20, 75));
+        // A point that spends it all: the next still gets 20.
+        w.set_credit(0);
+        assert!(g.proceed(&mut w));
+        assert_eq!((w.credit(), g.reserve), (20, 55));
+        assert!(!g.has_expired());
+        // The fourth question: the time is up, and stays up unasked.
+        assert!(!g.proceed(&mut w));
+        assert!(!g.proceed(&mut w) && g.check() && g.has_expired());
+        g.settle(&mut w);
+        assert_eq!((w.credit(), g.reserve), (75, 0));
+        assert_eq!(w.usage(), (25, 100));
+        let _ = g;
+        assert_eq!(asked, 4);
+    }
+
+    /// Without a deadline nothing is capped or asked.
+    #[test]
+    fn no_deadline_changes_nothing() {
+        let mut never = NoDeadline;
+        let mut g = Guard::new(&mut never, 10);
+        let mut w = Work::new();
+        w.grant(100);
+        assert!(g.proceed(&mut w) && !g.check() && !g.has_expired());
+        assert_eq!(w.credit(), 100);
+        g.settle(&mut w);
+        assert_eq!(w.usage(), (0, 100));
+    }
+}

@@ -63,8 +63,10 @@ pub enum Status {
     BoundaryEnd,
     /// The frame's work budget ([`crate::Config::with_work_budget`]) was
     /// spent before this point's search could finish, or before the
-    /// piece's lines could bound a stick that its range leaves unbounded:
-    /// no depth, and the frame did not run late.
+    /// piece's lines could bound a stick that its range leaves unbounded,
+    /// or the caller's deadline ([`crate::Processor::process_within`])
+    /// expired before the point was done: no depth, and the frame did not
+    /// run late.
     OverBudget,
 }
 

@@ -1014,6 +1014,69 @@ fn against_reference<const N: usize, const B: usize>(
     }
 }
 
+/// The pair `(kept, frame)` on a fresh processor within clocks that say
+/// the time is up from their `k`-th question on (`Processor::
+/// process_against_kept_within`), for a few `k` from 0 to past the last
+/// question: the expiry flag exactly when the clock said yes, the clock
+/// not asked after, the structure's own checks, and every point equal to
+/// the largest budget's (`reference`), `over_budget`, or `ok` with the
+/// same match and a stick holding that one's.
+fn within_deadlines<const N: usize, const B: usize>(
+    kept: &Frame<N, B>,
+    (frame, m): (&Frame<N, B>, &Motion),
+    config: &Config,
+    reference: &Structure<N, B>,
+    features: &mut u128,
+) {
+    let mut p = Box::new(Processor::<N, B>::new(*config));
+    assert!(matches!(p.process(kept, None), Ok(Step::First)));
+    let mut questions = 0usize;
+    let mut count = || {
+        questions += 1;
+        false
+    };
+    let _ = p.process_against_kept_within(frame, m, &mut count);
+    assert!(!p.deadline_expired(), "a clock that never says yes");
+    for k in [
+        0,
+        1,
+        questions / 3,
+        questions / 2,
+        questions.saturating_sub(1),
+        questions,
+    ] {
+        let mut asked = 0usize;
+        let mut clock = || {
+            asked += 1;
+            asked > k
+        };
+        let got = Box::new(
+            p.process_against_kept_within(frame, m, &mut clock)
+                .expect("kept")
+                .clone(),
+        );
+        assert_eq!(
+            p.deadline_expired(),
+            asked > k,
+            "deadline at question {k}: the flag"
+        );
+        assert!(
+            asked <= k + 1,
+            "deadline at question {k}: asked {asked} times"
+        );
+        check_structure(&got, kept, config, features);
+        for (x, y) in got.boundaries().iter().zip(reference.boundaries()) {
+            for (a, b) in x.points().iter().zip(y.points()) {
+                assert!(
+                    a == b || a.status() == Status::OverBudget || looser_stick(a, b),
+                    "deadline at question {k}: {a:?}, largest budget {b:?}"
+                );
+            }
+        }
+    }
+    assert_eq!(p.previous(), Some(kept), "the kept frame was replaced");
+}
+
 /// Whether `p` is `q` with a stick that holds `q`'s: both `ok`, the same
 /// pixels and depth, `p`'s ends at or beyond `q`'s (what a budget too small
 /// to tighten a stick by the piece's lines gives).
@@ -1162,6 +1225,7 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
                         points[1] += c[1];
                         check_structure(&s, k, &config, &mut features);
                         against_reference(&s, r, &config, &mut features);
+                        within_deadlines(k, (&frame, &motion), &config, r, &mut features);
                         assert!(
                             a.previous() == Some(&**k),
                             "{what}: the kept frame was replaced"

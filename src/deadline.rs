@@ -14,13 +14,16 @@
 //! ([`crate::Processor::deadline_expired`]).
 //!
 //! What the caller can count on, after the clock says yes:
-//! - **The point in progress ends within a bounded cost.** A point's search
-//!   may spend at most [`CARRY`] times the configured allowance
-//!   (`work_per_point`) under a deadline: the units cheap points leave
-//!   still carry over to later points, but no single point can spend the
-//!   whole frame's savings at once, which is what makes its cost bounded
-//!   by a constant (`C_P + C_U · CARRY · w` instructions in the terms of
-//!   README's "Worst case") rather than by the frame's size.
+//! - **The point in progress ends within a bounded cost.** Between two
+//!   questions a point's search may spend at most [`CARRY`] times the
+//!   configured allowance (`work_per_point`) under a deadline (on the
+//!   pseudo-angle path a point's walk and its deferred refinement are two
+//!   such stretches): the units cheap points leave still carry over to
+//!   later points, but no single point can spend the whole frame's savings
+//!   at once, which is what makes its cost bounded by a constant (`C_P +
+//!   C_U · CARRY · w` instructions in the terms of README's "Worst case")
+//!   rather than by the frame's size. (The first point on the band path
+//!   also builds the index's radial levels, linear in the boundary.)
 //! - **Every other point costs a flag**: a store of a flagged result.
 //! - **Nothing is left half done**: every point is either a complete
 //!   result (the same checks as without a deadline: a stick that holds) or
@@ -35,8 +38,9 @@
 
 use crate::search::Work;
 
-/// A point's search may spend at most this many times the configured
-/// allowance per point under a deadline (see the module docs).
+/// Between two questions of the clock a point's search may spend at most
+/// this many times the configured allowance per point under a deadline
+/// (see the module docs).
 pub const CARRY: u32 = 2;
 
 /// The caller's clock: whether the frame's time is up. Asked once before

@@ -153,6 +153,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     /// Forget the previous frame (e.g. after a camera reset).
     pub fn reset(&mut self) {
         self.has_previous = false;
+        self.expired = false;
     }
 
     /// Process the next frame with the motion from the previous one.
@@ -176,8 +177,9 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     /// previous one either way, as with [`Self::process`]; the points done
     /// before the deadline are complete results. Under a deadline a point's
     /// search may spend at most [`crate::deadline::CARRY`] times its
-    /// allowance (what it leaves still carries over), so the point in
-    /// progress when the time is up ends within a bounded cost.
+    /// allowance between two questions (what it leaves still carries
+    /// over), so the point in progress when the time is up ends within a
+    /// bounded cost.
     pub fn process_within<D: Deadline>(
         &mut self,
         frame: &Frame<N, B>,

@@ -661,6 +661,19 @@ pub fn run(
     d: &Drive,
     input: &Input,
     policy: FusionConfig,
+    each: impl FnMut(usize, &FusionStep, &HostFusion),
+) -> Run {
+    run_within(d, input, policy, None, each)
+}
+
+/// [`run`] with every frame's step within a deadline
+/// (`Fusion::step_within`) whose clock says the time is up from its
+/// `k`-th question on, when `cut` is `Some(k)`.
+pub fn run_within(
+    d: &Drive,
+    input: &Input,
+    policy: FusionConfig,
+    cut: Option<usize>,
     mut each: impl FnMut(usize, &FusionStep, &HostFusion),
 ) -> Run {
     let k = d.spec.intrinsics;
@@ -673,9 +686,18 @@ pub fn run(
             from: (j - 1) as u32,
             motion: input.given[j - 1],
         });
-        let step = fusion
-            .step(j as u32, &frame, motion.as_ref())
-            .expect("frames chain");
+        let step = match cut {
+            None => fusion.step(j as u32, &frame, motion.as_ref()),
+            Some(k) => {
+                let mut asked = 0usize;
+                let mut clock = || {
+                    asked += 1;
+                    asked > k
+                };
+                fusion.step_within(j as u32, &frame, motion.as_ref(), &mut clock)
+            }
+        }
+        .expect("frames chain");
         steps.push(step);
         if step.paired.is_some() {
             let key = fusion.key().expect("a key frame");

@@ -125,6 +125,58 @@ fn containment(noise: Noise, motion: Option<MotionNoise>, per_family: usize) -> 
     all
 }
 
+/// The fusion with every frame's matching cut short by a deadline
+/// (`Fusion::step_within`, a clock that says the time is up from its
+/// 300th question on: about the first boundary of a 2 × 256 frame): the
+/// cut points get no new interval, so every fused interval still holds
+/// the truth and no wrong match is fused; the cut does not end key frames
+/// early (the "few matched" rule skips a cut pair), and the yield shows
+/// what the cut cost.
+#[test]
+fn containment_within_a_deadline() {
+    let policy = FusionConfig::DEFAULT;
+    let (mut cut_tally, mut full_tally) = (Tally::default(), Tally::default());
+    let mut cut_steps = 0usize;
+    for family in DriveFamily::ALL {
+        let (ds, _) = drives(family, 6, FRAMES);
+        for (seed, d) in &ds {
+            let input = d.input(Noise::Rounded, None, *seed);
+            let r = host_tests::drives::run_within(d, &input, policy, Some(300), |_, _, f| {
+                if f.deadline_expired() {
+                    cut_steps += 1;
+                }
+            });
+            cut_tally.add(&tally(d, &r));
+            full_tally.add(&tally(d, &run(d, &input, policy, |_, _, _| {})));
+        }
+    }
+    println!(
+        "within a deadline (300 questions a frame): {} drives, {cut_steps} steps cut; {} key frames ({} without the deadline); {} of {} fused point snapshots hold the truth ({} without); {} wrong two-view sticks, {} wrong fused",
+        cut_tally.drives,
+        cut_tally.key_frames,
+        full_tally.key_frames,
+        cut_tally.consistent_contained,
+        cut_tally.consistent,
+        full_tally.consistent,
+        cut_tally.wrong_pairs,
+        cut_tally.wrong_fused
+    );
+    assert!(cut_steps > cut_tally.drives * 4, "{cut_steps} steps cut");
+    assert_eq!(
+        cut_tally.consistent_contained, cut_tally.consistent,
+        "a fused interval misses the truth within a deadline"
+    );
+    assert_eq!(cut_tally.wrong_fused, 0);
+    assert_eq!(cut_tally.wrong_pairs_observed, 0);
+    assert!(cut_tally.consistent > 0 && cut_tally.consistent < full_tally.consistent);
+    assert!(
+        cut_tally.key_frames <= full_tally.key_frames,
+        "the cut ended key frames early: {} against {}",
+        cut_tally.key_frames,
+        full_tally.key_frames
+    );
+}
+
 #[test]
 fn containment_rounded() {
     containment(Noise::Rounded, None, PER_FAMILY);

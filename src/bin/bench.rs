@@ -477,6 +477,120 @@ fn deadline_sweep(
         }
     }
     processor.set_config(Config::DEFAULT);
+    deadline_gaps(processor, f1, f2);
+}
+
+/// Questions a frame asks its clock, at most (one to three a point and a
+/// few a boundary, 2 × 256 points: `host_tests/tests/deadline.rs`).
+const MAX_QUESTIONS: usize = 2048;
+
+/// The call's lateness where it is worst: each pair (the representative,
+/// every member, every configuration probe, and `search_3` under
+/// localisation errors of 100 px, an adversarial review's find) run once
+/// with a clock that never says yes, recording when each question is
+/// asked; then, for the questions after the four longest gaps, run with a
+/// clock that says yes there (the same clock otherwise). A limit just
+/// after the question before the gap makes the call that late: the gap,
+/// then the overrun past the yes. Logged per cut: the gap, the overrun,
+/// their sum (the lateness).
+fn deadline_gaps(
+    processor: &mut Processor<CAP, 2>,
+    f1: &mut Frame<CAP, 2>,
+    f2: &mut Frame<CAP, 2>,
+) {
+    let bench = BENCH
+        .iter()
+        .filter(|b| b.0 == 256)
+        .map(|b| ("representative", 0u8, b.1));
+    let members = ADVERSARIAL
+        .iter()
+        .filter(|a| a.1 == 256)
+        .map(|a| (a.0, a.2, a.3));
+    let probes = PROBES
+        .iter()
+        .filter(|p| p.2 == 256 && p.4.is_none())
+        .filter_map(|p| {
+            ADVERSARIAL
+                .iter()
+                .find(|a| a.0 == p.1 && a.1 == 256)
+                .map(|a| (p.0, p.3, a.3))
+        });
+    let wide = ADVERSARIAL
+        .iter()
+        .filter(|a| a.0 == "search_3" && a.1 == 256)
+        .map(|a| ("search_3+e_100", 9u8, a.3));
+    for (name, errors, data) in bench.chain(members).chain(probes).chain(wide) {
+        let (Some(m), Some(c)) = (
+            load(data, f1, f2),
+            member_config(errors, Config::DEFAULT_WORK_PER_POINT),
+        ) else {
+            defmt::error!("bad deadline data for {=str}", name);
+            continue;
+        };
+        processor.set_config(c);
+        // The questions' times, instructions from the call's start.
+        let mut times = heapless::Vec::<u32, MAX_QUESTIONS>::new();
+        let full = cut_at(processor, (f1, f2, &m), usize::MAX, &mut times);
+        // The four longest gaps (gap, index of the question after it).
+        let mut top = [(0u32, 0usize); 4];
+        for (k, w) in times.windows(2).enumerate() {
+            let (Some(&a), Some(&b)) = (w.first(), w.get(1)) else {
+                continue;
+            };
+            let gap = b.saturating_sub(a);
+            if let Some(slot) = top.iter_mut().min_by_key(|t| t.0) {
+                if gap > slot.0 {
+                    *slot = (gap, k + 1);
+                }
+            }
+        }
+        for (gap, k) in top {
+            if gap == 0 {
+                continue;
+            }
+            let mut t = heapless::Vec::<u32, MAX_QUESTIONS>::new();
+            let end = cut_at(processor, (f1, f2, &m), k, &mut t);
+            let at = t.get(k).copied().unwrap_or(end);
+            let before = t.get(k.wrapping_sub(1)).copied().unwrap_or(0);
+            defmt::info!(
+                "deadline_gap name={=str} questions={=usize} full={=u32} k={=usize} gap={=u32} overrun={=u32} lateness={=u32} reported={=bool}",
+                name,
+                times.len(),
+                full,
+                k,
+                gap,
+                end.saturating_sub(at),
+                end.saturating_sub(before),
+                processor.deadline_expired()
+            );
+        }
+    }
+    processor.set_config(Config::DEFAULT);
+}
+
+/// The pair's call within a clock that records each question's time in
+/// `times` (instructions from the call's start) and says yes from
+/// question `k` on; returns the call's instructions.
+fn cut_at(
+    processor: &mut Processor<CAP, 2>,
+    (f1, f2, m): (&Frame<CAP, 2>, &Frame<CAP, 2>, &roadstereo::Motion),
+    k: usize,
+    times: &mut heapless::Vec<u32, MAX_QUESTIONS>,
+) -> u32 {
+    processor.reset();
+    let _ = processor.process(f1, None);
+    let t0 = fw::ticks();
+    let mut clock = || {
+        let t = fw::ticks();
+        let _ = times.push(fw::instructions(t.saturating_sub(t0)));
+        times.len() > k
+    };
+    let (_, instr) = fw::measure(|| {
+        processor
+            .process_within(black_box(f2), Some(m), &mut clock)
+            .is_ok()
+    });
+    instr
 }
 
 /// An adversarial member's configuration: its error model (the id in
@@ -499,6 +613,8 @@ fn member_config(errors: u8, w: u32) -> Option<Config> {
         6 => Config::new(0.5, 0.5, 0.1, 1000.0).ok()?,
         7 => Config::DEFAULT.with_localisation_error(0.5, 2.0).ok()?,
         8 => Config::DEFAULT.with_localisation_error(3.0, 3.0).ok()?,
+        // The deadline's probe (`deadline_gaps`).
+        9 => Config::DEFAULT.with_localisation_error(100.0, 100.0).ok()?,
         _ => return None,
     };
     c.with_work_budget(w).ok()

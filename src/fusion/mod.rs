@@ -87,6 +87,7 @@ pub use key::{FusedCounts, FusedPoint, FusedStatus, KeyFrame, PairFused};
 
 use crate::boundary::Frame;
 use crate::config::Config;
+use crate::deadline::{Deadline, NoDeadline};
 use crate::map::{Retired, RoadMap};
 use crate::math::{sin_cos, sqrt};
 use crate::motion::Motion;
@@ -410,6 +411,27 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         frame: &Frame<N, B>,
         motion: Option<&ChainedMotion>,
     ) -> Result<FusionStep, FusionError> {
+        self.step_within(id, frame, motion, &mut NoDeadline)
+    }
+
+    /// [`Fusion::step`] with the pair's matching bounded by the caller's
+    /// `deadline` ([`Processor::process_within`], [`crate::deadline`]):
+    /// once it has expired the key-frame points not matched are
+    /// [`crate::Status::OverBudget`] in this pair, which gives them no new
+    /// interval (as any flag does), and [`Fusion::deadline_expired`] says
+    /// so. A cut pair does not count towards the key-frame policy's "few
+    /// matched" rule (a frame the clock cut short says nothing about how
+    /// much of the key frame is still in view). The fusion's own work after
+    /// the matching (one pass over the key frame's points, the map) is not
+    /// cut: it is bounded by the points (README, "Fusing many frames"), so
+    /// leave room for it in the limit.
+    pub fn step_within<D: Deadline>(
+        &mut self,
+        id: u32,
+        frame: &Frame<N, B>,
+        motion: Option<&ChainedMotion>,
+        deadline: &mut D,
+    ) -> Result<FusionStep, FusionError> {
         let mut out = FusionStep {
             paired: None,
             partner: 0,
@@ -458,7 +480,8 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         if bounds.any() {
             self.processor.set_config(cfg);
         }
-        let fused = self.fuse_pair(frame, &motion, last_partner);
+        let fused = self.fuse_pair(frame, &motion, last_partner, deadline);
+        let cut = self.processor.deadline_expired();
         // 4. The pair fused; a last partner retires the key frame.
         out.paired = Some(fused);
         out.partner = self.key.partners();
@@ -481,9 +504,10 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         // 5. The policy: is the next frame the last partner?
         let p = self.key.partners();
         let best = self.key.best_matched();
-        let few = u64::from(fused.matched) * 1000
-            < u64::from(self.config.keep_permille) * u64::from(best)
-            || (best == 0 && p >= 2);
+        let few = !cut
+            && (u64::from(fused.matched) * 1000
+                < u64::from(self.config.keep_permille) * u64::from(best)
+                || (best == 0 && p >= 2));
         self.due = p.saturating_add(1) >= self.config.max_partners || few;
         Ok(out)
     }
@@ -492,19 +516,35 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// into the key frame: a last partner is processed against the kept
     /// frame and replaces it (it becomes the next key frame), any other is
     /// processed against the kept frame, which stays.
-    fn fuse_pair(&mut self, frame: &Frame<N, B>, motion: &Motion, last_partner: bool) -> PairFused {
+    fn fuse_pair<D: Deadline>(
+        &mut self,
+        frame: &Frame<N, B>,
+        motion: &Motion,
+        last_partner: bool,
+        deadline: &mut D,
+    ) -> PairFused {
         if last_partner {
-            match self.processor.process(frame, Some(motion)) {
+            match self.processor.process_within(frame, Some(motion), deadline) {
                 Ok(Step::Structure(s)) => self.key.fuse(s),
                 // (A kept frame exists and a motion is given: not reached.)
                 _ => PairFused::default(),
             }
         } else {
-            match self.processor.process_against_kept(frame, motion) {
+            match self
+                .processor
+                .process_against_kept_within(frame, motion, deadline)
+            {
                 Ok(s) => self.key.fuse(s),
                 Err(_) => PairFused::default(),
             }
         }
+    }
+
+    /// Whether the deadline of the last [`Fusion::step_within`] cut its
+    /// pair's matching short ([`Processor::deadline_expired`]); `false`
+    /// after a step that did not pair.
+    pub fn deadline_expired(&self) -> bool {
+        self.processor.deadline_expired()
     }
 
     /// Make frame `id` the key frame (if it has points): the processor

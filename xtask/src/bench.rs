@@ -43,7 +43,12 @@ pub const BENCH_USAGE: &str =
   software f64, no allocator, the panic-never link.
   Also printed (integration limits while the deadline budgets are missed, not budgets): the points
   per boundary that fit the deadline for the representative pair at its costliest measured
-  per-point cost, with the fusion, and by the worst-case bound at the default budget and at w = 8.
+  per-point cost, with the fusion, and by the worst-case bound at the default budget and at w = 8;
+  and the call within a deadline (Processor::process_within, SysTick as the clock, 2 x 256): on a
+  grid of limits the instructions, overrun past the clock's yes, lateness past the limit and ok
+  points, and the lateness where it is worst (cut after each pair's longest gaps between questions)
+  with the limit that keeps every pair within the deadline (hard checks: the expiry flag agrees with
+  the clock, a passed deadline leaves no point ok).
   Not here: the representative window's estimated Cortex-M4F cycles per point <= 718 is
   checked by `cargo xtask profile` (see its --help).";
 
@@ -300,7 +305,8 @@ fn deadline_table(log: &str, deadline: u64, misses: &mut Vec<String>) {
         return;
     }
     // By pair in log order: (limit, instr, expired, expired_at, ok).
-    let mut pairs: Vec<(String, Vec<(u64, u64, bool, u64, u64)>)> = Vec::new();
+    type Row = (u64, u64, bool, u64, u64);
+    let mut pairs: Vec<(String, Vec<Row>)> = Vec::new();
     for r in &rows {
         let name = field(r, "name").unwrap_or("?").to_string();
         let expired = field(r, "expired") == Some("true");
@@ -393,12 +399,57 @@ limits {} … {} instructions): the overrun is the call's instructions past the 
         );
     }
     println!(
-        "largest overrun {} instructions ({}), largest lateness {} ({}); every pair ends within the deadline {deadline} at limits up to {}",
+        "on the limits' grid: largest overrun {} instructions ({}), largest lateness {} ({}); every pair ends within the deadline {deadline} at limits up to {}",
         worst.0,
         worst.1,
         late.0,
         late.1,
         fits.map_or("none of the sweep".to_string(), |l| l.to_string())
+    );
+    // Where it is worst: a limit just before each pair's longest gaps
+    // between questions (firmware `deadline_gaps`).
+    let gaps = records(log, "deadline_gap name=");
+    if gaps.is_empty() {
+        misses.push("no deadline_gap rows in the bench log".into());
+        return;
+    }
+    let mut by: Vec<(String, u64, u64, u64, u64)> = Vec::new();
+    for r in &gaps {
+        if field(r, "reported") != Some("true") {
+            misses.push(format!(
+                "deadline_gap {}: the processor did not report the expiry",
+                field(r, "name").unwrap_or("?")
+            ));
+        }
+        let name = field(r, "name").unwrap_or("?").to_string();
+        let (g, o, l) = (num(r, "gap"), num(r, "overrun"), num(r, "lateness"));
+        match by.iter_mut().find(|b| b.0 == name) {
+            Some(b) => {
+                b.1 = b.1.max(g);
+                b.2 = b.2.max(o);
+                b.3 = b.3.max(l);
+            }
+            None => by.push((name, g, o, l, num(r, "questions"))),
+        }
+    }
+    by.sort_by_key(|b| std::cmp::Reverse(b.3));
+    println!(
+        "
+lateness where it is worst (a limit just before each pair's four longest gaps between questions; every pair, the probes, `search_3+e_100`), the 8 latest:"
+    );
+    println!("| pair | questions | longest gap | overrun | lateness |");
+    println!("|---|---:|---:|---:|---:|");
+    for b in by.iter().take(8) {
+        println!("| {} | {} | {} | {} | {} |", b.0, b.4, b.1, b.2, b.3);
+    }
+    let (lmax, omax) = (
+        by.iter().map(|b| b.3).max().unwrap_or(0),
+        by.iter().map(|b| b.2).max().unwrap_or(0),
+    );
+    println!(
+        "largest lateness {lmax} instructions, largest overrun {omax}, over {} pairs: a limit of {} keeps every one within the deadline {deadline} (reported, not a budget)",
+        by.len(),
+        deadline.saturating_sub(lmax)
     );
 }
 

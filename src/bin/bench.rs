@@ -433,6 +433,20 @@ fn measure_within(
     )
 }
 
+/// The representative pair and every adversarial member at 2 × 256: name,
+/// error model ([`member_config`]), data.
+fn pairs_256() -> impl Iterator<Item = (&'static str, u8, &'static [u8])> {
+    let bench = BENCH
+        .iter()
+        .filter(|b| b.0 == 256)
+        .map(|b| ("representative", 0u8, b.1));
+    let members = ADVERSARIAL
+        .iter()
+        .filter(|a| a.1 == 256)
+        .map(|a| (a.0, a.2, a.3));
+    bench.chain(members)
+}
+
 /// The deadline sweep: the representative pair and every adversarial
 /// member at 2 × 256, each within every limit of [`DEADLINE_LIMITS`]: the
 /// call's instructions, when the clock said the time was up, and the
@@ -443,15 +457,7 @@ fn deadline_sweep(
     f1: &mut Frame<CAP, 2>,
     f2: &mut Frame<CAP, 2>,
 ) {
-    let bench = BENCH
-        .iter()
-        .filter(|b| b.0 == 256)
-        .map(|b| ("representative", 0u8, b.1));
-    let members = ADVERSARIAL
-        .iter()
-        .filter(|a| a.1 == 256)
-        .map(|a| (a.0, a.2, a.3));
-    for (name, errors, data) in bench.chain(members) {
+    for (name, errors, data) in pairs_256() {
         let (Some(m), Some(c)) = (
             load(data, f1, f2),
             member_config(errors, Config::DEFAULT_WORK_PER_POINT),
@@ -498,14 +504,6 @@ fn deadline_gaps(
     f1: &mut Frame<CAP, 2>,
     f2: &mut Frame<CAP, 2>,
 ) {
-    let bench = BENCH
-        .iter()
-        .filter(|b| b.0 == 256)
-        .map(|b| ("representative", 0u8, b.1));
-    let members = ADVERSARIAL
-        .iter()
-        .filter(|a| a.1 == 256)
-        .map(|a| (a.0, a.2, a.3));
     let probes = PROBES
         .iter()
         .filter(|p| p.2 == 256 && p.4.is_none())
@@ -519,7 +517,7 @@ fn deadline_gaps(
         .iter()
         .filter(|a| a.0 == "search_3" && a.1 == 256)
         .map(|a| ("search_3+e_100", 9u8, a.3));
-    for (name, errors, data) in bench.chain(members).chain(probes).chain(wide) {
+    for (name, errors, data) in pairs_256().chain(probes).chain(wide) {
         let (Some(m), Some(c)) = (
             load(data, f1, f2),
             member_config(errors, Config::DEFAULT_WORK_PER_POINT),

@@ -131,7 +131,7 @@ fn fusion_bench() -> bool {
             step.paired.is_none() || copy.structure().digest() == fusion.structure().digest();
         let own = step_instr.saturating_sub(matching);
         defmt::info!(
-            "fusion frame={=u32} points={=u32} step_instr={=u32} matching_instr={=u32} fusion_instr={=u32} per_point={=u32} paired={=bool} retired={=bool} same_structure={=bool} map={=u32}",
+            "fusion frame={=u32} points={=u32} step_instr={=u32} matching_instr={=u32} fusion_instr={=u32} per_point={=u32} paired={=bool} retired={=bool} same_structure={=bool} map={=u32} ok={=u32}",
             i,
             points as u32,
             step_instr,
@@ -141,7 +141,55 @@ fn fusion_bench() -> bool {
             step.paired.is_some(),
             step.retired.is_some(),
             same,
-            (fusion.map().len(0) + fusion.map().len(1)) as u32
+            (fusion.map().len(0) + fusion.map().len(1)) as u32,
+            fusion.structure().status_counts().get(Status::Ok) as u32
+        );
+    }
+    fusion.reset();
+    fusion_within(fusion)
+}
+
+/// The limit of the demo drive's steps within a deadline, instructions:
+/// the deadline (277 200) less the lateness the bench measures where it is
+/// worst (about 55 000 at 2 × 256) and the fusion's own work after the
+/// matching, which the deadline does not cut (at most 16 220 on this
+/// drive).
+const DRIVE_LIMIT: u32 = 205_000;
+
+/// The demo drive again through `Fusion::step_within`, SysTick as the
+/// clock at [`DRIVE_LIMIT`]: per frame the step's instructions, whether
+/// the deadline cut it, and the pair's `ok` and `over_budget` points.
+fn fusion_within(fusion: &mut Fusion<256, 2, 512>) -> bool {
+    let Ok(mut drive) = fw::Drive::new(DRIVE) else {
+        return false;
+    };
+    let mut frame = Frame::<256, 2>::new(drive.camera);
+    let budget = ticks_of(DRIVE_LIMIT);
+    for i in 0..drive.frames {
+        let Ok(motion) = drive.next_frame(&mut frame) else {
+            return false;
+        };
+        let chained = motion.map(|m| ChainedMotion {
+            from: i.wrapping_sub(1),
+            motion: m,
+        });
+        let t0 = fw::ticks();
+        let mut clock = || fw::ticks().saturating_sub(t0) >= budget;
+        let (result, instr) =
+            fw::measure(|| fusion.step_within(black_box(i), &frame, chained.as_ref(), &mut clock));
+        let Ok(step) = result else {
+            return false;
+        };
+        let counts = fusion.structure().status_counts();
+        defmt::info!(
+            "fusion_within frame={=u32} limit={=u32} step_instr={=u32} cut={=bool} paired={=bool} ok={=u32} over_budget={=u32}",
+            i,
+            DRIVE_LIMIT,
+            instr,
+            fusion.deadline_expired(),
+            step.paired.is_some(),
+            counts.get(Status::Ok) as u32,
+            counts.get(Status::OverBudget) as u32
         );
     }
     true

@@ -129,6 +129,7 @@ pub fn bench(b: &Budget) -> Result<(), String> {
     adversarial(&log, b, &mut misses);
     crate::worst::worst_case(&log, b.deadline(), OPEN, &mut misses);
     deadline_table(&log, b.deadline(), &mut misses);
+    drive_within(&log, b.deadline(), &mut misses);
     fusion_table(&log, &per, b, &mut misses);
     memory_table(&log, &demo_elf, b, &mut misses)?;
     wire_table(&log, &mut misses);
@@ -450,6 +451,60 @@ lateness where it is worst (a limit just before each pair's four longest gaps be
         "largest lateness {lmax} instructions, largest overrun {omax}, over {} pairs: a limit of {} keeps every one within the deadline {deadline} (reported, not a budget)",
         by.len(),
         deadline.saturating_sub(lmax)
+    );
+}
+
+/// The demo drive's fusion steps within a deadline (firmware
+/// `fusion_within`: `Fusion::step_within`, SysTick as the clock at its
+/// limit), against the same steps without one: per frame the step's
+/// instructions, whether it was cut, the pair's `ok` points with and
+/// without the cut and its `over_budget` points. Reported, not budgeted;
+/// hard check: the rows are there.
+fn drive_within(log: &str, deadline: u64, misses: &mut Vec<String>) {
+    let rows = records(log, "fusion_within frame=");
+    if rows.is_empty() {
+        misses.push("no fusion_within rows in the bench log".into());
+        return;
+    }
+    let full: BTreeMap<u64, u64> = records(log, "fusion frame=")
+        .iter()
+        .map(|r| (num(r, "frame"), num(r, "ok")))
+        .collect();
+    let limit = rows.first().map_or(0, |r| num(r, "limit"));
+    println!(
+        "
+the demo drive's fusion steps within a deadline (`Fusion::step_within`, SysTick as the clock, limit {limit}; the fusion's own work after the matching is not cut):"
+    );
+    println!(
+        "| frame | step | share of the deadline | cut | ok (without the deadline) | over_budget |"
+    );
+    println!("|---:|---:|---:|---|---:|---:|");
+    let (mut worst, mut cut) = (0u64, 0usize);
+    let (mut ok_within, mut ok_without) = (0u64, 0u64);
+    for r in &rows {
+        let f = num(r, "frame");
+        let step = num(r, "step_instr");
+        worst = worst.max(step);
+        let is_cut = field(r, "cut") == Some("true");
+        let ok = num(r, "ok");
+        let without = full.get(&f).copied().unwrap_or(0);
+        if is_cut {
+            cut += 1;
+        }
+        if field(r, "paired") == Some("true") {
+            ok_within += ok;
+            ok_without += without;
+            println!(
+                "| {f} | {step} | {:.1} % | {} | {ok} ({without}) | {} |",
+                100.0 * step as f64 / deadline as f64,
+                if is_cut { "yes" } else { "" },
+                num(r, "over_budget")
+            );
+        }
+    }
+    println!(
+        "every step within {worst} instructions ({:.1} % of the deadline {deadline}); {cut} steps cut; ok points over the drive's pairs {ok_within} within the deadline, {ok_without} without (after the first cut the key frames differ, so frames compare only roughly)",
+        100.0 * worst as f64 / deadline as f64
     );
 }
 

@@ -151,7 +151,8 @@ fn fusion_bench() -> bool {
 
 /// The limit of the demo drive's steps within a deadline, instructions:
 /// the deadline (277 200) less the lateness the bench measures where it is
-/// worst (about 55 000 at 2 × 256) and the fusion's own work after the
+/// worst (51 052 at 2 × 256, rounded up to 55 000) and the fusion's own
+/// work after the
 /// matching, which the deadline does not cut (at most 16 220 on this
 /// drive).
 const DRIVE_LIMIT: u32 = 205_000;

@@ -60,6 +60,16 @@ pub(super) fn match_boundary<const N: usize, D: Deadline>(
         }
         _ => {}
     }
+    if !D::NEVER && matcher == Matcher::Indexed && matches!(keying.pencil, Pencil::Half { .. }) {
+        // Under a deadline: the radial levels the band queries use built
+        // between two questions, not inside the first point's search.
+        if guard.check() {
+            expire(slots);
+            *work = credit;
+            return;
+        }
+        index.build_radial_once(b2);
+    }
     for r in slots.iter_mut() {
         if r.status == Status::NoIntersection {
             *r = if matcher == Matcher::Reference || guard.proceed(&mut credit) {

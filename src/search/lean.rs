@@ -136,6 +136,17 @@ impl<const N: usize> Index<N> {
         (self.radial_levels > 0).then_some(rad)
     }
 
+    /// The radial levels built now if they are not yet
+    /// ([`Self::build_radial`]; the same levels the first band query with
+    /// a radial test would build). Under a caller's deadline the band path
+    /// builds them before its first point, so that the build and that
+    /// point's search are two stretches between the clock's questions.
+    pub(crate) fn build_radial_once(&mut self, b: &[Pixel]) {
+        if self.radial_levels == UNBUILT {
+            self.build_radial(b);
+        }
+    }
+
     /// At segment `j` of a run: how many segments from `j` on the radial
     /// levels pass over, the largest block aligned at `j` that `rad`
     /// rejects as a whole ([`Radial::rejects_block`]; 0: look at segment

@@ -304,8 +304,11 @@ impl<const N: usize, const B: usize> Structure<N, B> {
     /// The frame's work budget ([`crate::Config::with_work_budget`]): the
     /// units the search spent and the units the frame's points brought,
     /// `(spent, granted)`. A frame whose points came out
-    /// [`Status::OverBudget`] spent all of it; the share spent says how
-    /// close to its deadline a frame came.
+    /// [`Status::OverBudget`] spent all of it (without a deadline: within
+    /// one, [`crate::Processor::process_within`], a point may also be cut
+    /// by the cap or the clock, and the points after a cut grant
+    /// nothing); the share spent says how close to its budget a frame
+    /// came.
     pub fn work_units(&self) -> (u32, u32) {
         self.work
     }

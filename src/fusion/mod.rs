@@ -542,7 +542,10 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
 
     /// Whether the deadline of the last [`Fusion::step_within`] cut its
     /// pair's matching short ([`Processor::deadline_expired`]); `false`
-    /// after a step that did not pair.
+    /// after a step that did not pair. A step that returned an error
+    /// changes nothing, this flag included. A pair cut short, even at
+    /// its first question, still takes one of the key frame's
+    /// `max_partners` places.
     pub fn deadline_expired(&self) -> bool {
         self.processor.deadline_expired()
     }

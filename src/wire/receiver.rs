@@ -92,11 +92,22 @@ impl<const N: usize, const B: usize> FrameJob<'_, N, B> {
         &self,
         processor: &'p mut Processor<N, B>,
     ) -> Result<Step<'p, N, B>, ProcessError> {
+        self.run_within(processor, &mut crate::deadline::NoDeadline)
+    }
+
+    /// [`Self::run`] within the caller's `deadline`
+    /// ([`Processor::process_within`]; [`Processor::deadline_expired`]
+    /// says afterwards whether it cut the frame short).
+    pub fn run_within<'p, D: crate::deadline::Deadline>(
+        &self,
+        processor: &'p mut Processor<N, B>,
+        deadline: &mut D,
+    ) -> Result<Step<'p, N, B>, ProcessError> {
         processor.set_config(self.config);
         if self.motion.is_none() {
             processor.reset();
         }
-        processor.process(self.frame, self.motion.as_ref())
+        processor.process_within(self.frame, self.motion.as_ref(), deadline)
     }
 
     /// The result packet's head for this job.

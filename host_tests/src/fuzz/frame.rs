@@ -1035,7 +1035,11 @@ fn within_deadlines<const N: usize, const B: usize>(
         questions += 1;
         false
     };
-    let _ = p.process_against_kept_within(frame, m, &mut count);
+    let uncut = Box::new(
+        p.process_against_kept_within(frame, m, &mut count)
+            .expect("kept")
+            .clone(),
+    );
     assert!(!p.deadline_expired(), "a clock that never says yes");
     for k in [
         0,
@@ -1065,6 +1069,15 @@ fn within_deadlines<const N: usize, const B: usize>(
             "deadline at question {k}: asked {asked} times"
         );
         check_structure(&got, kept, config, features);
+        // Up to the cut, the uncut frame: each point its result or flagged.
+        for (x, y) in got.boundaries().iter().zip(uncut.boundaries()) {
+            for (a, b) in x.points().iter().zip(y.points()) {
+                assert!(
+                    a == b || a.status() == Status::OverBudget,
+                    "deadline at question {k}: {a:?}, uncut {b:?}"
+                );
+            }
+        }
         for (x, y) in got.boundaries().iter().zip(reference.boundaries()) {
             for (a, b) in x.points().iter().zip(y.points()) {
                 assert!(

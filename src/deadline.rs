@@ -46,7 +46,7 @@
 //! then `over_budget` (`host_tests/tests/deadline.rs` counts them); with
 //! `w = 8` some random scenarios lose most of their points. A firmware
 //! that needs `process`'s results whenever its clock does not fire should
-//! give a larger `w`.
+//! give a larger `w`, or a clock whose [`Deadline::carry`] is larger.
 
 use crate::search::Work;
 
@@ -70,6 +70,16 @@ pub trait Deadline {
 
     /// Whether the time is up.
     fn expired(&mut self) -> bool;
+
+    /// How many allowances (`work_per_point`) a point's search may spend
+    /// between two questions: [`CARRY`] unless the clock says otherwise. A
+    /// larger carry caps fewer points (`u32::MAX`: none, every result
+    /// that of [`crate::Processor::process`] while the clock says no) and
+    /// makes the stretches between questions longer, up to about `C_U · w`
+    /// instructions more for each allowance (README, "Within a deadline").
+    fn carry(&self) -> u32 {
+        CARRY
+    }
 }
 
 impl<F: FnMut() -> bool> Deadline for F {
@@ -105,10 +115,11 @@ pub(crate) struct Guard<'d, D: Deadline> {
 
 impl<'d, D: Deadline> Guard<'d, D> {
     pub(crate) fn new(deadline: &'d mut D, allowance: u32) -> Self {
+        let cap = allowance.saturating_mul(deadline.carry());
         Self {
             deadline,
             expired: false,
-            cap: allowance.saturating_mul(CARRY),
+            cap,
             reserve: 0,
         }
     }

@@ -36,6 +36,18 @@ impl roadstereo::Deadline for Clock {
     }
 }
 
+/// A clock that never says yes and caps nothing (`Deadline::carry`).
+struct Uncapped;
+
+impl roadstereo::Deadline for Uncapped {
+    fn expired(&mut self) -> bool {
+        false
+    }
+    fn carry(&self) -> u32 {
+        u32::MAX
+    }
+}
+
 #[derive(Default, Debug)]
 struct Counts {
     equal: usize,
@@ -117,6 +129,16 @@ fn sweep(config: Config, (f1, f2, m): (&Frame<N, B>, &Frame<N, B>, &Motion), wha
     assert!(
         asked <= 3 * points + 8 * B,
         "{what}: {asked} questions for {points} points"
+    );
+    // With no cap and a clock that never says yes: `process` exactly.
+    let free = Box::new(
+        p.process_against_kept_within(f2, m, &mut Uncapped)
+            .expect("kept")
+            .clone(),
+    );
+    assert!(
+        free == default,
+        "{what}: an uncapped clock that never says yes differs from process"
     );
     let mut c = Counts::default();
     compare(&uncut, &full, what, &mut c);

@@ -59,7 +59,7 @@ use crate::structure::{PointResult, ProcessError, Status, Step, Structure};
 use crate::wedge::{WVertex, Wedge, WedgeWalk, WedgeWalker};
 
 mod step4;
-use step4::{expire, match_boundary, unmatched};
+use step4::{flag_pending, match_boundary};
 
 /// The per-frame motion-stereo processor for up to `B` boundaries of up to
 /// `N` points. No heap: everything lives inside this value, so it can be a
@@ -391,7 +391,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             }
             if guard.check() {
                 // The time ran out in step 1: no fold test, no search.
-                expire(slots);
+                flag_pending(slots, Status::OverBudget);
                 continue;
             }
             #[cfg(not(any(test, feature = "_reference")))]
@@ -421,18 +421,18 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             }
             if guard.check() {
                 // The time ran out in the fold test: no index, no search.
-                expire(slots);
+                flag_pending(slots, Status::OverBudget);
                 continue;
             }
             let Some(b2) = b2 else {
-                unmatched(slots);
+                flag_pending(slots, Status::NoIntersection);
                 continue;
             };
             let near_foe = pair.near_foe(r1_max);
             let builder = frame2_keys(index, &keying, b2, orient);
             if guard.check() {
                 // The time ran out in the keys: the index left unbuilt.
-                expire(slots);
+                flag_pending(slots, Status::OverBudget);
                 continue;
             }
             let radius = near_foe + 2.0 * (r1_max + pair.e2());

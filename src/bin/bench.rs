@@ -287,6 +287,26 @@ struct Measured {
     ok: u32,
 }
 
+impl Measured {
+    /// The call's outcome and instructions with the processor's output
+    /// counted.
+    fn of(processor: &Processor<CAP, 2>, (processed, instr): (bool, u32)) -> Self {
+        let points: usize = processor
+            .structure()
+            .boundaries()
+            .iter()
+            .map(|b| b.points().len())
+            .sum();
+        let ok = processor.structure().status_counts().get(Status::Ok);
+        Measured {
+            processed,
+            instr,
+            points: points as u32,
+            ok: ok as u32,
+        }
+    }
+}
+
 fn measure_pair(
     processor: &mut Processor<CAP, 2>,
     f1: &Frame<CAP, 2>,
@@ -296,19 +316,7 @@ fn measure_pair(
     processor.reset();
     let _ = processor.process(f1, None);
     let (processed, instr) = fw::measure(|| processor.process(black_box(f2), Some(m)).is_ok());
-    let points: usize = processor
-        .structure()
-        .boundaries()
-        .iter()
-        .map(|b| b.points().len())
-        .sum();
-    let ok = processor.structure().status_counts().get(Status::Ok);
-    Measured {
-        processed,
-        instr,
-        points: points as u32,
-        ok: ok as u32,
-    }
+    Measured::of(processor, (processed, instr))
 }
 
 #[entry]
@@ -441,44 +449,57 @@ fn ticks_of(instructions: u32) -> u64 {
 /// was up (instructions from the call's start).
 fn measure_within(
     processor: &mut Processor<CAP, 2>,
-    (f1, f2, m): (&Frame<CAP, 2>, &Frame<CAP, 2>, &roadstereo::Motion),
+    pair: (&Frame<CAP, 2>, &Frame<CAP, 2>, &roadstereo::Motion),
     limit: u32,
 ) -> (Measured, Option<u32>) {
-    processor.reset();
-    let _ = processor.process(f1, None);
     let budget = ticks_of(limit);
     let mut first = None;
-    let t0 = fw::ticks();
-    let mut clock = || {
-        let t = fw::ticks();
-        let up = t.saturating_sub(t0) >= budget;
+    let r = call_within(processor, pair, &mut |dt| {
+        let up = dt >= budget;
         if up && first.is_none() {
-            first = Some(t);
+            first = Some(dt);
         }
         up
-    };
+    });
+    (r, first.map(fw::instructions))
+}
+
+/// The pair's per-frame call (the processor reset, frame 1 given) within
+/// `clock`, which is handed the core-clock ticks since the call's start.
+fn call_within(
+    processor: &mut Processor<CAP, 2>,
+    (f1, f2, m): (&Frame<CAP, 2>, &Frame<CAP, 2>, &roadstereo::Motion),
+    clock: &mut impl FnMut(u64) -> bool,
+) -> Measured {
+    processor.reset();
+    let _ = processor.process(f1, None);
+    let t0 = fw::ticks();
+    let mut ask = || clock(fw::ticks().saturating_sub(t0));
     let (processed, instr) = fw::measure(|| {
         processor
-            .process_within(black_box(f2), Some(m), &mut clock)
+            .process_within(black_box(f2), Some(m), &mut ask)
             .is_ok()
     });
-    let points: usize = processor
-        .structure()
-        .boundaries()
-        .iter()
-        .map(|b| b.points().len())
-        .sum();
-    let ok = processor.structure().status_counts().get(Status::Ok);
-    let at = first.map(|t| fw::instructions(t.saturating_sub(t0)));
-    (
-        Measured {
-            processed,
-            instr,
-            points: points as u32,
-            ok: ok as u32,
-        },
-        at,
-    )
+    Measured::of(processor, (processed, instr))
+}
+
+/// A pair of the deadline's measurements loaded into `(f1, f2)` with its
+/// configuration set on `processor`: its motion, or `None` (logged).
+fn load_member(
+    processor: &mut Processor<CAP, 2>,
+    (name, errors, data): (&str, u8, &'static [u8]),
+    f1: &mut Frame<CAP, 2>,
+    f2: &mut Frame<CAP, 2>,
+) -> Option<roadstereo::Motion> {
+    let (Some(m), Some(c)) = (
+        load(data, f1, f2),
+        member_config(errors, Config::DEFAULT_WORK_PER_POINT),
+    ) else {
+        defmt::error!("bad deadline data for {=str}", name);
+        return None;
+    };
+    processor.set_config(c);
+    Some(m)
 }
 
 /// The representative pair and every adversarial member at 2 × 256: name,
@@ -506,14 +527,9 @@ fn deadline_sweep(
     f2: &mut Frame<CAP, 2>,
 ) {
     for (name, errors, data) in pairs_256() {
-        let (Some(m), Some(c)) = (
-            load(data, f1, f2),
-            member_config(errors, Config::DEFAULT_WORK_PER_POINT),
-        ) else {
-            defmt::error!("bad deadline data for {=str}", name);
+        let Some(m) = load_member(processor, (name, errors, data), f1, f2) else {
             continue;
         };
-        processor.set_config(c);
         for limit in DEADLINE_LIMITS {
             let (r, at) = measure_within(processor, (f1, f2, &m), limit);
             defmt::info!(
@@ -566,14 +582,9 @@ fn deadline_gaps(
         .filter(|a| a.0 == "search_3" && a.1 == 256)
         .map(|a| ("search_3+e_100", 9u8, a.3));
     for (name, errors, data) in pairs_256().chain(probes).chain(wide) {
-        let (Some(m), Some(c)) = (
-            load(data, f1, f2),
-            member_config(errors, Config::DEFAULT_WORK_PER_POINT),
-        ) else {
-            defmt::error!("bad deadline data for {=str}", name);
+        let Some(m) = load_member(processor, (name, errors, data), f1, f2) else {
             continue;
         };
-        processor.set_config(c);
         // The questions' times, instructions from the call's start.
         let mut times = heapless::Vec::<u32, MAX_QUESTIONS>::new();
         let full = cut_at(processor, (f1, f2, &m), usize::MAX, &mut times);
@@ -619,24 +630,15 @@ fn deadline_gaps(
 /// question `k` on; returns the call's instructions.
 fn cut_at(
     processor: &mut Processor<CAP, 2>,
-    (f1, f2, m): (&Frame<CAP, 2>, &Frame<CAP, 2>, &roadstereo::Motion),
+    pair: (&Frame<CAP, 2>, &Frame<CAP, 2>, &roadstereo::Motion),
     k: usize,
     times: &mut heapless::Vec<u32, MAX_QUESTIONS>,
 ) -> u32 {
-    processor.reset();
-    let _ = processor.process(f1, None);
-    let t0 = fw::ticks();
-    let mut clock = || {
-        let t = fw::ticks();
-        let _ = times.push(fw::instructions(t.saturating_sub(t0)));
+    let r = call_within(processor, pair, &mut |dt| {
+        let _ = times.push(fw::instructions(dt));
         times.len() > k
-    };
-    let (_, instr) = fw::measure(|| {
-        processor
-            .process_within(black_box(f2), Some(m), &mut clock)
-            .is_ok()
     });
-    instr
+    r.instr
 }
 
 /// An adversarial member's configuration: its error model (the id in

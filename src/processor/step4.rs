@@ -64,7 +64,7 @@ pub(super) fn match_boundary<const N: usize, D: Deadline>(
         // Under a deadline: the radial levels the band queries use built
         // between two questions, not inside the first point's search.
         if guard.check() {
-            expire(slots);
+            flag_pending(slots, Status::OverBudget);
             *work = credit;
             return;
         }
@@ -80,19 +80,6 @@ pub(super) fn match_boundary<const N: usize, D: Deadline>(
         }
     }
     *work = credit;
-}
-
-/// Every point still to be matched flagged [`Status::OverBudget`]: the
-/// caller's deadline has expired ([`crate::deadline`]).
-#[cold]
-#[inline(never)]
-pub(super) fn expire(slots: &mut [PointResult]) {
-    for r in slots
-        .iter_mut()
-        .filter(|r| r.status == Status::NoIntersection)
-    {
-        *r = PointResult::flagged(r.pixel1, Status::OverBudget);
-    }
 }
 
 /// The wedge path through an index's lean view ([`Index::lean`]): every
@@ -402,16 +389,18 @@ fn match_wedge_angular_reference<const N: usize>(
     }
 }
 
-/// Every point still to be matched flagged [`Status::NoIntersection`] (a
-/// clean result, step 1's values gone).
+/// Every point still to be matched flagged `status` (a clean result,
+/// step 1's values gone): [`Status::NoIntersection`] where frame 2 lacks
+/// the boundary, [`Status::OverBudget`] once the caller's deadline has
+/// expired ([`crate::deadline`]).
 #[cold]
 #[inline(never)]
-pub(super) fn unmatched(slots: &mut [PointResult]) {
+pub(super) fn flag_pending(slots: &mut [PointResult], status: Status) {
     for r in slots
         .iter_mut()
         .filter(|r| r.status == Status::NoIntersection)
     {
-        *r = PointResult::flagged(r.pixel1, Status::NoIntersection);
+        *r = PointResult::flagged(r.pixel1, status);
     }
 }
 

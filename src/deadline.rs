@@ -31,11 +31,18 @@
 //!   [`crate::Processor::process`] uses) nothing of this runs: the checks
 //!   are compiled out.
 //!
-//! Not checked inside: the stretches of a boundary between two questions
-//! (the certified step 1, the fold test's `O(1)` rules and its index
-//! build, the frame-2 keys, the frame-2 index build), each linear in the
-//! boundary's points; the bench measures the longest (README, "Within a
-//! deadline").
+//! - **No stretch between two questions grows with the boundary.** The
+//!   passes over a whole boundary (the certified step 1, the fold test's
+//!   `O(1)` rules, its index build and the envelopes' clearing, the
+//!   frame-2 keys and index build, the band path's radial levels) ask the
+//!   clock before every [`crate::search::CHUNK`] (32) items: the longest
+//!   stretch is one point's capped search or 32 items of the dearest pass
+//!   (the frame-2 index build's outlier test and FOE-near list, about 150
+//!   instructions an item), not a boundary's worth. What does grow with
+//!   `N` is the flags after the yes (one store a point) and the
+//!   questions themselves (about 1.2 a point). The bench measures the
+//!   lateness where it is worst at 2 × 256 and 2 × 512 (README, "Within a
+//!   deadline").
 //!
 //! **What the cap costs.** The cap holds even while the clock says no, so
 //! a point whose search needs more than `CARRY · w` units at once comes

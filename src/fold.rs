@@ -31,7 +31,7 @@
 use crate::deadline::{Deadline, Guard};
 use crate::math::{fmax, fmin};
 use crate::pencil::NO_KEY;
-use crate::search::{Index, KeyOrder, OutOfWork, Unkeyed, Work};
+use crate::search::{Index, KeyOrder, OutOfWork, Tick, Unkeyed, Work, CHUNK};
 use crate::structure::{PointResult, Status, FOLD_WINDOW};
 
 /// Step 2 for one boundary's points in `slots` (step 1's results: a point
@@ -55,24 +55,43 @@ pub(crate) fn step<const N: usize, D: Deadline>(
         work.grant(allowance.saturating_mul(n));
         return;
     }
-    if period <= 0.0 && by_hulls(slots, index.margins()) {
-        work.grant(allowance.saturating_mul(n));
-        return;
+    if period <= 0.0 {
+        match by_hulls(slots, index.margins(), || guard.check()) {
+            Hulls::Decided => {
+                work.grant(allowance.saturating_mul(n));
+                return;
+            }
+            // Out of time: the caller flags the points left.
+            Hulls::Stopped => return,
+            Hulls::Undecided => {}
+        }
     }
     let mut fold_index = index.builder((period, orient), Unkeyed::MeetNone);
-    fold_index.push_all_stored(slots.iter().map(|r| {
+    let key = |r: &PointResult| {
         if r.status == Status::NoIntersection {
             r.z_far
         } else {
             NO_KEY
         }
-    }));
-    if guard.check() {
-        // Out of time before the index is built: the caller flags the
-        // points left.
+    };
+    if D::NEVER {
+        fold_index.push_all_stored(slots.iter().map(key));
+    } else {
+        // Under a deadline, in parts of `CHUNK` points with the clock
+        // asked between them (out of time: the caller flags the points
+        // left).
+        for (c, part) in slots.chunks(CHUNK).enumerate() {
+            if c > 0 && guard.check() {
+                return;
+            }
+            fold_index.push_all_stored(part.iter().map(key));
+        }
+    }
+    let mut ask = || guard.check();
+    let mut tick: Tick = if D::NEVER { None } else { Some(&mut ask) };
+    if !fold_index.finish(None, &mut tick) {
         return;
     }
-    fold_index.finish(None);
     by_index(index, slots, allowance, work, guard);
 }
 
@@ -96,7 +115,10 @@ fn by_index<const N: usize, D: Deadline>(
         slots,
         (FOLD_WINDOW, allowance),
         work,
-        |w| guard.proceed(w),
+        |w: Option<&mut Work>| match w {
+            Some(w) => guard.proceed(w),
+            None => !guard.check(),
+        },
         |r| (r.status == Status::NoIntersection && r.z_far.is_finite()).then_some(r.z_far),
         |r, folds| match folds {
             Err(OutOfWork) => *r = PointResult::flagged(r.pixel1, Status::OverBudget),
@@ -106,26 +128,42 @@ fn by_index<const N: usize, D: Deadline>(
     );
 }
 
-/// Rule 2 on the processor's slots ([`folds_by_hulls`]); `false`, with
-/// nothing changed, when a point has no key.
-fn by_hulls(slots: &mut [PointResult], margins: &[f32]) -> bool {
+/// What [`folds_by_hulls`] came to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Hulls {
+    /// Every item tested.
+    Decided,
+    /// An item has no key (nothing changed): the index decides.
+    Undecided,
+    /// The caller's clock said the time is up: the items marked so far
+    /// fold, the others are untested.
+    Stopped,
+}
+
+/// Rule 2 on the processor's slots ([`folds_by_hulls`], `expired` its
+/// clock); [`Hulls::Undecided`], with nothing changed, when a point has no
+/// key. The points marked are flagged (also when the clock stopped the
+/// test: they do fold).
+fn by_hulls(slots: &mut [PointResult], margins: &[f32], expired: impl FnMut() -> bool) -> Hulls {
     let valid = |r: &PointResult| r.status == Status::NoIntersection;
     // Marked points keep their key (`z_far`) until both passes are done.
     let mark = |r: &mut PointResult| r.status = Status::Folded;
     let unmark = |r: &mut PointResult| r.status = Status::NoIntersection;
-    if !folds_by_hulls(
+    let hulls = folds_by_hulls(
         slots,
         margins,
         FOLD_WINDOW,
         (valid, |r| r.z_far),
         (mark, unmark),
-    ) {
-        return false;
+        expired,
+    );
+    if hulls == Hulls::Undecided {
+        return hulls;
     }
     for r in slots.iter_mut().filter(|r| r.status == Status::Folded) {
         *r = PointResult::flagged(r.pixel1, Status::Folded);
     }
-    true
+    hulls
 }
 
 /// The fold test ([`Index::folds`]'s answer) of every vertex of a
@@ -137,7 +175,11 @@ fn by_hulls(slots: &mut [PointResult], margins: &[f32]) -> bool {
 /// fewer margins than items, or an item is not valid, or its margin is not
 /// a number `≥ 0`, or its `k + e` is not finite (its key is not, or the sum
 /// overflows): then the items marked so far get `unmark` (which must make
-/// them valid again) and the index decides ([`Index::folds_all`]).
+/// them valid again) and the index decides ([`Index::folds_all`]):
+/// [`Hulls::Undecided`]. `expired` (the caller's clock) is asked before
+/// every [`CHUNK`] items of each pass: once it says yes the test stops,
+/// [`Hulls::Stopped`], the items marked so far marked (they fold: each
+/// pass marks only those that do).
 ///
 /// Vertex `i` folds when its widened key `[k − e, k + e]` meets the
 /// interval of a segment `j ≤ i − w − 1` or `j ≥ i + w` (segment `j` from
@@ -162,10 +204,11 @@ fn folds_by_hulls<T>(
     w: usize,
     (valid, key): (impl Fn(&T) -> bool, impl Fn(&T) -> f32),
     (mut mark, mut unmark): (impl FnMut(&mut T), impl FnMut(&mut T)),
-) -> bool {
+    mut expired: impl FnMut() -> bool,
+) -> Hulls {
     let n = items.len();
     if margins.len() < n {
-        return false;
+        return Hulls::Undecided;
     }
     let widened = |items: &[T], i: usize| match (items.get(i), margins.get(i)) {
         (Some(it), Some(&e)) => {
@@ -182,6 +225,9 @@ fn folds_by_hulls<T>(
     // test from i = w + 1 on.
     let mut hull = (f32::INFINITY, f32::NEG_INFINITY);
     for i in 0..n {
+        if i % CHUNK == CHUNK - 1 && expired() {
+            return Hulls::Stopped;
+        }
         let e = margins.get(i).copied().unwrap_or(f32::NAN);
         let checked = items.get(i).filter(|&it| valid(it)).map(&key);
         // (A NaN fails.)
@@ -192,7 +238,7 @@ fn folds_by_hulls<T>(
             for it in items.iter_mut().take(i).filter(|it| !valid(it)) {
                 unmark(it);
             }
-            return false;
+            return Hulls::Undecided;
         };
         let wi = (wi - e, wi + e);
         if let Some(v) = i.checked_sub(w) {
@@ -209,10 +255,13 @@ fn folds_by_hulls<T>(
     // and takes vertex i + w (< n − 1) at each tested i.
     let tested = n.saturating_sub(w.saturating_add(1));
     if tested == 0 {
-        return true;
+        return Hulls::Decided;
     }
     let mut hull = widened(items, n - 1);
     for i in (0..tested).rev() {
+        if i % CHUNK == 0 && expired() {
+            return Hulls::Stopped;
+        }
         hull = join(hull, widened(items, i + w));
         // (An item the forward pass marked is no longer `valid`.)
         if items.get(i).is_some_and(&valid) && meets(widened(items, i), hull) {
@@ -221,7 +270,7 @@ fn folds_by_hulls<T>(
             }
         }
     }
-    true
+    Hulls::Decided
 }
 
 #[cfg(test)]
@@ -238,7 +287,7 @@ mod tests {
     #[test]
     fn folds_by_hulls_equals_brute_force() {
         let mut rng = Rng(0xf01d_0003);
-        let (w, mut taken) = (4, 0);
+        let (w, mut taken, mut cuts) = (4, 0, 0);
         for case in 0..3000 {
             let shape = case % 5;
             let n = 1 + (rng.next() * (CAP - 1) as f32) as usize;
@@ -258,7 +307,35 @@ mod tests {
                 |it: &mut (f32, u32)| it.1 += 1,
                 |it: &mut (f32, u32)| it.1 -= 1,
             );
-            let took = folds_by_hulls(&mut items, &margins, w, (valid, |it| it.0), marks);
+            // Stopped by a clock after `q` questions first: every item
+            // marked then folds (the brute force's answer, below).
+            let q = case % 7;
+            let mut asked = 0;
+            let clock = || {
+                asked += 1;
+                asked > q
+            };
+            let mut cut = items.clone();
+            let stopped = folds_by_hulls(&mut cut, &margins, w, (valid, |it| it.0), marks, clock);
+            let took = folds_by_hulls(&mut items, &margins, w, (valid, |it| it.0), marks, || false)
+                == Hulls::Decided;
+            let brute = |i: usize, (k, e): (f32, f32)| {
+                ivs.iter().enumerate().any(|(j, iv)| {
+                    let outside = j + w < i || j > i + w - 1;
+                    outside && iv.is_some_and(|iv| meets(iv, (k - e, k + e), false))
+                })
+            };
+            if stopped == Hulls::Stopped {
+                cuts += 1;
+                for (i, (c, &k)) in cut.iter().zip(&ks).enumerate() {
+                    assert!(
+                        c.1 == 0 || brute(i, k),
+                        "case {case}: vertex {i} marked by a stopped test, does not fold"
+                    );
+                }
+            } else {
+                assert_eq!(cut, items, "case {case}: not stopped, the same marks");
+            }
             let all_keyed = ks.iter().all(|k| k.0.is_finite());
             assert_eq!(
                 took, all_keyed,
@@ -272,19 +349,16 @@ mod tests {
                 continue;
             }
             taken += 1;
-            for (i, (&(k, e), it)) in ks.iter().zip(&items).enumerate() {
-                let brute = ivs.iter().enumerate().any(|(j, iv)| {
-                    let outside = j + w < i || j > i + w - 1;
-                    outside && iv.is_some_and(|iv| meets(iv, (k - e, k + e), false))
-                });
+            for (i, (&k, it)) in ks.iter().zip(&items).enumerate() {
                 assert_eq!(
                     it.1,
-                    u32::from(brute),
+                    u32::from(brute(i, k)),
                     "case {case} (shape {shape}) vertex {i} of {n}"
                 );
             }
         }
         assert!(taken > 2000, "{taken} cases taken");
+        assert!(cuts > 500, "{cuts} cases stopped");
         // A window past every vertex (no run on either side): nothing
         // folds, and no index arithmetic overflows.
         let mut items: Vec<(f32, u32)> = (0..5).map(|i| ((i % 2) as f32, 0)).collect();
@@ -294,13 +368,10 @@ mod tests {
                 |it: &mut (f32, u32)| it.1 -= 1,
             );
             let valid = |it: &(f32, u32)| it.1 == 0;
-            assert!(folds_by_hulls(
-                &mut items,
-                &[0.5; 5],
-                w,
-                (valid, |it| it.0),
-                marks
-            ));
+            let r = folds_by_hulls(&mut items, &[0.5; 5], w, (valid, |it| it.0), marks, || {
+                false
+            });
+            assert_eq!(r, Hulls::Decided);
             assert!(items.iter().all(|it| it.1 == 0), "w = {w}: nothing folds");
         }
     }

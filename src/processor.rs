@@ -52,8 +52,8 @@ use crate::matching::{Outcome, Radial, Walker};
 use crate::motion::Motion;
 use crate::pencil::{half_key, Keying, Pencil, NO_KEY};
 use crate::search::{
-    run_start_in, Blocks, Builder, Flow, Index, KeyOrder, Lean, OutOfWork, Query, Unkeyed, Visitor,
-    Work, CLIP_UNITS,
+    expired, run_start_in, Blocks, Builder, Flow, Index, KeyOrder, Lean, OutOfWork, Query, Tick,
+    Unkeyed, Visitor, Work, CHUNK, CLIP_UNITS,
 };
 use crate::structure::{PointResult, ProcessError, Status, Step, Structure};
 use crate::wedge::{WVertex, Wedge, WedgeWalk, WedgeWalker};
@@ -356,12 +356,14 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 (Some(r1), Pencil::Half { foe, side, min_t }) => {
                     let ks = keying.key_scale;
                     let key = |p| half_key(p, (foe, side, min_t), ks);
-                    compensate_all_certified(&pair, r1, (slots, b1, margins), &mut order, key);
+                    let points = (&mut *slots, b1, &mut margins[..]);
+                    step1_certified(&pair, r1, points, &mut order, key, &mut guard);
                     r1_max = if slots.is_empty() { 0.0 } else { r1 };
                 }
                 (Some(r1), _) => {
                     let key = |p| keying.key(p);
-                    compensate_all_certified(&pair, r1, (slots, b1, margins), &mut order, key);
+                    let points = (&mut *slots, b1, &mut margins[..]);
+                    step1_certified(&pair, r1, points, &mut order, key, &mut guard);
                     r1_max = if slots.is_empty() { 0.0 } else { r1 };
                 }
                 (None, _) => {
@@ -429,14 +431,19 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 continue;
             };
             let near_foe = pair.near_foe(r1_max);
-            let builder = frame2_keys(index, &keying, b2, orient);
-            if guard.check() {
-                // The time ran out in the keys: the index left unbuilt.
+            // Under a deadline the clock is asked before every `CHUNK`
+            // vertices or segments of each pass of the build.
+            let mut ask = || guard.check();
+            let mut tick: Tick = if D::NEVER { None } else { Some(&mut ask) };
+            let built = frame2_keys(index, &keying, b2, orient, &mut tick).is_some_and(|builder| {
+                let radius = near_foe + 2.0 * (r1_max + pair.e2());
+                frame2_index(builder, &pair, &keying, b2, radius, &mut tick)
+            });
+            if !built {
+                // The time ran out in the build: the index unfit, unused.
                 flag_pending(slots, Status::OverBudget);
                 continue;
             }
-            let radius = near_foe + 2.0 * (r1_max + pair.e2());
-            frame2_index(builder, &pair, &keying, b2, radius);
             match_boundary(
                 &pair,
                 &keying,
@@ -671,6 +678,43 @@ fn compensate_point(
     }
 }
 
+/// Step 1 on a certified pair ([`compensate_all_certified`]); under a
+/// deadline in parts of [`CHUNK`] points with the clock asked between them
+/// (the key order followed on from part to part): once it says yes, the
+/// points not reached are `over_budget`.
+#[inline(always)]
+fn step1_certified<D: Deadline>(
+    pair: &Pair,
+    r1: f32,
+    (slots, b1, margins): (&mut [PointResult], &[Pixel], &mut [f32]),
+    order: &mut KeyOrder,
+    key: impl Fn([f32; 2]) -> (f32, f32),
+    guard: &mut Guard<'_, D>,
+) {
+    if D::NEVER {
+        return compensate_all_certified(pair, r1, (slots, b1, margins), order, key);
+    }
+    let mut parts = slots
+        .chunks_mut(CHUNK)
+        .zip(b1.chunks(CHUNK))
+        .zip(margins.chunks_mut(CHUNK));
+    // (The clock was asked just before the first part.)
+    let mut first = true;
+    while let Some(((s, b), m)) = parts.next() {
+        if !first && guard.check() {
+            let rest = core::iter::once((s, b)).chain(parts.by_ref().map(|(p, _)| p));
+            for (s, b) in rest {
+                for (slot, &p1) in s.iter_mut().zip(b) {
+                    *slot = PointResult::flagged(p1, Status::OverBudget);
+                }
+            }
+            return;
+        }
+        compensate_all_certified(pair, r1, (s, b, m), order, &key);
+        first = false;
+    }
+}
+
 /// Step 1 for every point of `b1` when the pair certifies the whole image
 /// ([`Pair::certified_r1`]): [`compensate_point`] without its checks (they
 /// pass), `r₁` the frame's, the keys from `key`; each point's key margin in
@@ -720,31 +764,49 @@ fn compensate_all_certified(
 /// the FOE along the line and `2 (r₁ + e₂)` across it ([`crate::depth`]).
 /// In two parts, the keys ([`frame2_keys`]) and the index from them
 /// ([`frame2_index`]), so that a deadline can be asked in between.
+/// `None` when `tick`'s clock stopped the keys (asked between parts of
+/// [`CHUNK`] vertices; the builder takes each part where the last one
+/// ended).
 fn frame2_keys<'a, const N: usize>(
     index: &'a mut Index<N>,
     keying: &Keying,
     b2: &[Pixel],
     orient: f32,
-) -> Builder<'a, N> {
+    tick: &mut Tick<'_>,
+) -> Option<Builder<'a, N>> {
     let mut builder = index.builder((keying.period, orient), Unkeyed::MeetAll);
-    match keying.pencil {
-        Pencil::Half { foe, side, min_t } => {
-            let ks = keying.key_scale;
-            builder.push_all(b2.iter().map(|p| half_key(p.arr(), (foe, side, min_t), ks)));
+    // (Without a clock one part: the whole polyline.)
+    let part = if tick.is_some() {
+        CHUNK
+    } else {
+        b2.len().max(1)
+    };
+    // (The clock was asked just before the first part.)
+    for (c, b2) in b2.chunks(part).enumerate() {
+        if c > 0 && expired(tick) {
+            return None;
         }
-        _ => builder.push_all(b2.iter().map(|p| keying.key(p.arr()))),
+        match keying.pencil {
+            Pencil::Half { foe, side, min_t } => {
+                let ks = keying.key_scale;
+                builder.push_all(b2.iter().map(|p| half_key(p.arr(), (foe, side, min_t), ks)));
+            }
+            _ => builder.push_all(b2.iter().map(|p| keying.key(p.arr()))),
+        }
     }
-    builder
+    Some(builder)
 }
 
-/// The second part of step 3 ([`frame2_keys`]).
+/// The second part of step 3 ([`frame2_keys`]); `false` when `tick`'s
+/// clock stopped the build ([`Builder::finish`]).
 fn frame2_index<const N: usize>(
     builder: Builder<'_, N>,
     pair: &Pair,
     keying: &Keying,
     b2: &[Pixel],
     radius: f32,
-) {
+    tick: &mut Tick<'_>,
+) -> bool {
     let foe = pair.foe.filter(|_| pair.geom.w() < 0.0 && keying.angular());
     match foe {
         Some(f) => {
@@ -752,9 +814,9 @@ fn frame2_index<const N: usize>(
                 (Some(a), Some(b)) => segment_distance2(f, a.arr(), b.arr()) <= radius * radius,
                 _ => false,
             };
-            builder.finish(Some(&is_near));
+            builder.finish(Some(&is_near), tick)
         }
-        None => builder.finish(None),
+        None => builder.finish(None, tick),
     }
 }
 
@@ -976,7 +1038,7 @@ mod tests {
         let mut index = Index::<64>::new();
         let mut builder = index.builder((0.0, 1.0), Unkeyed::MeetAll);
         builder.push_all(b2.iter().map(key));
-        builder.finish(None);
+        builder.finish(None, &mut None);
         let lean = index.lean();
         assert_eq!(
             lean.aside.len(),

@@ -63,12 +63,15 @@ pub(super) fn match_boundary<const N: usize, D: Deadline>(
     if !D::NEVER && matcher == Matcher::Indexed && matches!(keying.pencil, Pencil::Half { .. }) {
         // Under a deadline: the radial levels the band queries use built
         // between two questions, not inside the first point's search.
-        if guard.check() {
+        let mut ask = || guard.check();
+        if !ask() {
+            index.build_radial_once(b2, &mut Some(&mut ask));
+        }
+        if guard.has_expired() {
             flag_pending(slots, Status::OverBudget);
             *work = credit;
             return;
         }
-        index.build_radial_once(b2);
     }
     for r in slots.iter_mut() {
         if r.status == Status::NoIntersection {

@@ -42,32 +42,47 @@ impl<const N: usize> Index<N> {
     }
 
     /// The suffix minima `sm`; whether somewhere the envelopes are more
-    /// than `wide` apart.
-    fn suffix_minima(&mut self, wide: f32) -> bool {
+    /// than `wide` apart (`None`: `tick`'s clock stopped the pass).
+    fn suffix_minima(&mut self, wide: f32, tick: &mut Tick<'_>) -> Option<bool> {
         let s = self.segments;
         let Some(seg) = self.seg.get_mut(..s) else {
-            return false;
+            return Some(false);
         };
         let (mut run, mut gap) = (f32::INFINITY, f32::NEG_INFINITY);
-        for g in seg.iter_mut().rev() {
+        let mut one = |g: &mut Seg| {
             run = fmin(run, g.lo);
             g.sm = run;
             gap = fmax(gap, g.pm - run);
+        };
+        match tick {
+            None => seg.iter_mut().rev().for_each(&mut one),
+            Some(t) => {
+                for (c, part) in seg.rchunks_mut(CHUNK).enumerate() {
+                    if c > 0 && t() {
+                        return None;
+                    }
+                    part.iter_mut().rev().for_each(&mut one);
+                }
+            }
         }
         // (A NaN gap fails: loose.)
-        !(gap <= wide)
+        Some(!(gap <= wide))
     }
 
     /// The slow path of [`Self::build`]: orient the intervals as `orient`,
     /// set aside the unkeyed segments and those of outlying vertices, and
-    /// rebuild the envelopes without them.
-    fn rebuild(&mut self, orient: f32, wide: f32) {
+    /// rebuild the envelopes without them; `false` when `tick`'s clock
+    /// stopped it (the index then unfit for queries).
+    fn rebuild(&mut self, orient: f32, wide: f32, tick: &mut Tick<'_>) -> bool {
         let s = self.segments;
         let Some(seg) = self.seg.get_mut(..s) else {
-            return;
+            return true;
         };
         if orient != self.orient {
-            for g in seg.iter_mut() {
+            for (j, g) in seg.iter_mut().enumerate() {
+                if j % CHUNK == CHUNK - 1 && expired(tick) {
+                    return false;
+                }
                 (g.lo, g.hi) = (-g.hi, -g.lo);
             }
             self.orient = orient;
@@ -88,6 +103,9 @@ impl<const N: usize> Index<N> {
                 .map_or((f32::INFINITY, f32::NEG_INFINITY), |x| (x.lo, x.hi))
         };
         for (j, g) in seg.iter().enumerate() {
+            if j % CHUNK == CHUNK - 1 && expired(tick) {
+                return false;
+            }
             let all = g.lo == f32::NEG_INFINITY;
             let out = g.lo.is_finite() && g.hi.is_finite() && {
                 let (bl, bh) = j
@@ -110,24 +128,29 @@ impl<const N: usize> Index<N> {
         }
         self.aside = aside;
         let Some(seg) = self.seg.get_mut(..s) else {
-            return;
+            return true;
         };
         let mut run = f32::NEG_INFINITY;
-        for g in seg.iter_mut() {
+        for (j, g) in seg.iter_mut().enumerate() {
+            if j % CHUNK == CHUNK - 1 && expired(tick) {
+                return false;
+            }
             run = fmax(run, g.hi);
             g.pm = run;
         }
         // The block tree for runs through the rebuilt envelopes, when they
         // are still loose (tight runs are short: no tree needed).
-        self.loose = self.suffix_minima(wide);
-        if self.loose {
-            self.build_tree();
-        }
+        let Some(loose) = self.suffix_minima(wide, tick) else {
+            return false;
+        };
+        self.loose = loose;
+        !loose || self.build_tree(tick)
     }
 
     /// The block tree over the current intervals (module docs): the key
-    /// levels, `(min lo, max hi)` of each block ([`build_levels`]).
-    fn build_tree(&mut self) {
+    /// levels, `(min lo, max hi)` of each block ([`build_levels`]); `false`
+    /// when `tick`'s clock stopped it.
+    fn build_tree(&mut self, tick: &mut Tick<'_>) -> bool {
         let s = self.segments;
         let seg = &self.seg;
         let leaf = |c0: usize, c1: usize| {
@@ -137,7 +160,13 @@ impl<const N: usize> Index<N> {
             }
             q
         };
-        (self.levels, self.tree_end) = build_levels(&mut self.tree, s, 0, leaf);
+        match build_levels(&mut self.tree, s, 0, leaf, tick) {
+            Some(built) => {
+                (self.levels, self.tree_end) = built;
+                true
+            }
+            None => false,
+        }
     }
 
     /// The block tree's radial levels (module docs) for the polyline `b`
@@ -145,8 +174,9 @@ impl<const N: usize> Index<N> {
     /// of each block's intervals and `(min v, max v)` of its vertices'
     /// rows (the `FAN^l + 1` vertices of its segments) ([`build_levels`]).
     /// Built once until the next build of the index; none when `b` is not
-    /// this index's polyline.
-    pub(super) fn build_radial(&mut self, b: &[crate::camera::Pixel]) {
+    /// this index's polyline, or when `tick`'s clock stops the build (the
+    /// queries then go without them).
+    pub(super) fn build_radial(&mut self, b: &[crate::camera::Pixel], tick: &mut Tick<'_>) {
         self.radial_levels = 0;
         let s = self.segments;
         if s == 0 || b.len() != s + 1 {
@@ -175,7 +205,9 @@ impl<const N: usize> Index<N> {
             }
             q
         };
-        let (levels, _) = build_levels(&mut self.tree, s, self.tree_end, leaf);
+        let Some((levels, _)) = build_levels(&mut self.tree, s, self.tree_end, leaf, tick) else {
+            return;
+        };
         // (`levels` ≤ LEVELS = 4.)
         self.radial_levels = u8::try_from(levels).unwrap_or(0);
     }
@@ -190,13 +222,15 @@ impl<const N: usize> Index<N> {
 /// of one block; returns how many were built and where the last one ends.
 /// Every loop is bounded by the array or by the blocks of the level below;
 /// an entry that cannot be read counts as the widest (`−∞` at even places,
-/// `∞` at odd ones).
+/// `∞` at odd ones). `None` when `tick`'s clock stopped it (asked before
+/// every `CHUNK / FAN` blocks: about `CHUNK` segments' or blocks' work).
 fn build_levels<const W: usize>(
     tree: &mut [f32],
     s: usize,
     mut base: usize,
     leaf: impl Fn(usize, usize) -> [f32; W],
-) -> (usize, usize) {
+    tick: &mut Tick<'_>,
+) -> Option<(usize, usize)> {
     let (mut built, mut end_of) = (0usize, base);
     let (mut below_base, mut below_n, mut size) = (0usize, s, 1usize);
     for level in 1..=LEVELS {
@@ -206,6 +240,9 @@ fn build_levels<const W: usize>(
             break;
         };
         for k in 0..n {
+            if k % (CHUNK / FAN) == CHUNK / FAN - 1 && expired(tick) {
+                return None;
+            }
             let q = if level == 1 {
                 leaf(k * FAN, ((k + 1) * FAN).min(s))
             } else {
@@ -243,7 +280,7 @@ fn build_levels<const W: usize>(
             break;
         }
     }
-    (built, end_of)
+    Some((built, end_of))
 }
 
 /// Whether the widened keys of a polyline's vertices, in order, each lie
@@ -357,30 +394,39 @@ impl<const N: usize> Builder<'_, N> {
     /// a lean loop writes the intervals and prefix maxima (the values
     /// [`Self::push_stored`] gives) without the key-order test (the index
     /// is then not [`Index::strict`], a shortcut of the fold test only);
-    /// from the first vertex it cannot take on, [`Self::push_stored`].
+    /// from the first vertex it cannot take on, [`Self::push_stored`]. A
+    /// polyline may come in parts (a caller's deadline asked between them):
+    /// a part that follows a finite key goes on in the lean loop, with the
+    /// same values one call would give.
     #[inline(always)]
     fn push_run(&mut self, mut next: impl FnMut(&mut f32) -> Option<f32>) {
         let mut pending = None;
-        if self.n == 0 && self.period <= 0.0 {
-            let Some(raw) = self.index.margin.first_mut().and_then(&mut next) else {
-                return;
-            };
-            self.push_stored(raw);
-            let k = self.o * raw;
-            let (Some(&e), true) = (self.index.margin.first(), k.is_finite()) else {
+        if self.period <= 0.0 {
+            if self.n == 0 {
+                let Some(raw) = self.index.margin.first_mut().and_then(&mut next) else {
+                    return;
+                };
+                self.push_stored(raw);
+            }
+            // The last vertex's oriented key and margin (`push_stored`
+            // keeps the key in the order tracker, the lean loop below too).
+            let n0 = self.n;
+            let k = self.order.prev;
+            let last = n0.checked_sub(1).and_then(|i| self.index.margin.get(i));
+            let (Some(&e), true) = (last, k.is_finite()) else {
                 return self.push_rest(next);
             };
             let o = self.o;
             let (mut prev, mut plo, mut phi) = (k, k - e, k + e);
             let (mut run, mut sum) = (self.run, self.sum);
-            let mut n = 1usize;
-            let slots = self
+            let mut n = n0;
+            let margins = self.index.margin.get_mut(n0..).unwrap_or_default();
+            let segs = self
                 .index
-                .margin
-                .iter_mut()
-                .skip(1)
-                .zip(self.index.seg.iter_mut());
-            for (m, g) in slots {
+                .seg
+                .get_mut(n0.saturating_sub(1)..)
+                .unwrap_or_default();
+            for (m, g) in margins.iter_mut().zip(segs.iter_mut()) {
                 let Some(raw) = next(m) else {
                     break;
                 };
@@ -399,7 +445,7 @@ impl<const N: usize> Builder<'_, N> {
                 (prev, plo, phi) = (k, vlo, vhi);
                 n += 1;
             }
-            if n > 1 {
+            if n > n0 {
                 self.order = KeyOrder {
                     prev,
                     plo,
@@ -407,7 +453,7 @@ impl<const N: usize> Builder<'_, N> {
                     first: false,
                     up: false,
                     down: false,
-                    odd: false,
+                    odd: self.order.odd,
                 };
                 (self.n, self.run, self.sum, self.last) = (n, run, sum, prev);
             }
@@ -503,8 +549,9 @@ impl<const N: usize> Builder<'_, N> {
 
     /// Pass 2 and, when needed, the slow path (module docs); `near(j)`
     /// says whether segment `j` comes within the FOE-near radius (frame 2
-    /// with `W' < 0`; `None` otherwise).
-    pub(crate) fn finish(self, near: Option<&dyn Fn(usize) -> bool>) {
+    /// with `W' < 0`; `None` otherwise). `false` when `tick`'s clock
+    /// stopped a pass ([`Tick`]): the index is then unfit for queries.
+    pub(crate) fn finish(self, near: Option<&dyn Fn(usize) -> bool>, tick: &mut Tick<'_>) -> bool {
         let Builder {
             index,
             o,
@@ -524,10 +571,12 @@ impl<const N: usize> Builder<'_, N> {
         let flip = last < first;
         index.orient = o;
         let wide = WIDE * sum / fmax(s as f32, 1.0);
-        let loose = index.suffix_minima(wide);
+        let Some(loose) = index.suffix_minima(wide, tick) else {
+            return false;
+        };
         index.loose = loose;
-        if loose || odd || flip {
-            index.rebuild(if flip { -o } else { o }, wide);
+        if (loose || odd || flip) && !index.rebuild(if flip { -o } else { o }, wide, tick) {
+            return false;
         }
         index.kmin = index.seg.first().map_or(f32::INFINITY, |g| g.sm);
         index.kmax = index
@@ -542,6 +591,9 @@ impl<const N: usize> Builder<'_, N> {
         }
         if let Some(is_near) = near {
             for j in 0..s {
+                if j % CHUNK == CHUNK - 1 && expired(tick) {
+                    return false;
+                }
                 if is_near(j) {
                     match u16::try_from(j).ok().map(|jj| index.near.push(jj)) {
                         Some(Ok(())) => {}
@@ -550,5 +602,6 @@ impl<const N: usize> Builder<'_, N> {
                 }
             }
         }
+        true
     }
 }

@@ -131,7 +131,7 @@ impl<const N: usize> Index<N> {
     pub(super) fn radial_for(&mut self, quick: Option<(Radial, &[Pixel])>) -> Option<Radial> {
         let (rad, b) = quick?;
         if self.radial_levels == UNBUILT {
-            self.build_radial(b);
+            self.build_radial(b, &mut None);
         }
         (self.radial_levels > 0).then_some(rad)
     }
@@ -140,10 +140,12 @@ impl<const N: usize> Index<N> {
     /// ([`Self::build_radial`]; the same levels the first band query with
     /// a radial test would build). Under a caller's deadline the band path
     /// builds them before its first point, so that the build and that
-    /// point's search are two stretches between the clock's questions.
-    pub(crate) fn build_radial_once(&mut self, b: &[Pixel]) {
+    /// point's search are two stretches between the clock's questions,
+    /// and the build asks `tick` too (if its clock stops the build, the
+    /// index has no radial levels).
+    pub(crate) fn build_radial_once(&mut self, b: &[Pixel], tick: &mut Tick<'_>) {
         if self.radial_levels == UNBUILT {
-            self.build_radial(b);
+            self.build_radial(b, tick);
         }
     }
 

@@ -123,6 +123,27 @@ const LEVELS: usize = 4;
 /// `Index::radial_levels` before the radial levels are built.
 const UNBUILT: u8 = u8::MAX;
 
+/// The caller's clock inside a pass over a polyline ([`crate::deadline`]):
+/// asked before every [`CHUNK`] items of each pass of a build, so that no
+/// stretch between two questions grows with the polyline; `None` without
+/// a deadline. A pass it stops leaves the index unfit for queries (the
+/// caller flags the points instead and builds it anew for the next
+/// boundary).
+pub(crate) type Tick<'t> = Option<&'t mut dyn FnMut() -> bool>;
+
+/// Items (vertices, segments, blocks) a pass handles between two
+/// questions of the clock ([`Tick`]).
+pub(crate) const CHUNK: usize = 64;
+
+/// Whether `tick`'s clock says the time is up (never without one).
+#[inline(always)]
+pub(crate) fn expired(tick: &mut Tick<'_>) -> bool {
+    match tick {
+        Some(t) => t(),
+        None => false,
+    }
+}
+
 /// The looseness of the envelopes (in average interval widths) that makes
 /// the build look for outliers, and how far an outlier's interval reaches
 /// beyond its neighbours'.

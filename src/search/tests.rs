@@ -149,7 +149,7 @@ fn visit_offers_every_segment_that_meets_the_query() {
                 b.push(k, e);
             }
         }
-        b.finish(None);
+        b.finish(None, &mut None);
         let ivs = intervals(&ks, period);
         for _ in 0..8 {
             let c = if period {
@@ -210,7 +210,7 @@ fn folds_equals_brute_force() {
                 b.push(k, e);
             }
         }
-        b.finish(None);
+        b.finish(None, &mut None);
         let ivs = intervals(&ks, period);
         for (i, &(k, e)) in ks.iter().enumerate() {
             if !k.is_finite() {
@@ -241,7 +241,7 @@ fn lean_copy_picks_the_single_copy() {
     let mut index = Index::<16>::new();
     let mut b = index.builder((4.0, 1.0), Unkeyed::MeetAll);
     b.push_all([0.5f32, 1.5, 2.5, 3.5, 3.9].iter().map(|&k| (k, 0.0)));
-    b.finish(None);
+    b.finish(None, &mut None);
     let lean = index.lean();
     let none = Some((f32::NEG_INFINITY, f32::NEG_INFINITY));
     // (The unwrapped keys start at some whole number of turns.)
@@ -258,7 +258,7 @@ fn lean_copy_picks_the_single_copy() {
     let mut b = wound.builder((4.0, 1.0), Unkeyed::MeetAll);
     // Nine turns at 1.5 a step: a query meets many copies.
     b.push_all((0..26).map(|i| ((1.5 * i as f32) % 4.0, 0.0)));
-    b.finish(None);
+    b.finish(None, &mut None);
     let lean = wound.lean();
     assert!(lean.range.1 - lean.range.0 > 36.0, "{:?}", lean.range);
     assert_eq!(lean.copy(1.0, 1.1), None, "many copies");
@@ -306,7 +306,7 @@ fn lean_copy_picks_the_single_copy() {
     let mut flat = Index::<16>::new();
     let mut b = flat.builder((0.0, 1.0), Unkeyed::MeetAll);
     b.push_all([0.1f32, 0.2, 0.3].iter().map(|&k| (k, 0.0)));
-    b.finish(None);
+    b.finish(None, &mut None);
     assert_eq!(flat.lean().copy(5.0, 6.0), Some((5.0, 6.0)));
 }
 
@@ -322,7 +322,7 @@ fn a_segment_half_a_turn_long_meets_every_key() {
         let mut index = Index::<8>::new();
         let mut builder = index.builder((4.0, 1.0), Unkeyed::MeetAll);
         builder.push_all([(a, 1.0e-5), (b, 1.0e-5)].into_iter());
-        builder.finish(None);
+        builder.finish(None, &mut None);
         let mid = 0.5 * (a + b);
         let mut seen = Record {
             seen: [false; CAP],
@@ -338,4 +338,74 @@ fn a_segment_half_a_turn_long_meets_every_key() {
             "({a}, {b}): the segment was not offered for key {mid}"
         );
     }
+}
+
+/// A polyline pushed in parts (as under a caller's deadline, the clock
+/// asked between them) and built with a clock that never says yes gives
+/// the index one push and no clock give, field for field, whatever the
+/// shape of the keys and the parts' sizes; a clock that says yes stops
+/// the build at its first yes (`finish` then `false`), asked no more.
+#[test]
+fn a_build_in_parts_or_with_a_clock_is_the_same_build() {
+    let mut rng = Rng(0xc4a2_0001);
+    let (mut stopped, mut built) = (0, 0);
+    for case in 0..3000 {
+        let (shape, period) = (case % 5, case % 3 == 0);
+        let n = 2 + (rng.next() * (CAP - 2) as f32) as usize;
+        let ks = keys(&mut rng, shape, n, period);
+        let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+        let unkeyed = if case % 2 == 0 {
+            Unkeyed::MeetAll
+        } else {
+            Unkeyed::MeetNone
+        };
+        let p = if period { 4.0 } else { 0.0 };
+        let near = |j: usize| j % 7 == 3;
+        let near = (case % 4 == 0).then_some(&near as &dyn Fn(usize) -> bool);
+        let mut whole = Index::<CAP>::new();
+        let mut b = whole.builder((p, orient), unkeyed);
+        b.push_all(ks.iter().copied());
+        assert!(b.finish(near, &mut None));
+        let mut parts = Index::<CAP>::new();
+        let mut b = parts.builder((p, orient), unkeyed);
+        let mut rest = &ks[..];
+        while !rest.is_empty() {
+            let k = (1 + (rng.next() * 40.0) as usize).min(rest.len());
+            b.push_all(rest[..k].iter().copied());
+            rest = &rest[k..];
+        }
+        let mut asked = 0usize;
+        let mut never = || {
+            asked += 1;
+            false
+        };
+        assert!(b.finish(near, &mut Some(&mut never)));
+        assert_eq!(
+            std::format!("{whole:?}"),
+            std::format!("{parts:?}"),
+            "case {case} (shape {shape}, period {period})"
+        );
+        // Stopped at a question of the build.
+        let q = (rng.next() * (asked + 1) as f32) as usize;
+        let mut cut = Index::<CAP>::new();
+        let mut b = cut.builder((p, orient), unkeyed);
+        b.push_all(ks.iter().copied());
+        let mut seen = 0usize;
+        let mut clock = || {
+            seen += 1;
+            seen > q
+        };
+        let done = b.finish(near, &mut Some(&mut clock));
+        assert_eq!(done, q >= asked, "case {case}: q = {q} of {asked}");
+        assert_eq!(seen, (q + 1).min(asked), "case {case}: asked after the yes");
+        if done {
+            built += 1;
+        } else {
+            stopped += 1;
+        }
+    }
+    assert!(
+        stopped > 500 && built > 50,
+        "{stopped} stopped, {built} built"
+    );
 }

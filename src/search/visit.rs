@@ -47,16 +47,19 @@ impl<const N: usize> Index<N> {
     /// one. Without a period and with nothing aside, the envelopes' `O(1)`
     /// answer ([`Self::may_fold`]) is taken in the loop itself, and only the
     /// vertices it cannot clear go through [`Self::folds`]. Before each
-    /// query `proceed` is asked (the caller's deadline,
+    /// query `proceed(Some(work))` is asked (the caller's deadline,
     /// [`crate::deadline::Guard::proceed`]): `false` answers
-    /// [`OutOfWork`] without a query.
+    /// [`OutOfWork`] without a query. In the loop that clears vertices by
+    /// the envelopes, `proceed(None)` is also asked before every
+    /// [`CHUNK`] vertices (whether the time is not up yet): `false` stops
+    /// the loop, the items from there on left as they are.
     #[inline(always)]
     pub(crate) fn folds_all<T>(
         &mut self,
         items: &mut [T],
         (w, allowance): (usize, u32),
         work: &mut Work,
-        mut proceed: impl FnMut(&mut Work) -> bool,
+        mut proceed: impl FnMut(Option<&mut Work>) -> bool,
         key: impl Fn(&T) -> Option<f32>,
         mut flag: impl FnMut(&mut T, Result<bool, OutOfWork>),
     ) {
@@ -67,7 +70,7 @@ impl<const N: usize> Index<N> {
                 let Some(k) = key(it) else {
                     continue;
                 };
-                let r = if proceed(work) {
+                let r = if proceed(Some(work)) {
                     self.folds(i, k, w, work)
                 } else {
                     Err(OutOfWork)
@@ -82,6 +85,9 @@ impl<const N: usize> Index<N> {
         // each query sees is the one granting item by item gives).
         let mut owed = 0u32;
         for (i, it) in items.iter_mut().enumerate() {
+            if i % CHUNK == CHUNK - 1 && !proceed(None) {
+                break;
+            }
             owed = owed.saturating_add(allowance);
             let Some(k) = key(it) else {
                 continue;
@@ -97,7 +103,7 @@ impl<const N: usize> Index<N> {
             }
             work.grant(owed);
             owed = 0;
-            let r = if !proceed(work) {
+            let r = if !proceed(Some(work)) {
                 Err(OutOfWork)
             } else if self.strict {
                 self.folds(i, k, w, work)

@@ -22,27 +22,27 @@
 //!   later points, but no single point can spend the whole frame's savings
 //!   at once, which is what makes its cost bounded by a constant (`C_P +
 //!   C_U · CARRY · w` instructions in the terms of README's "Worst case")
-//!   rather than by the frame's size. (The first point on the band path
-//!   also builds the index's radial levels, linear in the boundary.)
+//!   rather than by the frame's size. (Before the first point, the band
+//!   path builds the index's radial levels, asking the clock as below.)
 //! - **Every other point costs a flag**: a store of a flagged result.
 //! - **Nothing is left half done**: every point is either a complete
 //!   result (the same checks as without a deadline: a stick that holds) or
 //!   flagged. Without a deadline ([`NoDeadline`], what
 //!   [`crate::Processor::process`] uses) nothing of this runs: the checks
 //!   are compiled out.
-//!
 //! - **No stretch between two questions grows with the boundary.** The
 //!   passes over a whole boundary (the certified step 1, the fold test's
-//!   `O(1)` rules, its index build and the envelopes' clearing, the
+//!   rule from the keys, its index build and the envelopes' clearing, the
 //!   frame-2 keys and index build, the band path's radial levels) ask the
-//!   clock before every [`crate::search::CHUNK`] (32) items: the longest
-//!   stretch is one point's capped search or 32 items of the dearest pass
-//!   (the frame-2 index build's outlier test and FOE-near list, about 150
-//!   instructions an item), not a boundary's worth. What does grow with
-//!   `N` is the flags after the yes (one store a point) and the
-//!   questions themselves (about 1.2 a point). The bench measures the
-//!   lateness where it is worst at 2 × 256 and 2 × 512 (README, "Within a
-//!   deadline").
+//!   clock between parts of 64 items (`search::CHUNK`); a pass
+//!   it stops leaves its index unused and the boundary's points flagged.
+//!   So the longest stretch is one point's capped search, or up to 64
+//!   items of each of a boundary's few passes (a few thousand
+//!   instructions), not a boundary's worth. What does grow with `N` is
+//!   the flags after the yes (one store a point) and the number of
+//!   questions. The bench measures the lateness where it is worst at
+//!   2 × 256 and 2 × 512 (README, "Within a deadline": 27 770 and 35 737
+//!   instructions; 51 051 and 101 082 before these questions).
 //!
 //! **What the cap costs.** The cap holds even while the clock says no, so
 //! a point whose search needs more than `CARRY · w` units at once comes

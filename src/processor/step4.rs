@@ -62,7 +62,8 @@ pub(super) fn match_boundary<const N: usize, D: Deadline>(
     }
     if !D::NEVER && matcher == Matcher::Indexed && matches!(keying.pencil, Pencil::Half { .. }) {
         // Under a deadline: the radial levels the band queries use built
-        // between two questions, not inside the first point's search.
+        // before the first point's search, not inside it, the clock asked
+        // before and during the build (between parts of `CHUNK` blocks).
         let mut ask = || guard.check();
         if !ask() {
             index.build_radial_once(b2, &mut Some(&mut ask));

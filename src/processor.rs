@@ -101,9 +101,6 @@ pub struct Processor<const N: usize, const B: usize> {
     /// `has_previous`'s padding).
     #[cfg(any(test, feature = "_reference"))]
     fold_test: bool,
-    /// Whether the deadline of the last reconstruction expired before it
-    /// finished (in the same padding).
-    expired: bool,
     index: Index<N>,
     output: Structure<N, B>,
 }
@@ -117,7 +114,6 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             has_previous: false,
             #[cfg(any(test, feature = "_reference"))]
             fold_test: true,
-            expired: false,
             index: Index::new(),
             output: Structure::EMPTY,
         }
@@ -153,7 +149,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     /// Forget the previous frame (e.g. after a camera reset).
     pub fn reset(&mut self) {
         self.has_previous = false;
-        self.expired = false;
+        self.output.cut = false;
     }
 
     /// Process the next frame with the motion from the previous one.
@@ -189,11 +185,11 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         if !self.has_previous {
             self.previous.assign(frame);
             self.has_previous = true;
-            self.expired = false;
+            self.output.cut = false;
             return Ok(Step::First);
         }
         let motion = motion.ok_or(ProcessError::MissingMotion)?;
-        self.expired = self.reconstruct(frame, motion, Matcher::Indexed, deadline);
+        self.reconstruct(frame, motion, Matcher::Indexed, deadline);
         self.previous.assign(frame);
         Ok(Step::Structure(&self.output))
     }
@@ -204,7 +200,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     /// [`Status::OverBudget`]. Always `false` after [`Self::process`] and
     /// [`Self::process_against_kept`].
     pub fn deadline_expired(&self) -> bool {
-        self.expired
+        self.output.cut
     }
 
     /// Reconstruct `frame` against the kept frame *without replacing it*,
@@ -235,7 +231,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         if !self.has_previous {
             return Err(ProcessError::NoKeptFrame);
         }
-        self.expired = self.reconstruct(frame, motion, Matcher::Indexed, deadline);
+        self.reconstruct(frame, motion, Matcher::Indexed, deadline);
         Ok(&self.output)
     }
 
@@ -261,7 +257,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         if !self.has_previous {
             return Err(ProcessError::NoKeptFrame);
         }
-        self.expired = self.reconstruct(frame, motion, Matcher::Reference, &mut NoDeadline);
+        self.reconstruct(frame, motion, Matcher::Reference, &mut NoDeadline);
         Ok(&self.output)
     }
 
@@ -293,20 +289,21 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             Matcher::Indexed
         };
         self.fold_test = false;
-        self.expired = self.reconstruct(frame, motion, matcher, &mut NoDeadline);
+        self.reconstruct(frame, motion, matcher, &mut NoDeadline);
         self.fold_test = true;
         Ok(&self.output)
     }
 
     /// Steps 1–4 of the module docs for every boundary of the kept frame;
-    /// whether `deadline` expired before they were done.
+    /// whether `deadline` expired before they were done goes into the
+    /// output ([`Structure::deadline_expired`]).
     fn reconstruct<D: Deadline>(
         &mut self,
         frame: &Frame<N, B>,
         motion: &Motion,
         matcher: Matcher,
         deadline: &mut D,
-    ) -> bool {
+    ) {
         #[cfg(any(test, feature = "_reference"))]
         let fold_test = self.fold_test;
         let Self {
@@ -318,7 +315,8 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         } = self;
         let pair = Pair::new(config, previous.camera(), frame.camera(), motion);
         output.camera1 = *previous.camera();
-        output.count = previous.boundaries().len();
+        // (At most `B`, below 2¹⁶: `Structure::EMPTY`.)
+        output.count = u16::try_from(previous.boundaries().len()).unwrap_or(u16::MAX);
         let mut work = Work::new();
         let mut guard = Guard::new(deadline, config.work_per_point);
         for (k, (b1, out)) in previous
@@ -456,7 +454,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         }
         guard.settle(&mut work);
         output.work = work.usage();
-        guard.has_expired()
+        output.cut = guard.has_expired();
     }
 }
 

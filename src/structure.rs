@@ -256,7 +256,12 @@ impl<const N: usize> BoundaryStructure<N> {
 pub struct Structure<const N: usize, const B: usize> {
     pub(crate) camera1: Camera,
     pub(crate) slots: [BoundaryStructure<N>; B],
-    pub(crate) count: usize,
+    /// Live boundaries (at most `B`, below 2¹⁶: [`Self::EMPTY`]'s check),
+    /// and beside it in the same word whether the caller's deadline cut
+    /// the reconstruction short ([`Structure::deadline_expired`]): the
+    /// flag costs no byte.
+    pub(crate) count: u16,
+    pub(crate) cut: bool,
     /// Work units spent and granted ([`Structure::work_units`]).
     pub(crate) work: (u32, u32),
 }
@@ -289,16 +294,20 @@ impl<const N: usize, const B: usize> defmt::Format for Structure<N, B> {
 }
 
 impl<const N: usize, const B: usize> Structure<N, B> {
-    pub(crate) const EMPTY: Self = Self {
-        camera1: Camera::PLACEHOLDER,
-        slots: [BoundaryStructure::EMPTY; B],
-        count: 0,
-        work: (0, 0),
+    pub(crate) const EMPTY: Self = {
+        assert!(B <= u16::MAX as usize, "at most 65 535 boundaries");
+        Self {
+            camera1: Camera::PLACEHOLDER,
+            slots: [BoundaryStructure::EMPTY; B],
+            count: 0,
+            cut: false,
+            work: (0, 0),
+        }
     };
 
     /// Per-boundary results (index as in frame 1).
     pub fn boundaries(&self) -> &[BoundaryStructure<N>] {
-        self.slots.get(..self.count).unwrap_or(&[])
+        self.slots.get(..usize::from(self.count)).unwrap_or(&[])
     }
 
     /// The frame's work budget ([`crate::Config::with_work_budget`]): the
@@ -311,6 +320,18 @@ impl<const N: usize, const B: usize> Structure<N, B> {
     /// came.
     pub fn work_units(&self) -> (u32, u32) {
         self.work
+    }
+
+    /// Whether the caller's deadline expired before this structure was
+    /// done ([`crate::Processor::process_within`]): its points not matched
+    /// by then are [`Status::OverBudget`] (so a consumer can tell the
+    /// clock's flags from the work budget's). Always `false` for a
+    /// structure from [`crate::Processor::process`]. The result packet
+    /// carries it ([`crate::wire::ResultView::deadline_expired`]). Not part
+    /// of the structure's equality or [`Self::digest`], which compare the
+    /// results.
+    pub fn deadline_expired(&self) -> bool {
+        self.cut
     }
 
     /// The camera of frame 1, in whose coordinates the points are given.

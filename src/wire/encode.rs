@@ -344,7 +344,9 @@ pub fn result<const N: usize, const B: usize>(
     w.u8(u8::from(s.is_some()))?;
     let nb = s.map_or(0, |s| s.boundaries().len());
     w.u8(u8::try_from(nb).map_err(|_| EncodeError::TooLarge)?)?;
-    w.u16(0)?;
+    // Flags: bit 0, the caller's deadline cut the frame short.
+    w.u8(u8::from(s.is_some_and(|s| s.deadline_expired())))?;
+    w.u8(0)?;
     w.u32(head.instructions)?;
     w.u32(s.map_or(0, |s| s.digest()))?;
     let counts = s.map(|s| s.status_counts()).unwrap_or_default();

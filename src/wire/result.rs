@@ -148,6 +148,10 @@ pub struct ResultView<'a> {
     /// Whether a structure was computed (`false`: the frame was kept as
     /// the first of a new pairing).
     pub structure: bool,
+    /// Whether the caller's deadline cut the frame's reconstruction short
+    /// (flags bit 0, [`crate::Structure::deadline_expired`]): its
+    /// `over_budget` points are then (also) the clock's.
+    pub deadline_expired: bool,
     /// Instructions of the per-frame call (0 where not measured).
     pub instructions: u32,
     /// [`crate::Structure::digest`].
@@ -177,6 +181,7 @@ impl<'a> ResultView<'a> {
             timestamp_us: u64::from(le32(head, 8)) | (u64::from(le32(head, 12)) << 32),
             structure: head.get(16) == Some(&1),
             boundaries: head.get(17).copied().unwrap_or(0),
+            deadline_expired: head.get(18).is_some_and(|f| f & 1 != 0),
             instructions: le32(head, 20),
             digest: le32(head, 24),
             counts,

@@ -349,3 +349,56 @@ fn cobs_paths_agree_with_the_crate() {
         }
     }
 }
+
+/// The result packet's flags byte carries `Structure::deadline_expired`:
+/// set when the caller's clock cut the frame short (every point then
+/// `over_budget`, for a clock that says yes at once), clear without a
+/// deadline and for a first frame.
+#[test]
+fn result_packet_carries_the_deadline_flag() {
+    use crate::{Config, Motion, Processor, Status};
+    let frame = |u0: f32| {
+        let mut f = Frame::<64, 2>::new(cam());
+        f.push_boundary(&line(40, u0)).unwrap();
+        f
+    };
+    let (f1, f2) = (frame(100.0), frame(96.0));
+    let motion = Motion::new([0.0, 0.0, 0.4], [0.0, 0.0, 0.0]).unwrap();
+    let head = encode::ResultHead {
+        frame_id: 2,
+        kept_id: 1,
+        timestamp_us: 7,
+        instructions: 0,
+    };
+    let parse = |raw: &[u8]| -> (bool, bool, u16, u16) {
+        let c = result::check(raw).unwrap();
+        let v = ResultView::parse(c.payload).unwrap();
+        let ok = v.count(Status::Ok);
+        (
+            v.structure,
+            v.deadline_expired,
+            ok,
+            v.count(Status::OverBudget),
+        )
+    };
+    let mut p = Processor::<64, 2>::new(Config::default());
+    let mut raw = vec![0u8; 4096];
+    let first = p.process_within(&f1, None, &mut || true).unwrap();
+    let n = encode::result(&mut raw, IDS.result, 0, &head, &first, &[0]).unwrap();
+    assert_eq!(parse(&raw[..n]), (false, false, 0, 0));
+    // Cut at once: every point flagged, the flag set.
+    let cut = p
+        .process_against_kept_within(&f2, &motion, &mut || true)
+        .unwrap();
+    assert!(cut.deadline_expired());
+    let step = crate::Step::Structure(cut);
+    let n = encode::result(&mut raw, IDS.result, 1, &head, &step, &[0]).unwrap();
+    assert_eq!(parse(&raw[..n]), (true, true, 0, 40));
+    // The same pair without a deadline: points matched, the flag clear.
+    let whole = p.process_against_kept(&f2, &motion).unwrap();
+    assert!(!whole.deadline_expired());
+    let step = crate::Step::Structure(whole);
+    let n = encode::result(&mut raw, IDS.result, 2, &head, &step, &[0]).unwrap();
+    let (structure, expired, ok, over) = parse(&raw[..n]);
+    assert!(structure && !expired && over == 0 && ok > 0, "{ok} ok");
+}

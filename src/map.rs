@@ -15,17 +15,29 @@
 //! stick in the current **vehicle frame** (the camera frame turned by the
 //! mounting tilt, Appendix I, [`crate::analysis::camera_to_vehicle`]).
 //!
-//! # Motion errors
+//! # The radius: how far the true point may be from the stick
+//! The fused interval bounds the true point's depth `Z`, but on the ray
+//! of the **detected** key-frame pixel; the true point lies on the ray of
+//! the true pixel, within `e₁` of it ([`crate::Config::e1`]), so in the
+//! key frame it is within `Z |Δ(x, y)| ≤ Z_far λ` of the stick's point at
+//! its own depth, `λ = e₁/min(f_x, f_y)` (a pixel step `(du, dv)` is
+//! `(du/f_x, dv/f_y)` in normalised coordinates). Its distance from the
+//! key-frame camera is `|P_K| = Z √(1 + x² + y²)` on the true ray, at most
+//! `Z_far (1 + ½((|x| + λ)² + (|y| + λ)²))` with the detected `(x, y)`.
+//!
 //! When the configuration bounds the per-frame motion errors, a carried
-//! point may be off its computed position by at most `ρ + φ |P_K|`, `|P_K|`
-//! its distance from the key-frame camera: the batch starts with the bound
-//! of its key frame's composed motion ([`crate::fusion`]) and each frame
-//! adds `√3 δ + ω |b'|` to `ρ` and `ω` to `φ` (`δ` the translation error
-//! per component, `ω` the rotation error angle, `b'` the key-frame camera's
-//! new position): the true point `Ωᵀ Rᵀ (P_t − T − d)` is off by at most
-//! the old error plus `|d| + ω |P'|`, and `|P'| ≤ |P_K| + |b'|`. A
-//! [`MapPoint`] carries that bound as its `radius`: the true point is within
-//! `radius` of the stick.
+//! point may be off its computed position by at most `ρ + φ |P_K|` more:
+//! the batch starts with the bound of its key frame's composed motion
+//! ([`crate::fusion`]) and each frame adds `√3 δ + ω |b'|` to `ρ` and `ω`
+//! to `φ` (`δ` the translation error per component, `ω` the rotation error
+//! angle, `b'` the key-frame camera's new position): the true point `Ωᵀ Rᵀ
+//! (P_t − T − d)` is off by at most the old error plus `|d| + ω |P'|`, and
+//! `|P'| ≤ |P_K| + |b'|`. The carrying is a rotation and a translation, so
+//! it keeps the key frame's lateral distance. A [`MapPoint`] carries the
+//! sum, `Z_far λ + ρ + φ |P_K|`, as its `radius`: the true point is within
+//! `radius` of the stick. (The radius left out `Z_far λ` until an
+//! adversarial review found it: about `0.49 Z/800` missing with the
+//! key-frame pixels 0.49 px off, `host_tests/tests/fusion.rs`.)
 //!
 //! # What leaves the map, all counted ([`MapDrops`])
 //! * **Behind**: a point whose whole stick, widened by its radius, is
@@ -45,9 +57,9 @@
 //!   its own farthest points beyond `M`.
 //!
 //! Size: `12·B·M` bytes of points and [`MAP_BATCHES`] batches of
-//! `72 + 4·B` bytes (12 968 bytes in all for `B = 2`, `M = 512`).
+//! `76 + 4·B` bytes (13 000 bytes in all for `B = 2`, `M = 512`).
 
-use crate::fusion::code::DepthScale;
+use crate::fusion::code::{DepthScale, UNBOUNDED};
 use crate::fusion::{Admit, Chain, KeyFrame, StepBounds};
 use crate::geometry::Sample;
 use crate::math::{fmax, fmin, mat3_mul, mat3_transpose, mat3_vec, sqrt, Mat3};
@@ -97,6 +109,9 @@ struct Batch<const B: usize> {
     /// The carried error bound `ρ + φ |P_K|`.
     rho: f32,
     phi: f32,
+    /// `λ = e₁/min(f_x, f_y)`, rounded up: the key frame's localisation
+    /// error across the ray, per unit of depth (module docs).
+    lat: f32,
     /// The key frame's id.
     key: u32,
     /// Slots of each boundary's ring the batch occupies (live or not).
@@ -115,6 +130,7 @@ impl<const B: usize> Batch<B> {
         b: [0.0; 3],
         rho: 0.0,
         phi: 0.0,
+        lat: 0.0,
         key: 0,
         len: [0; B],
         live: [0; B],
@@ -140,8 +156,10 @@ pub struct MapPoint {
     pub near: [f32; 3],
     /// The far end.
     pub far: [f32; 3],
-    /// The true point is within this distance of the stick (0 without
-    /// motion-error bounds).
+    /// The true point is within this distance of the stick: the key
+    /// frame's localisation error `e₁` across the ray (`Z_far e₁/min(f_x,
+    /// f_y)`) and, with motion-error bounds, the carried motion's error
+    /// (module docs).
     pub radius: f32,
     /// The id of the key frame the point was fused in.
     pub key: u32,
@@ -173,6 +191,11 @@ pub struct Retired {
     pub unverified: u32,
     /// Points left out: inconsistent.
     pub inconsistent: u32,
+    /// Points left out: admitted, but with a far end beyond what the map's
+    /// depth codes hold (about twice `Config::max_depth`: a range
+    /// constraint or a stick reaching that far), which would be an
+    /// unbounded stick in the map.
+    pub unbounded: u32,
     /// Older points dropped to make room (also in [`MapDrops::capacity`]).
     pub dropped: u32,
     /// This key frame's own points beyond a boundary's capacity `M` (the
@@ -223,6 +246,7 @@ struct View {
     dg: f32,
     rho: f32,
     phi: f32,
+    lat: f32,
 }
 
 impl View {
@@ -236,13 +260,15 @@ impl View {
             dg: sqrt(dot3(d, d)) * 1.000_01 + 1e-7,
             rho: b.rho,
             phi: b.phi,
+            lat: b.lat,
         }
     }
 
     /// The whole batch ahead, behind (sticks and radii), or neither.
     fn whole<const B: usize>(&self, b: &Batch<B>) -> Whole {
         let slack = self.dg * b.reach;
-        let radius = self.rho + self.phi * b.reach;
+        // (`reach` bounds `|P_K|`, and so `Z_far`, over the batch.)
+        let radius = self.rho + (self.phi + self.lat) * b.reach;
         if b.forward.1 + self.g0 + slack + radius < 0.0 {
             Whole::Behind
         } else if b.forward.0 + self.g0 - slack >= 0.0 {
@@ -259,12 +285,18 @@ impl View {
         // The stick's forward coordinate is largest at its far end when it
         // points forward, at its near end otherwise.
         let ahead = dir * scale.depth(if dir >= 0.0 { e.far } else { e.near }) + self.g0;
-        if self.rho == 0.0 && self.phi == 0.0 {
-            return ahead < 0.0;
-        }
-        let r = self.rho + self.phi * scale.depth(e.far) * (1.0 + 0.5 * (e.x * e.x + e.y * e.y));
-        ahead + r < 0.0
+        ahead + radius(self.rho, self.phi, self.lat, e, scale.depth(e.far)) < 0.0
     }
+}
+
+/// The radius of an entry `e` whose far end is `zf` in a batch with the
+/// bounds `rho`, `phi`, `lat` (module docs): `zf λ + ρ + φ |P_K|`, `|P_K|`
+/// bounded on the true ray.
+#[inline]
+fn radius(rho: f32, phi: f32, lat: f32, e: &Entry, zf: f32) -> f32 {
+    let (x, y) = (e.x.abs() + lat, e.y.abs() + lat);
+    let reach = zf * (1.0 + 0.5 * (x * x + y * y));
+    (zf * lat + rho + phi * reach) * ROUND_UP
 }
 
 /// The fixed-capacity road map: up to `M` points on each of `B`
@@ -407,7 +439,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         MapPoint {
             near: at(zn),
             far: at(zf),
-            radius: b.rho + b.phi * zf * (1.0 + 0.5 * (e.x * e.x + e.y * e.y)),
+            radius: radius(b.rho, b.phi, b.lat, e, zf),
             key: b.key,
             ray: [e.x, e.y],
         }
@@ -657,8 +689,11 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
     /// [`crate::fusion::FusedStatus::Single`] if `min_pairs ≤ 1`) with at
     /// least `min_pairs` agreeing pairs and a bounded interval, as one
     /// batch posed by `chain` (the key frame's motion to the current
-    /// frame). `s` is a reconstruction of the key frame (its pixels). The
-    /// oldest points make room.
+    /// frame). `s` is a reconstruction of the key frame (its pixels), `e1`
+    /// the key frame's localisation error (the radius, module docs). The
+    /// oldest points make room. An admitted point whose far end the depth
+    /// codes cannot hold is left out ([`Retired::unbounded`]; the room was
+    /// made for it).
     ///
     /// Work: two passes over the key frame's points (`B·N`), plus the
     /// points dropped for room.
@@ -667,6 +702,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         key: &KeyFrame<N, B>,
         s: &Structure<N, B>,
         chain: &Chain,
+        e1: f32,
     ) -> Retired {
         let mut out = Retired {
             key: key.id(),
@@ -689,17 +725,23 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         // 3. The batch: its pose, each boundary's points, the forward
         // extent and reach of all of them.
         let (a, b, rho, phi) = chain.pose();
+        let cam = s.camera1();
+        let lat = e1 / fmin(cam.fx(), cam.fy()) * ROUND_UP;
         let mut batch = Batch::<B> {
             a,
             b,
             rho,
             phi,
+            // (A camera's focal lengths are positive and finite, `e₁` at
+            // most 100: finite; the guard keeps a NaN out regardless.)
+            lat: if lat.is_finite() { lat } else { 0.0 },
             key: key.id(),
             ..Batch::EMPTY
         };
         let mut extent = Extent::EMPTY;
         for (k, &w) in want.iter().enumerate() {
-            let n = self.enter(k, w, key, s, &mut extent);
+            let (n, unbounded) = self.enter(k, w, (key, s, batch.lat), &mut extent);
+            out.unbounded += unbounded;
             let n16 = n as u16;
             if let (Some(l), Some(lv), Some(u)) = (
                 batch.len.get_mut(k),
@@ -752,25 +794,26 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
 
     /// [`Self::retire`]'s entries on boundary `k`: the first `w` admitted
     /// points of the key frame, written into the ring after its used
-    /// slots, their forward coordinates and reach taken into `extent`.
-    /// Returns how many entered.
+    /// slots, their forward coordinates and reach (`|P_K|` on the true
+    /// ray, `lat` the batch's `λ`) taken into `extent`. Returns how many
+    /// entered, and how many were left out for a far end the codes cannot
+    /// hold.
     fn enter<const N: usize>(
         &mut self,
         k: usize,
         w: usize,
-        key: &KeyFrame<N, B>,
-        s: &Structure<N, B>,
+        (key, s, lat): (&KeyFrame<N, B>, &Structure<N, B>, f32),
         extent: &mut Extent,
-    ) -> usize {
+    ) -> (usize, u32) {
         let min_pairs = key.min_pairs();
         let (ts, tc) = self.tilt;
         let (cam, scale) = (s.camera1(), self.scale);
         let start = self.tail.get(k).map_or(0, |&t| usize::from(t))
             + self.used.get(k).map_or(0, |&u| usize::from(u));
         let (Some(ring), Some(results)) = (self.entries.get_mut(k), s.boundaries().get(k)) else {
-            return 0;
+            return (0, 0);
         };
-        let mut n = 0usize;
+        let (mut n, mut unbounded) = (0usize, 0u32);
         for (c, r) in key.cells(k).iter().zip(results.points()) {
             if n >= w {
                 break;
@@ -780,11 +823,16 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             }
             let [x, y] = cam.normalise(r.pixel1());
             let (z_near, z_far) = c.ends();
+            let far = scale.up(z_far);
+            if far == UNBOUNDED {
+                unbounded += 1;
+                continue;
+            }
             let e = Entry {
                 x,
                 y,
                 near: scale.down(z_near),
-                far: scale.up(z_far).max(1),
+                far: far.max(1),
             };
             // Forward coordinate (key frame's vehicle frame) of both
             // ends; the coded ends are within 2⁻¹² of these (widened by
@@ -793,13 +841,14 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             let (a, b) = (z_near * dir, z_far * dir);
             extent.lo = fmin(extent.lo, fmin(a, b));
             extent.hi = fmax(extent.hi, fmax(a, b));
-            extent.reach = fmax(extent.reach, z_far * (1.0 + 0.5 * (x * x + y * y)));
+            let (xl, yl) = (x.abs() + lat, y.abs() + lat);
+            extent.reach = fmax(extent.reach, z_far * (1.0 + 0.5 * (xl * xl + yl * yl)));
             if let Some(slot) = ring.get_mut((start + n) % M) {
                 *slot = e;
             }
             n += 1;
         }
-        n
+        (n, unbounded)
     }
 
     pub(crate) fn digest_into(&self, eat: &mut impl FnMut(u32)) {
@@ -811,6 +860,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             }
             eat(b.rho.to_bits());
             eat(b.phi.to_bits());
+            eat(b.lat.to_bits());
             for k in 0..B {
                 let (start, len) = self.range(i, k);
                 if let Some(ring) = self.entries.get(k) {

@@ -471,10 +471,9 @@ struct MapCheck {
     live_at_end: u64,
 }
 
-/// Every map point after every frame: the key-frame ray point at the true
-/// depth, carried into the frame's vehicle frame by the **true** poses,
-/// lies within the point's radius of its stick (up to `f32` rounding,
-/// `1e-4` of its distance).
+/// Every map point after every frame: the true 3-D point of its key-frame
+/// pixel, carried into the frame's vehicle frame by the **true** poses,
+/// lies within the point's radius of its stick.
 fn check_map(d: &Drive, input: &host_tests::drives::Input, policy: FusionConfig) -> MapCheck {
     let k = d.spec.intrinsics;
     let cam = k.camera();
@@ -487,11 +486,9 @@ fn check_map(d: &Drive, input: &host_tests::drives::Input, policy: FusionConfig)
                     .iter()
                     .position(|px| cam.normalise(*px) == p.ray)
                     .expect("the map point's ray is a key-frame pixel's");
-                let z = d.z_true(key, b, i);
-                let ray = [f64::from(p.ray[0]) * z, f64::from(p.ray[1]) * z, z];
-                let kp = &d.frames[key].pose;
-                let world = synth::add(kp.centre, synth::mv(&kp.rot, ray));
-                let truth = d.in_vehicle(j, world);
+                // The true point itself (not the detected ray's point at
+                // the true depth): the radius covers `e₁` across the ray.
+                let truth = d.in_vehicle(j, d.world_point(key, b, i));
                 let near = p.near.map(f64::from);
                 let far = p.far.map(f64::from);
                 let dist = Drive::segment_distance(truth, near, far);
@@ -562,7 +559,10 @@ fn the_map_holds_the_truth_in_the_vehicle_frame() {
             all.points, all.worst_excess, all.largest_radius, all.entered, all.behind, all.capacity
         ));
         assert!(all.points > 10_000, "{all:?}");
-        assert!(all.worst_excess <= 1e-4, "{all:?}");
+        // Within the radius outright: it carries the key frame's `e₁`
+        // across the ray (at least `Z e₁/f`, far above the `f32`
+        // rounding of the stick's ends).
+        assert!(all.worst_excess <= 0.0, "{all:?}");
         // (With motion errors the sticks reach far ahead: none is wholly
         // behind within 24 frames.)
         assert!(motion.is_some() || all.behind > 0, "{all:?}");
@@ -711,6 +711,280 @@ fn bad_inputs_are_typed_errors_and_change_nothing() {
         .to_string(),
         "the motion starts from frame 7, the last frame was 1"
     );
+}
+
+/// Everything about the key frame a caller can see (its id, partners and
+/// every point), for the checks that an error changed nothing.
+fn key_view(f: &HostFusion) -> String {
+    match f.key() {
+        None => "none".into(),
+        Some(k) => {
+            let mut s = format!("{} {} ", k.id(), k.partners());
+            for b in 0..B {
+                for p in k.points(b) {
+                    s += &format!("{p:?};");
+                }
+            }
+            s
+        }
+    }
+}
+
+/// Found by an adversarial review: right after a step that retired a key
+/// frame, `key()` shows the retired key frame's final state until the
+/// next step, and a `constrain` that failed (no such point) started the
+/// new key frame's fusion anyway, so `key()` changed under an error. Every
+/// check now comes first; a good constraint then starts it.
+#[test]
+fn a_failed_constraint_after_a_retire_changes_nothing() {
+    let cam = synth::Intrinsics::default().camera();
+    let step = Motion::new([0.05, 0.0, 0.25], [0.0; 3]).expect("motion");
+    let policy = FusionConfig::new(2, 0).expect("policy");
+    let mut f = Box::new(HostFusion::new(Config::DEFAULT, policy));
+    f.step(0, &edge_frame(cam, 0.0, 24), None).expect("key");
+    let mut retired = None;
+    for id in 1..=2u32 {
+        let m = ChainedMotion { from: id - 1, motion: step };
+        retired = f
+            .step(id, &edge_frame(cam, id as f32, 24), Some(&m))
+            .expect("step")
+            .retired;
+    }
+    assert_eq!(retired.map(|r| r.key), Some(0), "frame 2 retires key 0");
+    let (view, digest) = (key_view(&f), f.digest());
+    assert!(view.starts_with("0 2 "), "{view}");
+    for (b, i, near, far, e) in [
+        (0, 999, 1.0, 2.0, FusionError::NoSuchPoint),
+        (3, 0, 1.0, 2.0, FusionError::NoSuchPoint),
+        (0, 0, 3.0, 2.0, FusionError::InvalidRange),
+    ] {
+        assert_eq!(f.constrain(b, i, near, far), Err(e));
+        assert_eq!(key_view(&f), view, "constrain({b}, {i}, {near}, {far})");
+        assert_eq!(f.digest(), digest);
+    }
+    // A good one is on the new key frame (frame 2), which starts then.
+    let p = f.constrain(0, 0, 1.0, 100.0).expect("a point of frame 2");
+    assert_eq!(p.pairs, 1);
+    assert_eq!(f.key().map(|k| (k.id(), k.partners())), Some((2, 0)));
+}
+
+/// Found by an adversarial review: a range constraint whose far end
+/// overflows as a depth (`f32::MAX` on the principal point's ray) gave an
+/// infinite fused far end, and one far past the map's depth codes (1e30)
+/// went into the map (with single-pair points admitted) as a stick without
+/// a far end: `points()` hid it (its coordinates NaN) while `len()`
+/// counted it. The first is an `InvalidRange` now; the second is left out
+/// of the map and counted as `Retired::unbounded`; every map point is
+/// finite.
+#[test]
+fn ranges_past_the_depth_codes_stay_out_of_the_map() {
+    let cam = synth::Intrinsics::default().camera();
+    let policy = FusionConfig::new(2, 0)
+        .and_then(|p| p.with_map_min_pairs(1))
+        .expect("policy");
+    // A ground edge, then the principal point (the horizon: no disparity,
+    // no bounded stick in any pair, so only the range fuses it).
+    let edge = |n: f32| {
+        let mut f = Frame::<N, B>::new(cam);
+        let mut pts: Vec<Pixel> = (0..10)
+            .map(|i| {
+                let z = 7.0 + i as f32 - 0.25 * n;
+                Pixel::new(255.5 - 800.0 * (1.0 + 0.05 * n) / z, 239.5 + 800.0 / z)
+            })
+            .collect();
+        pts.push(Pixel::new(255.5, 239.5));
+        f.push_boundary(&pts).expect("valid");
+        f
+    };
+    let step = Motion::new([0.05, 0.0, 0.25], [0.0; 3]).expect("motion");
+    let mut f = Box::new(HostFusion::new(Config::DEFAULT, policy));
+    f.step(0, &edge(0.0), None).expect("key");
+    let k = f.key().expect("key").len(0) - 1;
+    let digest = f.digest();
+    assert_eq!(f.constrain(0, k, 1.0, f32::MAX), Err(FusionError::InvalidRange));
+    assert_eq!(f.digest(), digest);
+    let p = f.constrain(0, k, 1.0, 1.0e30).expect("a valid range");
+    assert_eq!(p.status, FusedStatus::Single);
+    let mut unbounded = 0;
+    for id in 1..=2u32 {
+        let m = ChainedMotion { from: id - 1, motion: step };
+        let s = f.step(id, &edge(id as f32), Some(&m)).expect("step");
+        unbounded += s.retired.map_or(0, |r| r.unbounded);
+    }
+    assert_eq!(unbounded, 1, "the constrained point is left out");
+    let map = f.map();
+    assert_eq!(map.points(0).count(), map.len(0), "every stored point is given");
+    assert!(map.len(0) > 0);
+    for p in map.points(0) {
+        assert!(
+            p.near.iter().chain(&p.far).all(|v| v.is_finite()) && p.radius.is_finite(),
+            "{p:?}"
+        );
+    }
+}
+
+/// Found by an adversarial review: the map's radius bounded the carried
+/// motion's error only, but the stick lies on the detected key-frame
+/// pixel's ray, and the true point on the true pixel's, up to `e₁` away:
+/// with the key frame's pixels 0.49 px off (inside `e₁` = 0.5) every true
+/// point was outside its stick widened by the radius, by about `0.49 Z /
+/// 800`. A straight edge on flat ground, exact motions, a tiny configured
+/// translation error; the true 3-D point (not the detected ray's) must lie
+/// within the radius, and the radius must not be vacuous (under 2 `Z_far
+/// e₁/f` plus the motion term).
+#[test]
+fn the_map_radius_covers_the_key_frames_localisation_error() {
+    let cam = synth::Intrinsics::default().camera();
+    let base = Config::DEFAULT.with_translation_error(1.0e-4).expect("config");
+    let mut f = Box::new(HostFusion::new(base, FusionConfig::DEFAULT));
+    // True points (-1, 1, 7 + i) in the frame-0 camera; the camera moves
+    // 0.05 right and 0.25 forward a frame.
+    let truth: Vec<[f64; 3]> = (0..12).map(|i| [-1.0, 1.0, 7.0 + f64::from(i)]).collect();
+    let frame_at = |n: f64, du: f64| {
+        let mut fr = Frame::<N, B>::new(cam);
+        let pts: Vec<Pixel> = truth
+            .iter()
+            .map(|p| {
+                let (x, y, z) = (p[0] - 0.05 * n, p[1], p[2] - 0.25 * n);
+                Pixel::new(
+                    (255.5 + 800.0 * x / z + du) as f32,
+                    (239.5 + 800.0 * y / z) as f32,
+                )
+            })
+            .collect();
+        fr.push_boundary(&pts).expect("valid");
+        fr
+    };
+    f.step(0, &frame_at(0.0, 0.49), None).expect("key");
+    let step = Motion::new([0.05, 0.0, 0.25], [0.0; 3]).expect("motion");
+    for id in 1..=8u32 {
+        let m = ChainedMotion { from: id - 1, motion: step };
+        f.step(id, &frame_at(f64::from(id), 0.0), Some(&m)).expect("step");
+    }
+    let map = f.map();
+    assert_eq!(map.batches(), 1);
+    let mut checked = 0;
+    for p in map.points(0) {
+        let i = truth
+            .iter()
+            .position(|t| ((t[1] / t[2]) as f32 - p.ray[1]).abs() < 1e-6)
+            .expect("a true point on the ray's row");
+        // In frame 8's camera (tilt 0: the vehicle frame).
+        let t = [truth[i][0] - 0.4, truth[i][1], truth[i][2] - 2.0];
+        let d = Drive::segment_distance(t, p.near.map(f64::from), p.far.map(f64::from));
+        let lateral = f64::from(p.far[2]) * 0.5 / 800.0;
+        assert!(d <= f64::from(p.radius), "point {i}: {d} > {} ({p:?})", p.radius);
+        assert!(d > 0.5 * lateral, "point {i}: the test's offset shows ({d})");
+        assert!(f64::from(p.radius) < 2.0 * lateral + 0.01, "{p:?}");
+        checked += 1;
+    }
+    assert!(checked >= 6, "{checked} map points");
+}
+
+/// The limit of the consistency check, pinned (README, "Limits"; found by
+/// an adversarial review, reduced from its crest family): every pair's
+/// stick is guaranteed only where the point's true correspondent is in
+/// that partner's data. Here the vehicle drives over a crest; the key
+/// frame sees the near stretch of the left edge (point 1 at depth 9.52),
+/// which has left the image by frames 2 and 3 (its true images at (−155,
+/// 694) and (−362, 844)), and what they report near the same image place
+/// is the far stretch beyond the crest, which the key frame's view hid
+/// behind it, along the same rays. Both pairs match it, their sticks
+/// overlap, and the point comes out `Consistent` on two agreeing pairs at
+/// the far stretch's depth: a depth of the boundary on that ray, not the
+/// one the key frame saw. No pair here contradicts it (the first has no
+/// match), and no check on these polylines could: the three views agree.
+/// (The per-frame rotation errors are inside the configured bounds.) If a
+/// change catches it, this test fails: update README's limits with it.
+#[test]
+fn limit_two_partners_past_a_crest_agree_on_the_hidden_stretch() {
+    let cam = roadstereo::Camera::new(2040.024, 1751.3557, 555.9182, 350.90897, 1280, 720)
+        .expect("camera");
+    let config = Config::new(0.25, 0.25, 5.0, 1000.0)
+        .and_then(|c| c.with_rotation_error([0.0005, 0.000_357_564_16, 0.000_332_282_54]))
+        .expect("config");
+    let policy = FusionConfig::new(64, 0).expect("policy");
+    let mut f = Box::new(HostFusion::new(config, policy));
+    let frames: [&[(f32, f32)]; 4] = [
+        &[(33.720425, 535.8427), (40.37532, 533.3972)],
+        &[(113.94611, 559.26965), (115.672844, 559.15875)],
+        &[(52.902264, 543.791), (41.326317, 542.28906), (28.987741, 540.7667)],
+        &[
+            (50.23746, 528.56134),
+            (39.272568, 527.05615),
+            (27.834503, 525.561),
+            (15.301357, 524.00854),
+        ],
+    ];
+    let motions = [
+        ([-0.009433916, -0.17606132, 1.455624], [-0.0009653559, -0.007718359, -0.0005456084]),
+        ([0.0044060056, -0.1807901, 1.5268402], [-0.008483555, -0.0059730206, 0.0020656479]),
+        ([-0.011022777, -0.18070243, 1.5621607], [-0.011423063, -0.0023354213, 0.0021708028]),
+    ];
+    let mut sticks = Vec::new();
+    for (j, pts) in frames.iter().enumerate() {
+        let mut fr = Frame::<N, B>::new(cam);
+        let px: Vec<Pixel> = pts.iter().map(|&(u, v)| Pixel::new(u, v)).collect();
+        fr.push_boundary(&px).expect("valid");
+        let m = (j > 0).then(|| ChainedMotion {
+            from: j as u32 - 1,
+            motion: Motion::new(motions[j - 1].0, motions[j - 1].1).expect("motion"),
+        });
+        f.step(j as u32, &fr, m.as_ref()).expect("step");
+        if j > 0 {
+            let r = f.structure().boundaries()[0].points()[1];
+            sticks.push(r.interval());
+        }
+    }
+    let z_seen = 9.52;
+    assert!(sticks[0].is_none(), "the first pair matches nothing: {sticks:?}");
+    for s in sticks[1..].iter().flatten() {
+        assert!(s.z_near > 4.0 * z_seen, "a far-stretch stick: {s:?}");
+    }
+    let p = f.key().expect("key").point(0, 1).expect("point");
+    assert_eq!((p.status, p.pairs), (FusedStatus::Consistent, 2), "{p:?}");
+    let iv = p.interval.expect("interval");
+    assert!(iv.z_near > 4.0 * z_seen && iv.z_far < 70.0, "{iv:?}");
+}
+
+/// The same limit with one pair (README, "Limits"): the partner sees only
+/// another stretch of the boundary, at the image's left edge, 670 px from
+/// the point's true image; the pair matches it and the point is `Single`
+/// at depth 2.28 where the truth is 52.8. A `Single` point is a two-view
+/// stick nothing has checked; the map leaves it out by default (two
+/// agreeing pairs).
+#[test]
+fn limit_a_single_pair_on_another_stretch() {
+    let cam = roadstereo::Camera::new(1270.8977, 1267.7975, 613.9354, 374.1418, 1280, 720)
+        .expect("camera");
+    let config = Config::new(0.5, 0.5, 10.0, 1000.0).expect("config");
+    let mut f = Box::new(HostFusion::new(config, FusionConfig::DEFAULT));
+    let mut key = Frame::<N, B>::new(cam);
+    key.push_boundary(&[Pixel::new(434.69595, 283.7184), Pixel::new(417.65152, 242.88559)])
+        .expect("valid");
+    let mut partner = Frame::<N, B>::new(cam);
+    partner
+        .push_boundary(&[
+            Pixel::new(11.563808, 596.5284),
+            Pixel::new(10.204302, 591.519),
+            Pixel::new(8.683846, 586.51245),
+            Pixel::new(7.685968, 583.227),
+            Pixel::new(7.101487, 581.49994),
+            Pixel::new(5.4075723, 576.4951),
+        ])
+        .expect("valid");
+    let motion = Motion::new(
+        [-0.09189772, -0.2295378, 1.929738],
+        [0.00017760562, -0.1391907, -0.020123838],
+    )
+    .expect("motion");
+    f.step(0, &key, None).expect("key");
+    f.step(1, &partner, Some(&ChainedMotion { from: 0, motion }))
+        .expect("pair");
+    let p = f.key().expect("key").point(0, 0).expect("point");
+    assert_eq!(p.status, FusedStatus::Single, "{p:?}");
+    let iv = p.interval.expect("interval");
+    assert!(iv.z_far < 3.0, "the other stretch's depth, not 52.8: {iv:?}");
 }
 
 /// A range sensor's return along a key-frame point's ray (the truth ± 1 %

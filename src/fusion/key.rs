@@ -52,10 +52,15 @@ use crate::structure::{Status, Structure};
 pub enum FusedStatus {
     /// No pair has given the point an interval yet.
     Unmatched,
-    /// One pair has: its stick, guaranteed like any stick, but nothing has
-    /// checked the match.
+    /// One pair has: its stick, guaranteed like any two-view stick where
+    /// the point's true correspondent is in the partner's data, but
+    /// nothing has checked the match.
     Single,
     /// Two or more pairs have, and all their intervals share the fused one.
+    /// (Agreement is evidence, not proof: pairs whose partners all see
+    /// another stretch of the boundary along the same rays, e.g. one the
+    /// key frame's view hid behind a crest, can agree on its depth; README,
+    /// "Limits".)
     Consistent,
     /// Some interval missed the others: a pair matched wrongly. The
     /// interval given is the one most pairs agree on (module docs), not a

@@ -254,7 +254,8 @@ pub enum FusionError {
     NoKeyFrame,
     /// The key frame has no such boundary point.
     NoSuchPoint,
-    /// A range is not `0 ≤ near ≤ far` with both finite.
+    /// A range is not `0 ≤ near ≤ far` with both finite (or its far end
+    /// converted to a depth overflows).
     InvalidRange,
 }
 
@@ -271,7 +272,9 @@ impl fmt::Display for FusionError {
             Self::RepeatedFrame(id) => write!(f, "frame {id} was the last frame already"),
             Self::NoKeyFrame => f.write_str("there is no key frame"),
             Self::NoSuchPoint => f.write_str("the key frame has no such point"),
-            Self::InvalidRange => f.write_str("a range must be finite with 0 <= near <= far"),
+            Self::InvalidRange => {
+                f.write_str("a range must be finite with 0 <= near <= far, its far depth too")
+            }
         }
     }
 }
@@ -593,7 +596,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         }
         Some(
             self.map
-                .retire(&self.key, self.processor.structure(), chain),
+                .retire(&self.key, self.processor.structure(), chain, self.base.e1()),
         )
     }
 
@@ -605,7 +608,15 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// fused one flags the point. Returns the point after.
     ///
     /// The distance `r` along the ray through normalised `(x, y)` is the
-    /// depth `Z = r / √(1 + x² + y²)`; the conversion is rounded outwards.
+    /// depth `Z = r / √(1 + x² + y²)`; the conversion is rounded outwards
+    /// (a `far` whose depth overflows `f32` is an
+    /// [`FusionError::InvalidRange`]).
+    ///
+    /// The key frame is the processor's kept frame: right after a step
+    /// that retired a key frame, the constraint is on the **new** one,
+    /// whose fusion starts with it ([`Fusion::key`] shows the new key frame
+    /// from then on, not the retired one's final state). An error leaves
+    /// everything as it was, [`Fusion::key`] included.
     pub fn constrain(
         &mut self,
         boundary: usize,
@@ -616,7 +627,9 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         if !(near.is_finite() && far.is_finite() && 0.0 <= near && near <= far) {
             return Err(FusionError::InvalidRange);
         }
-        self.settle();
+        // Every check before the pending key frame's fusion starts
+        // (`settle`): the kept frame is that key frame, and an error must
+        // leave the state untouched.
         let kept = self
             .processor
             .previous()
@@ -632,6 +645,11 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         let n = sqrt(1.0 + x * x + y * y);
         // (sqrt is within 2e-7 of the truth; 1e-6 covers it and the division.)
         let (zn, zf) = (near / n * (1.0 - 1.0e-6), far / n * (1.0 + 1.0e-6));
+        // (A far end near `f32::MAX` overflows; `n ≥ 1`, so only the far one.)
+        if !zf.is_finite() {
+            return Err(FusionError::InvalidRange);
+        }
+        self.settle();
         match self.key.constrain(boundary, index, zn, zf) {
             Some(Added::Agreed | Added::Conflict { .. }) => {}
             None => return Err(FusionError::NoSuchPoint),

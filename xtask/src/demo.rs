@@ -70,8 +70,18 @@ pub fn demo_on(check: bool, board: Board) -> Result<Vec<Record>, String> {
 }
 
 /// The demo on both boards: the same results, and the same instruction
-/// counts (within SysTick's resolution, a few instructions a frame), which
-/// holds only if each board converts its ticks with its own core clock.
+/// counts up to [`BOARD_SPREAD`], which holds only if each board converts
+/// its ticks with its own core clock (a wrong one is off by 168/25 = 6.7×).
+/// The two are separate LTO builds (the board feature changes the crates'
+/// hashes and with them the order LLVM sees the functions in), so their
+/// machine code differs a little: an instruction trace of both demos
+/// showed `Processor::reconstruct` 3 738 instructions apart over the drive
+/// (0.3 %), the rest within a few, all results bit for bit equal.
+/// How far the two boards' instruction counts may be apart in a frame
+/// (relative): the two builds' codegen noise, measured up to 0.4 % (frame
+/// 9 of the drive, 2026-12-04), with room; a wrong clock is 570 % off.
+const BOARD_SPREAD: f64 = 0.01;
+
 pub fn demo_on_both_boards() -> Result<(), String> {
     let mps2 = demo_on(true, Board::Mps2)?;
     let f405 = demo_on(true, Board::F405)?;
@@ -93,7 +103,7 @@ pub fn demo_on_both_boards() -> Result<(), String> {
         let (ia, ib) = (num(a, "instr") as f64, num(b, "instr") as f64);
         let rel = (ia - ib).abs() / ia.max(1.0);
         worst = worst.max(rel);
-        if rel > 0.001 {
+        if rel > BOARD_SPREAD {
             return Err(format!(
                 "frame {frame}: {ia} instructions on mps2-an386, {ib} on stm32f405 (a board's clock is wrong)"
             ));

@@ -203,7 +203,9 @@ pub(crate) struct Wedge {
     /// `T`, the tangent of the half-angle (rounded up).
     t: f32,
     /// The wedge's key interval (oriented, widened by the edges' margins):
-    /// the index query.
+    /// the index query. Ordered, `kl ≤ kh`: the lean walks test a
+    /// segment's interval `[lo, hi]` against it as `lo ≤ kh` and `hi ≥ kl`
+    /// (`r₁, e₂ ≥ 0`, so `T`, `δ` and the margins are not negative).
     pub(crate) kl: f32,
     pub(crate) kh: f32,
     /// `X_min = R − ρ₊ (r₁ + e₂)`: `λ ≥ −(r₁ + e₂)` is `X ≥ X_min`.
@@ -752,7 +754,7 @@ fn exact_keys(d: [f32; 2], t: f32, side: f32, key_scale: f32, orient: f32) -> (f
 /// the row no keyed point is in it, and the interval is `(−∞, −∞)`: it
 /// meets only the intervals of segments with an unkeyed end (frame 2's
 /// `(−∞, ∞)`, [`crate::search`]), and a walk's tests of a segment's low
-/// end against it (`lo < kl || lo ≤ kh`, `sm > kh`) reject every other
+/// end against it (`lo ≤ kh`, `sm > kh`) reject every other
 /// segment and end the run at the first one past them. (As the empty
 /// `(∞, −∞)`, the same segments meet it, but those tests took every
 /// finite low end for one below the query.)

@@ -707,11 +707,19 @@ pub(super) fn wedge_run_aside<const SKIP: bool>(
                 break 'walk;
             }
         }
-        // The interval's low end decides first: below `kl` the segment
-        // reaches past the low edge, above `kh` it misses (and past the
-        // suffix minimum, at most the low end, the run ends).
-        // (A NaN fails.)
-        let lo_meets = g.lo < kl || g.lo <= kh;
+        // The interval's low end decides first: above `kh` it misses (and
+        // past the suffix minimum, at most the low end, the run ends).
+        // One comparison per end: every wedge's query is ordered, `kl ≤
+        // kh` (a key less and plus margins that are not negative, the
+        // edges' keys in order, or `(−∞, −∞)`; [`Wedge::new`],
+        // [`Wedge::new_angular`] and a copy of its interval,
+        // [`Lean::copy`]), so `lo ≤ kh` is the `lo < kl || lo ≤ kh` this
+        // walk tested before (below `kl` the segment reaches past the low
+        // edge), and `hi ≥ kl` its `hi > kh || hi ≥ kl`: the test of
+        // [`offer`] and the references'. (The same decisions, 3 VFP
+        // comparisons a look and a take fewer: the representative window
+        // 728.0 → 711.5 instructions a point.) (A NaN fails.)
+        let lo_meets = g.lo <= kh;
         if !lo_meets {
             if g.sm > kh {
                 break;
@@ -726,7 +734,7 @@ pub(super) fn wedge_run_aside<const SKIP: bool>(
             }
             continue;
         }
-        let hi_meets = g.hi > kh || g.hi >= kl;
+        let hi_meets = g.hi >= kl;
         if !hi_meets {
             if c == 0 {
                 stop = Some(Status::OverBudget);

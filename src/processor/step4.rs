@@ -89,7 +89,8 @@ pub(super) fn match_boundary<const N: usize, D: Deadline>(
 /// The wedge path through an index's lean view ([`Index::lean`]): every
 /// point's run walked in locals ([`LeanWalk::point`]); the aside entries,
 /// if any, merged in by index ([`LeanWalk::point_aside`]), and on a loose
-/// index the block tree's skips taken too ([`LeanWalk::point_loose`]).
+/// index the block tree's skips taken too ([`LeanWalk::points`] with
+/// `LOOSE`).
 #[inline(never)]
 fn match_wedge_lean<const N: usize, D: Deadline>(
     pair: &Pair,
@@ -124,21 +125,9 @@ fn match_wedge_lean<const N: usize, D: Deadline>(
     };
     if blocks.any() {
         // A loose index (the keys fold somewhere): the tree's skips too.
-        for r in slots.iter_mut() {
-            if r.status == Status::NoIntersection {
-                if !guard.proceed(work) {
-                    *r = PointResult::flagged(r.pixel1, Status::OverBudget);
-                    continue;
-                }
-                let (h, refine) = walk.point_loose(r, hint, work);
-                hint = h;
-                if refine != 0 {
-                    walk.refine(r, refine, work);
-                }
-            }
-        }
+        hint = walk.points::<true, D>(slots, hint, (work, guard));
     } else if aside.is_empty() {
-        hint = walk.points(slots, hint, (work, guard));
+        hint = walk.points::<false, D>(slots, hint, (work, guard));
     } else {
         for r in slots.iter_mut() {
             if r.status == Status::NoIntersection {
@@ -415,7 +404,12 @@ struct LeanWalk<'a> {
 
 impl LeanWalk<'_> {
     /// [`Self::point`] for every point of `slots` left by steps 1–2, from
-    /// the run start `hint`; returns the last run's start. (Out of line,
+    /// the run start `hint`; returns the last run's start. With `LOOSE`,
+    /// through a loose index: the run's blocks that miss the wedge's keys
+    /// skipped by the tree ([`Self::aside_walk`], [`wedge_run_aside`];
+    /// in this loop `demo_9` 961.9 → 932.3 and `demo_13` 1 005.5 → 989.2
+    /// instructions a point, out of line per point as `point_aside` is
+    /// before). (Out of line,
     /// the loop inside with [`Self::point`] inlined: the registers a point
     /// uses are saved once a boundary, not once a point. With the point's
     /// `p₁` and `1/q_z` read only after its walk this measured 711.5 →
@@ -424,7 +418,7 @@ impl LeanWalk<'_> {
     /// the loop alone `demo_15` +6.1 instructions a point, the late reads
     /// alone every plain window.)
     #[inline(never)]
-    fn points<D: Deadline>(
+    fn points<const LOOSE: bool, D: Deadline>(
         &self,
         slots: &mut [PointResult],
         mut hint: usize,
@@ -436,7 +430,11 @@ impl LeanWalk<'_> {
                     *r = PointResult::flagged(r.pixel1, Status::OverBudget);
                     continue;
                 }
-                let (h, refine) = self.point(r, hint, work);
+                let (h, refine) = if LOOSE {
+                    self.aside_walk::<true>(r, hint, work)
+                } else {
+                    self.point(r, hint, work)
+                };
                 hint = h;
                 if refine != 0 {
                     self.refine(r, refine, work);
@@ -527,17 +525,12 @@ impl LeanWalk<'_> {
         self.aside_walk::<false>(r, hint, work)
     }
 
-    /// [`Self::point_aside`] through a loose index: the run's blocks that
-    /// miss the wedge's keys skipped by the tree ([`wedge_run_aside`]).
-    #[inline(never)]
-    fn point_loose(&self, r: &mut PointResult, hint: usize, work: &mut Work) -> (usize, usize) {
-        self.aside_walk::<true>(r, hint, work)
-    }
-
-    /// The body of [`Self::point_aside`] and [`Self::point_loose`], inlined
-    /// into each. (Two out-of-line wrappers, not one generic out-of-line
-    /// function: that one measured 15 instructions per point more on the
-    /// `spur_f2` window.)
+    /// The body of [`Self::point_aside`] and of a loose index's
+    /// [`Self::points`], inlined into each. (Not one generic out-of-line
+    /// function for both: that one measured 15 instructions per point more
+    /// on the `spur_f2` window. The aside walk's points in a loop like
+    /// [`Self::points`]' measured `demo_15` +17.2 instructions a point, and
+    /// `p₁` and `1/q_z` read after its walk `spur_f2` +6.8.)
     #[inline(always)]
     fn aside_walk<const SKIP: bool>(
         &self,
@@ -587,6 +580,9 @@ impl LeanWalk<'_> {
             (self.segments, self.cot_twice),
             work,
         );
+        // (On a loose index, in [`Self::points`]: what only the conclusion
+        // needs read after the walk, as [`Self::point`] does.)
+        let (p1, iz) = if SKIP { (r.pixel1, r.z) } else { (p1, iz) };
         (a, self.conclude(r, (p1, iz, r1), &wedge, outcome))
     }
 }

@@ -753,7 +753,18 @@ pub(super) fn wedge_run_aside<const SKIP: bool>(
             continue;
         }
         let hi_meets = g.hi >= kl;
-        if !hi_meets {
+        if !SKIP && !hi_meets {
+            // (Rare on a tight index: laid out of the walk's way. As
+            // `SKIP`'s below, without the skip.)
+            core::hint::cold_path();
+            if c == 0 {
+                stop = Some(Status::OverBudget);
+                break;
+            }
+            c -= 1;
+            continue;
+        }
+        if SKIP && !hi_meets {
             if c == 0 {
                 stop = Some(Status::OverBudget);
                 break;

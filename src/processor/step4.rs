@@ -1121,12 +1121,14 @@ fn finish_point(
         return r;
     };
     let z = s * iz;
-    // (A NaN fails.)
+    // (A NaN fails. Both flags rare: laid out of the usual point's way.)
     if !(z > 0.0) {
+        core::hint::cold_path();
         r.status = Status::NonPositiveDepth;
         return r;
     }
     if z > pair.config.max_depth {
+        core::hint::cold_path();
         r.status = Status::BeyondMaxDepth;
         return r;
     }

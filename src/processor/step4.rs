@@ -738,7 +738,21 @@ pub(super) fn wedge_run_aside<const SKIP: bool>(
         // comparisons a look and a take fewer: the representative window
         // 728.0 → 711.5 instructions a point.) (A NaN fails.)
         let lo_meets = g.lo <= kh;
-        if !lo_meets {
+        if !SKIP && !lo_meets {
+            // (On a tight index about once a run, at its end: laid out of
+            // the walk's way. As `SKIP`'s below, without the skip.)
+            core::hint::cold_path();
+            if g.sm > kh {
+                break;
+            }
+            if c == 0 {
+                stop = Some(Status::OverBudget);
+                break;
+            }
+            c -= 1;
+            continue;
+        }
+        if SKIP && !lo_meets {
             if g.sm > kh {
                 break;
             }

@@ -751,14 +751,8 @@ fn compensate_all_certified(
     // and the compensation's loop stays lean. (In that loop until settled,
     // as before, the representative window measured 675.9 instructions a
     // point against 673.7, every other window dearer too.)
-    if !order.settled() {
-        for (slot, &e) in slots.iter().zip(margins.iter()).take(n) {
-            order.push(slot.z_far, e);
-            if order.settled() {
-                break;
-            }
-        }
-    }
+    let keys = slots.iter().zip(margins.iter()).take(n);
+    order.push_until_settled(keys.map(|(slot, &e)| (slot.z_far, e)));
 }
 
 /// Step 3: index the frame-2 polyline; with `W' < 0` and the FOE near, the

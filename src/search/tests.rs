@@ -409,3 +409,45 @@ fn a_build_in_parts_or_with_a_clock_is_the_same_build() {
         "{stopped} stopped, {built} built"
     );
 }
+
+/// [`KeyOrder::push_until_settled`] leaves [`KeyOrder::strict`] and
+/// [`KeyOrder::settled`] as pushing every key one at a time does, whole or
+/// in parts (a caller's deadline between them), and, while not settled,
+/// the last key and its widened ends too: on every shape of
+/// [`keys`], short and long, with keys missing, ties and steps both ways.
+#[test]
+fn key_order_pass_is_the_pushes() {
+    let mut rng = Rng(0x5eed_04d3);
+    for case in 0..4000 {
+        let n = 1 + (rng.next() * 40.0) as usize;
+        let mut ks = keys(&mut rng, case % 5, n, false);
+        // Ties and exact steps of the margins now and then.
+        if case % 7 == 0 && n > 2 {
+            let i = 1 + (rng.next() * (n - 2) as f32) as usize;
+            ks[i] = ks[i - 1];
+        }
+        if case % 11 == 0 {
+            ks.reverse();
+        }
+        let mut one = KeyOrder::NEW;
+        for &(k, e) in &ks {
+            one.push(k, e);
+        }
+        let parts = 1 + (case % 3) as usize;
+        let cut = |p: usize| (p * ks.len()) / parts;
+        let mut pass = KeyOrder::NEW;
+        for p in 0..parts {
+            pass.push_until_settled(ks[cut(p)..cut(p + 1)].iter().copied());
+        }
+        assert_eq!(pass.strict(0.0), one.strict(0.0), "case {case}: {ks:?}");
+        assert_eq!(pass.settled(), one.settled(), "case {case}");
+        if !one.settled() {
+            // (Every field, the floats to their shortest exact form.)
+            assert_eq!(
+                std::format!("{pass:?}"),
+                std::format!("{one:?}"),
+                "case {case}"
+            );
+        }
+    }
+}

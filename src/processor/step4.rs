@@ -88,9 +88,9 @@ pub(super) fn match_boundary<const N: usize, D: Deadline>(
 
 /// The wedge path through an index's lean view ([`Index::lean`]): every
 /// point's run walked in locals ([`LeanWalk::point`]); the aside entries,
-/// if any, merged in by index ([`LeanWalk::point_aside`]), and on a loose
-/// index the block tree's skips taken too ([`LeanWalk::points`] with
-/// `LOOSE`).
+/// if any, merged in by index, and on a loose index the block tree's skips
+/// taken too ([`LeanWalk::aside_walk`]); each walk's points in one loop
+/// ([`LeanWalk::points`]).
 #[inline(never)]
 fn match_wedge_lean<const N: usize, D: Deadline>(
     pair: &Pair,
@@ -125,23 +125,11 @@ fn match_wedge_lean<const N: usize, D: Deadline>(
     };
     if blocks.any() {
         // A loose index (the keys fold somewhere): the tree's skips too.
-        hint = walk.points::<true, D>(slots, hint, (work, guard));
+        hint = walk.points::<2, D>(slots, hint, (work, guard));
     } else if aside.is_empty() {
-        hint = walk.points::<false, D>(slots, hint, (work, guard));
+        hint = walk.points::<0, D>(slots, hint, (work, guard));
     } else {
-        for r in slots.iter_mut() {
-            if r.status == Status::NoIntersection {
-                if !guard.proceed(work) {
-                    *r = PointResult::flagged(r.pixel1, Status::OverBudget);
-                    continue;
-                }
-                let (h, refine) = walk.point_aside(r, hint, work);
-                hint = h;
-                if refine != 0 {
-                    walk.refine(r, refine, work);
-                }
-            }
-        }
+        hint = walk.points::<1, D>(slots, hint, (work, guard));
     }
     index.set_hint(hint);
 }
@@ -403,13 +391,15 @@ struct LeanWalk<'a> {
 }
 
 impl LeanWalk<'_> {
-    /// [`Self::point`] for every point of `slots` left by steps 1–2, from
-    /// the run start `hint`; returns the last run's start. With `LOOSE`,
-    /// through a loose index: the run's blocks that miss the wedge's keys
-    /// skipped by the tree ([`Self::aside_walk`], [`wedge_run_aside`];
-    /// in this loop `demo_9` 961.9 → 932.3 and `demo_13` 1 005.5 → 989.2
-    /// instructions a point, out of line per point as `point_aside` is
-    /// before). (Out of line,
+    /// Step 4 for every point of `slots` left by steps 1–2, from the run
+    /// start `hint`; returns the last run's start. `WALK` 0: the plain
+    /// walk ([`Self::point`]); 1: with the index's aside entries merged
+    /// into the run ([`Self::aside_walk`]); 2: through a loose index, the
+    /// run's blocks that miss the wedge's keys skipped by the tree
+    /// ([`Self::aside_walk`], [`wedge_run_aside`]). (The aside and loose
+    /// walks in this loop, not out of line per point: `spur_f2` 977.0 →
+    /// 966.0, `demo_9` 961.9 → 932.3, `demo_13` 1 005.5 → 977.4
+    /// instructions a point.) (Out of line,
     /// the loop inside with [`Self::point`] inlined: the registers a point
     /// uses are saved once a boundary, not once a point. With the point's
     /// `p₁` and `1/q_z` read only after its walk this measured 711.5 →
@@ -418,7 +408,7 @@ impl LeanWalk<'_> {
     /// the loop alone `demo_15` +6.1 instructions a point, the late reads
     /// alone every plain window.)
     #[inline(never)]
-    fn points<const LOOSE: bool, D: Deadline>(
+    fn points<const WALK: u8, D: Deadline>(
         &self,
         slots: &mut [PointResult],
         mut hint: usize,
@@ -430,10 +420,10 @@ impl LeanWalk<'_> {
                     *r = PointResult::flagged(r.pixel1, Status::OverBudget);
                     continue;
                 }
-                let (h, refine) = if LOOSE {
-                    self.aside_walk::<true>(r, hint, work)
-                } else {
-                    self.point(r, hint, work)
+                let (h, refine) = match WALK {
+                    0 => self.point(r, hint, work),
+                    1 => self.aside_walk::<false>(r, hint, work),
+                    _ => self.aside_walk::<true>(r, hint, work),
                 };
                 hint = h;
                 if refine != 0 {
@@ -519,18 +509,10 @@ impl LeanWalk<'_> {
     }
 
     /// [`Self::point`] with the index's aside entries merged into the run
-    /// ([`wedge_run_aside`]).
-    #[inline(never)]
-    fn point_aside(&self, r: &mut PointResult, hint: usize, work: &mut Work) -> (usize, usize) {
-        self.aside_walk::<false>(r, hint, work)
-    }
-
-    /// The body of [`Self::point_aside`] and of a loose index's
-    /// [`Self::points`], inlined into each. (Not one generic out-of-line
-    /// function for both: that one measured 15 instructions per point more
-    /// on the `spur_f2` window. The aside walk's points in a loop like
-    /// [`Self::points`]' measured `demo_15` +17.2 instructions a point, and
-    /// `p₁` and `1/q_z` read after its walk `spur_f2` +6.8.)
+    /// ([`wedge_run_aside`]), through a loose index (`SKIP`) with the
+    /// tree's skips too; inlined into [`Self::points`]. (Without `SKIP`,
+    /// `p₁` and `1/q_z` read after the walk measured `demo_15` +17.2
+    /// instructions a point, read before it as here none dearer.)
     #[inline(always)]
     fn aside_walk<const SKIP: bool>(
         &self,

@@ -125,11 +125,11 @@ fn match_wedge_lean<const N: usize, D: Deadline>(
     };
     if blocks.any() {
         // A loose index (the keys fold somewhere): the tree's skips too.
-        hint = walk.points::<2, D>(slots, hint, (work, guard));
+        hint = walk.points_for::<2, D>(slots, hint, (work, guard));
     } else if aside.is_empty() {
-        hint = walk.points::<0, D>(slots, hint, (work, guard));
+        hint = walk.points_for::<0, D>(slots, hint, (work, guard));
     } else {
-        hint = walk.points::<1, D>(slots, hint, (work, guard));
+        hint = walk.points_for::<1, D>(slots, hint, (work, guard));
     }
     index.set_hint(hint);
 }
@@ -391,6 +391,22 @@ struct LeanWalk<'a> {
 }
 
 impl LeanWalk<'_> {
+    /// [`Self::points`], or under a caller's deadline
+    /// [`Self::points_within`].
+    #[inline(always)]
+    fn points_for<const WALK: u8, D: Deadline>(
+        &self,
+        slots: &mut [PointResult],
+        hint: usize,
+        (work, guard): (&mut Work, &mut Guard<'_, D>),
+    ) -> usize {
+        if D::NEVER {
+            self.points::<WALK, D>(slots, hint, (work, guard))
+        } else {
+            self.points_within::<WALK, D>(slots, hint, (work, guard))
+        }
+    }
+
     /// Step 4 for every point of `slots` left by steps 1–2, from the run
     /// start `hint`; returns the last run's start. `WALK` 0: the plain
     /// walk ([`Self::point`]); 1: with the index's aside entries merged
@@ -421,9 +437,9 @@ impl LeanWalk<'_> {
                     continue;
                 }
                 let (h, refine) = match WALK {
-                    0 => self.point(r, hint, work),
-                    1 => self.aside_walk::<false>(r, hint, work),
-                    _ => self.aside_walk::<true>(r, hint, work),
+                    0 => self.point::<true>(r, hint, work),
+                    1 => self.aside_walk::<false, false>(r, hint, work),
+                    _ => self.aside_walk::<true, true>(r, hint, work),
                 };
                 hint = h;
                 if refine != 0 {
@@ -434,12 +450,68 @@ impl LeanWalk<'_> {
         hint
     }
 
+    /// [`Self::points`] under a caller's deadline, whose question before
+    /// each point ([`Guard::proceed`]) is a call: each point's walk out of
+    /// line ([`Self::walk_out`]), its registers its own. (With the walks
+    /// inlined into the loop, as without a deadline, the bench's demo drive
+    /// within 212 000 measured frames 1–5 +2.4 to +4.4 %, two of them then
+    /// cut.)
+    #[inline(always)]
+    fn points_within<const WALK: u8, D: Deadline>(
+        &self,
+        slots: &mut [PointResult],
+        mut hint: usize,
+        (work, guard): (&mut Work, &mut Guard<'_, D>),
+    ) -> usize {
+        for r in slots.iter_mut() {
+            if r.status == Status::NoIntersection {
+                if !guard.proceed(work) {
+                    *r = PointResult::flagged(r.pixel1, Status::OverBudget);
+                    continue;
+                }
+                let (h, refine) = self.walk_out::<WALK>(r, hint, work);
+                hint = h;
+                if refine != 0 {
+                    self.refine(r, refine, work);
+                }
+            }
+        }
+        hint
+    }
+
+    /// One point's walk `WALK` ([`Self::points`]) out of line, `p₁` and
+    /// `1/q_z` read before it ([`Self::points_within`]).
+    #[inline(never)]
+    fn walk_out<const WALK: u8>(
+        &self,
+        r: &mut PointResult,
+        hint: usize,
+        work: &mut Work,
+    ) -> (usize, usize) {
+        match WALK {
+            0 => self.point::<false>(r, hint, work),
+            1 => self.aside_walk::<false, false>(r, hint, work),
+            _ => self.aside_walk::<true, false>(r, hint, work),
+        }
+    }
+
     /// Step 4 for the point left by steps 1–2 in `r`: its wedge, the walk
     /// over its run (from the last run's start `hint`), the result in `r`;
-    /// returns where the run started. (Inlined into [`Self::points`].)
+    /// returns where the run started. (Inlined into [`Self::points`], with
+    /// `LATE`: `p₁` and `1/q_z` read after the walk; into
+    /// [`Self::walk_out`] without, read before it.)
     #[inline(always)]
-    fn point(&self, r: &mut PointResult, hint: usize, work: &mut Work) -> (usize, usize) {
+    fn point<const LATE: bool>(
+        &self,
+        r: &mut PointResult,
+        hint: usize,
+        work: &mut Work,
+    ) -> (usize, usize) {
         let (p, r1, key) = (r.pixel2.arr(), r.z_near, r.z_far);
+        // (Not read at all here with `LATE`: a read left for the optimiser
+        // to drop measured two register moves more per flagged point in
+        // the bench firmware's loop, `straight_exact` +1.0 %.)
+        let early = if LATE { None } else { Some((r.pixel1, r.z)) };
         let Ok(wedge) = Wedge::new(
             p,
             (self.foe, self.side),
@@ -457,9 +529,9 @@ impl LeanWalk<'_> {
             self.cot_twice,
             work,
         );
-        // (`r` as steps 1–2 left it: what only the conclusion needs read
-        // after the walk, not kept through it.)
-        let (p1, iz) = (r.pixel1, r.z);
+        // (`r` as steps 1–2 left it: with `LATE` what only the conclusion
+        // needs read after the walk, not kept through it.)
+        let (p1, iz) = early.unwrap_or((r.pixel1, r.z));
         (a, self.conclude(r, (p1, iz, r1), &wedge, outcome))
     }
 
@@ -514,7 +586,7 @@ impl LeanWalk<'_> {
     /// `p₁` and `1/q_z` read after the walk measured `demo_15` +17.2
     /// instructions a point, read before it as here none dearer.)
     #[inline(always)]
-    fn aside_walk<const SKIP: bool>(
+    fn aside_walk<const SKIP: bool, const LATE: bool>(
         &self,
         r: &mut PointResult,
         hint: usize,
@@ -564,7 +636,11 @@ impl LeanWalk<'_> {
         );
         // (On a loose index, in [`Self::points`]: what only the conclusion
         // needs read after the walk, as [`Self::point`] does.)
-        let (p1, iz) = if SKIP { (r.pixel1, r.z) } else { (p1, iz) };
+        let (p1, iz) = if SKIP && LATE {
+            (r.pixel1, r.z)
+        } else {
+            (p1, iz)
+        };
         (a, self.conclude(r, (p1, iz, r1), &wedge, outcome))
     }
 }

@@ -744,7 +744,10 @@ fn a_failed_constraint_after_a_retire_changes_nothing() {
     f.step(0, &edge_frame(cam, 0.0, 24), None).expect("key");
     let mut retired = None;
     for id in 1..=2u32 {
-        let m = ChainedMotion { from: id - 1, motion: step };
+        let m = ChainedMotion {
+            from: id - 1,
+            motion: step,
+        };
         retired = f
             .step(id, &edge_frame(cam, id as f32, 24), Some(&m))
             .expect("step")
@@ -801,19 +804,29 @@ fn ranges_past_the_depth_codes_stay_out_of_the_map() {
     f.step(0, &edge(0.0), None).expect("key");
     let k = f.key().expect("key").len(0) - 1;
     let digest = f.digest();
-    assert_eq!(f.constrain(0, k, 1.0, f32::MAX), Err(FusionError::InvalidRange));
+    assert_eq!(
+        f.constrain(0, k, 1.0, f32::MAX),
+        Err(FusionError::InvalidRange)
+    );
     assert_eq!(f.digest(), digest);
     let p = f.constrain(0, k, 1.0, 1.0e30).expect("a valid range");
     assert_eq!(p.status, FusedStatus::Single);
     let mut unbounded = 0;
     for id in 1..=2u32 {
-        let m = ChainedMotion { from: id - 1, motion: step };
+        let m = ChainedMotion {
+            from: id - 1,
+            motion: step,
+        };
         let s = f.step(id, &edge(id as f32), Some(&m)).expect("step");
         unbounded += s.retired.map_or(0, |r| r.unbounded);
     }
     assert_eq!(unbounded, 1, "the constrained point is left out");
     let map = f.map();
-    assert_eq!(map.points(0).count(), map.len(0), "every stored point is given");
+    assert_eq!(
+        map.points(0).count(),
+        map.len(0),
+        "every stored point is given"
+    );
     assert!(map.len(0) > 0);
     for p in map.points(0) {
         assert!(
@@ -835,7 +848,9 @@ fn ranges_past_the_depth_codes_stay_out_of_the_map() {
 #[test]
 fn the_map_radius_covers_the_key_frames_localisation_error() {
     let cam = synth::Intrinsics::default().camera();
-    let base = Config::DEFAULT.with_translation_error(1.0e-4).expect("config");
+    let base = Config::DEFAULT
+        .with_translation_error(1.0e-4)
+        .expect("config");
     let mut f = Box::new(HostFusion::new(base, FusionConfig::DEFAULT));
     // True points (-1, 1, 7 + i) in the frame-0 camera; the camera moves
     // 0.05 right and 0.25 forward a frame.
@@ -858,8 +873,12 @@ fn the_map_radius_covers_the_key_frames_localisation_error() {
     f.step(0, &frame_at(0.0, 0.49), None).expect("key");
     let step = Motion::new([0.05, 0.0, 0.25], [0.0; 3]).expect("motion");
     for id in 1..=8u32 {
-        let m = ChainedMotion { from: id - 1, motion: step };
-        f.step(id, &frame_at(f64::from(id), 0.0), Some(&m)).expect("step");
+        let m = ChainedMotion {
+            from: id - 1,
+            motion: step,
+        };
+        f.step(id, &frame_at(f64::from(id), 0.0), Some(&m))
+            .expect("step");
     }
     let map = f.map();
     assert_eq!(map.batches(), 1);
@@ -873,8 +892,15 @@ fn the_map_radius_covers_the_key_frames_localisation_error() {
         let t = [truth[i][0] - 0.4, truth[i][1], truth[i][2] - 2.0];
         let d = Drive::segment_distance(t, p.near.map(f64::from), p.far.map(f64::from));
         let lateral = f64::from(p.far[2]) * 0.5 / 800.0;
-        assert!(d <= f64::from(p.radius), "point {i}: {d} > {} ({p:?})", p.radius);
-        assert!(d > 0.5 * lateral, "point {i}: the test's offset shows ({d})");
+        assert!(
+            d <= f64::from(p.radius),
+            "point {i}: {d} > {} ({p:?})",
+            p.radius
+        );
+        assert!(
+            d > 0.5 * lateral,
+            "point {i}: the test's offset shows ({d})"
+        );
         assert!(f64::from(p.radius) < 2.0 * lateral + 0.01, "{p:?}");
         checked += 1;
     }
@@ -908,7 +934,11 @@ fn limit_two_partners_past_a_crest_agree_on_the_hidden_stretch() {
     let frames: [&[(f32, f32)]; 4] = [
         &[(33.720425, 535.8427), (40.37532, 533.3972)],
         &[(113.94611, 559.26965), (115.672844, 559.15875)],
-        &[(52.902264, 543.791), (41.326317, 542.28906), (28.987741, 540.7667)],
+        &[
+            (52.902264, 543.791),
+            (41.326317, 542.28906),
+            (28.987741, 540.7667),
+        ],
         &[
             (50.23746, 528.56134),
             (39.272568, 527.05615),
@@ -917,9 +947,18 @@ fn limit_two_partners_past_a_crest_agree_on_the_hidden_stretch() {
         ],
     ];
     let motions = [
-        ([-0.009433916, -0.17606132, 1.455624], [-0.0009653559, -0.007718359, -0.0005456084]),
-        ([0.0044060056, -0.1807901, 1.5268402], [-0.008483555, -0.0059730206, 0.0020656479]),
-        ([-0.011022777, -0.18070243, 1.5621607], [-0.011423063, -0.0023354213, 0.0021708028]),
+        (
+            [-0.009433916, -0.17606132, 1.455624],
+            [-0.0009653559, -0.007718359, -0.0005456084],
+        ),
+        (
+            [0.0044060056, -0.1807901, 1.5268402],
+            [-0.008483555, -0.0059730206, 0.0020656479],
+        ),
+        (
+            [-0.011022777, -0.18070243, 1.5621607],
+            [-0.011423063, -0.0023354213, 0.0021708028],
+        ),
     ];
     let mut sticks = Vec::new();
     for (j, pts) in frames.iter().enumerate() {
@@ -937,7 +976,10 @@ fn limit_two_partners_past_a_crest_agree_on_the_hidden_stretch() {
         }
     }
     let z_seen = 9.52;
-    assert!(sticks[0].is_none(), "the first pair matches nothing: {sticks:?}");
+    assert!(
+        sticks[0].is_none(),
+        "the first pair matches nothing: {sticks:?}"
+    );
     for s in sticks[1..].iter().flatten() {
         assert!(s.z_near > 4.0 * z_seen, "a far-stretch stick: {s:?}");
     }
@@ -960,8 +1002,11 @@ fn limit_a_single_pair_on_another_stretch() {
     let config = Config::new(0.5, 0.5, 10.0, 1000.0).expect("config");
     let mut f = Box::new(HostFusion::new(config, FusionConfig::DEFAULT));
     let mut key = Frame::<N, B>::new(cam);
-    key.push_boundary(&[Pixel::new(434.69595, 283.7184), Pixel::new(417.65152, 242.88559)])
-        .expect("valid");
+    key.push_boundary(&[
+        Pixel::new(434.69595, 283.7184),
+        Pixel::new(417.65152, 242.88559),
+    ])
+    .expect("valid");
     let mut partner = Frame::<N, B>::new(cam);
     partner
         .push_boundary(&[
@@ -984,7 +1029,10 @@ fn limit_a_single_pair_on_another_stretch() {
     let p = f.key().expect("key").point(0, 0).expect("point");
     assert_eq!(p.status, FusedStatus::Single, "{p:?}");
     let iv = p.interval.expect("interval");
-    assert!(iv.z_far < 3.0, "the other stretch's depth, not 52.8: {iv:?}");
+    assert!(
+        iv.z_far < 3.0,
+        "the other stretch's depth, not 52.8: {iv:?}"
+    );
 }
 
 /// A range sensor's return along a key-frame point's ray (the truth ± 1 %

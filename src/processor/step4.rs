@@ -749,9 +749,12 @@ pub(super) fn wedge_run_aside<const SKIP: bool>(
     let mut cached = usize::MAX;
     let mut va = WVertex::NONE;
     let mut stop = None;
-    // The aside entries not yet offered.
+    // The aside entries not yet offered, and the segment index of the
+    // next one (`usize::MAX`: none left).
     let mut rest = aside.iter();
     let mut next = rest.next();
+    let at_of = |e: Option<&crate::search::Aside>| e.map_or(usize::MAX, |e| usize::from(e.0));
+    let mut next_at = at_of(next);
     let cx = (segments, cot_twice);
     let end = segs.len().min(b2.len().saturating_sub(1));
     // The vertices up to the run's last end (the aside entries take theirs
@@ -766,13 +769,28 @@ pub(super) fn wedge_run_aside<const SKIP: bool>(
         let (Some(g), Some(v1)) = (segs.get(j), run.get(j + 1)) else {
             break;
         };
-        // The aside entries before segment `j` come first.
-        while let Some(&(k, l, h)) = next.filter(|e| usize::from(e.0) < j) {
+        // The aside entries before segment `j` come first. (On a loose
+        // index a look tests only `next_at`, one integer comparison: the
+        // entry's `Option` and its index took 9 instructions a look there,
+        // `demo_9` 920.6 → 893.4, `demo_13` 977.4 → 953.9 instructions a
+        // point. On a tight index the same form made the usual walk
+        // beside it dearer, `demo_15` +0.6 %: there the test is as before,
+        // and `next_at` unused.)
+        while if SKIP {
+            next_at < j
+        } else {
+            next.is_some_and(|e| usize::from(e.0) < j)
+        } {
+            let Some(&(k, l, h)) = next else {
+                break;
+            };
+            let k = usize::from(k);
             next = rest.next();
+            next_at = at_of(next);
             if let Err(s) = offer(
                 wedge,
                 b2,
-                usize::from(k),
+                k,
                 (l, h),
                 &mut c,
                 &mut walk,

@@ -451,3 +451,67 @@ fn key_order_pass_is_the_pushes() {
         }
     }
 }
+
+/// The outlier pass ([`build::outliers`]) against a look-up of both
+/// neighbours of every segment (its form before it carried them along), on
+/// random intervals with outliers, unkeyed and empty ones, from 0 to 40
+/// segments, with and without a clock that never stops it.
+#[test]
+fn outliers_are_the_look_ups() {
+    fn reference(seg: &[Seg], wide: f32) -> Vec<Aside> {
+        let mut aside = Vec::new();
+        let ends = |i: usize| {
+            seg.get(i)
+                .map_or((f32::INFINITY, f32::NEG_INFINITY), |x| (x.lo, x.hi))
+        };
+        for (j, g) in seg.iter().enumerate() {
+            let all = g.lo == f32::NEG_INFINITY;
+            let out = g.lo.is_finite() && g.hi.is_finite() && {
+                let (bl, bh) = j
+                    .checked_sub(2)
+                    .map_or((f32::INFINITY, f32::NEG_INFINITY), ends);
+                let (al, ah) = ends(j + 2);
+                let (lo, hi) = (fmin(bl, al), fmax(bh, ah));
+                hi > f32::NEG_INFINITY && (g.hi - hi > wide || lo - g.lo > wide)
+            };
+            if (all || out) && aside.len() < MAX_ASIDE {
+                aside.push((j as u16, g.lo, g.hi));
+            }
+        }
+        aside
+    }
+    let mut rng = Rng(0x5eed_0a51);
+    let mut found = 0;
+    for case in 0..4000 {
+        let s = case % 41;
+        let mut k = rng.next();
+        let seg: Vec<Seg> = (0..s)
+            .map(|_| {
+                k += 0.05 * (rng.next() - 0.3);
+                let (mut lo, mut hi) = (k - 0.01 * rng.next(), k + 0.03 * rng.next());
+                match (rng.next() * 20.0) as u32 {
+                    0 => (lo, hi) = (f32::NEG_INFINITY, f32::INFINITY),
+                    1 => (lo, hi) = (f32::INFINITY, f32::NEG_INFINITY),
+                    2 => hi += 2.0 * rng.next(),
+                    3 => lo -= 2.0 * rng.next(),
+                    _ => {}
+                }
+                Seg {
+                    lo,
+                    hi,
+                    sm: 0.0,
+                    pm: 0.0,
+                }
+            })
+            .collect();
+        let wide = 0.2 * rng.next();
+        let want = reference(&seg, wide);
+        found += want.len();
+        let got = build::outliers(&seg, wide, &mut None).unwrap();
+        assert_eq!(got.as_slice(), want.as_slice(), "case {case}");
+        let mut never = || false;
+        let got = build::outliers(&seg, wide, &mut Some(&mut never)).unwrap();
+        assert_eq!(got.as_slice(), want.as_slice(), "case {case}, clock");
+    }
+    assert!(found > 4000, "{found}");
+}

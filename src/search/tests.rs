@@ -150,6 +150,19 @@ fn visit_offers_every_segment_that_meets_the_query() {
             }
         }
         b.finish(None, &mut None);
+        // The envelopes are the running extremes of the intervals, bit for
+        // bit (the rebuild's prefix maxima taken on from the pushes').
+        let segs = index.seg.get(..index.segments).unwrap();
+        let mut run = f32::NEG_INFINITY;
+        for (j, g) in segs.iter().enumerate() {
+            run = fmax(run, g.hi);
+            assert_eq!(g.pm.to_bits(), run.to_bits(), "case {case}: pm[{j}]");
+        }
+        let mut run = f32::INFINITY;
+        for (j, g) in segs.iter().enumerate().rev() {
+            run = fmin(run, g.lo);
+            assert_eq!(g.sm.to_bits(), run.to_bits(), "case {case}: sm[{j}]");
+        }
         let ivs = intervals(&ks, period);
         for _ in 0..8 {
             let c = if period {

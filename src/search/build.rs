@@ -42,8 +42,12 @@ impl<const N: usize> Index<N> {
     }
 
     /// The suffix minima `sm`; whether somewhere the envelopes are more
-    /// than `wide` apart (`None`: `tick`'s clock stopped the pass).
-    fn suffix_minima(&mut self, wide: f32, tick: &mut Tick<'_>) -> Option<bool> {
+    /// than `wide` apart (`None`: `tick`'s clock stopped the pass). With
+    /// `answer`, only that answer is wanted where it is yes (a rebuild
+    /// follows, which computes them anew): without a clock the pass stops
+    /// when the last two segments tell (an outlier at a boundary's far
+    /// end, often), the minima before them left as they were.
+    fn suffix_minima(&mut self, wide: f32, tick: &mut Tick<'_>, answer: bool) -> Option<bool> {
         let s = self.segments;
         let Some(seg) = self.seg.get_mut(..s) else {
             return Some(false);
@@ -53,15 +57,39 @@ impl<const N: usize> Index<N> {
             run = fmin(run, g.lo);
             g.sm = run;
             gap = fmax(gap, g.pm - run);
+            gap
         };
         match tick {
-            None => seg.iter_mut().rev().for_each(&mut one),
+            None => {
+                // (The last two peeled off the loop, not a loop of their
+                // own: the rest is the loop it was.)
+                let head = match seg {
+                    [head @ .., a, b] => {
+                        one(b);
+                        // (The gap only grows from here, unless a NaN
+                        // comes, which needs an empty interval, an unkeyed
+                        // vertex's in the fold test's index: then the
+                        // rebuild is taken anyway, `Builder::finish`. A
+                        // NaN here goes on.)
+                        if one(a) > wide && answer {
+                            return Some(true);
+                        }
+                        head
+                    }
+                    seg => seg,
+                };
+                head.iter_mut().rev().for_each(|g| {
+                    one(g);
+                });
+            }
             Some(t) => {
                 for (c, part) in seg.rchunks_mut(CHUNK).enumerate() {
                     if c > 0 && t() {
                         return None;
                     }
-                    part.iter_mut().rev().for_each(&mut one);
+                    part.iter_mut().rev().for_each(|g| {
+                        one(g);
+                    });
                 }
             }
         }
@@ -131,7 +159,7 @@ impl<const N: usize> Index<N> {
         }
         // The block tree for runs through the rebuilt envelopes, when they
         // are still loose (tight runs are short: no tree needed).
-        let Some(loose) = self.suffix_minima(wide, tick) else {
+        let Some(loose) = self.suffix_minima(wide, tick, false) else {
             return false;
         };
         self.loose = loose;
@@ -700,7 +728,11 @@ impl<const N: usize> Builder<'_, N> {
         let flip = last < first;
         index.orient = o;
         let wide = WIDE * sum / fmax(s as f32, 1.0);
-        let Some(loose) = index.suffix_minima(wide, tick) else {
+        // (Loose envelopes are rebuilt, and their minima computed anew:
+        // this pass may stop once it knows, `answer`. Where an outlier at
+        // the boundary's far end tells, the whole pass is saved: `demo_13`
+        // 930.2 → 915.7 instructions a point.)
+        let Some(loose) = index.suffix_minima(wide, tick, true) else {
             return false;
         };
         index.loose = loose;

@@ -171,15 +171,14 @@ impl<const N: usize> Index<N> {
     /// when `tick`'s clock stopped it.
     fn build_tree(&mut self, tick: &mut Tick<'_>) -> bool {
         let s = self.segments;
-        let seg = &self.seg;
-        let leaf = |c0: usize, c1: usize| {
+        let leaves = self.seg.get(..s).unwrap_or(&[]).chunks(FAN).map(|c| {
             let mut q = [f32::INFINITY, f32::NEG_INFINITY];
-            for g in seg.get(c0..c1).unwrap_or(&[]) {
+            for g in c {
                 q = [fmin(q[0], g.lo), fmax(q[1], g.hi)];
             }
             q
-        };
-        match build_levels(&mut self.tree, s, 0, leaf, tick) {
+        });
+        match build_levels(&mut self.tree, s, 0, leaves, tick) {
             Some(built) => {
                 (self.levels, self.tree_end) = built;
                 true
@@ -224,7 +223,8 @@ impl<const N: usize> Index<N> {
             }
             q
         };
-        let Some((levels, _)) = build_levels(&mut self.tree, s, self.tree_end, leaf, tick) else {
+        let leaves = (0..s.div_ceil(FAN)).map(|k| leaf(k * FAN, ((k + 1) * FAN).min(s)));
+        let Some((levels, _)) = build_levels(&mut self.tree, s, self.tree_end, leaves, tick) else {
             return;
         };
         // (`levels` ≤ LEVELS = 4.)
@@ -233,8 +233,9 @@ impl<const N: usize> Index<N> {
 }
 
 /// Levels of a block tree over `s` segments in `tree` from `base` on,
-/// `W` values a block: level 1's block `k` is `leaf(k·FAN, min((k + 1)·FAN,
-/// s))` (its segments' range), each higher level's block the hull of the
+/// `W` values a block: level 1's block `k` is the `k`-th of `leaves` (the
+/// values of segments `k·FAN .. min((k + 1)·FAN, s)`; the widest where
+/// there are fewer), each higher level's block the hull of the
 /// `FAN` blocks below it (values at even places the minimum, at odd places
 /// the maximum: `(min, max)` pairs). As many levels as fit in `tree` (level
 /// `l` has `⌈s / FAN^l⌉` blocks), at most [`LEVELS`], stopping at the level
@@ -247,9 +248,18 @@ fn build_levels<const W: usize>(
     tree: &mut [f32],
     s: usize,
     mut base: usize,
-    leaf: impl Fn(usize, usize) -> [f32; W],
+    leaves: impl Iterator<Item = [f32; W]>,
     tick: &mut Tick<'_>,
 ) -> Option<(usize, usize)> {
+    let mut leaves = leaves;
+    let mut widest = [0.0f32; W];
+    for (i, v) in widest.iter_mut().enumerate() {
+        *v = if i % 2 == 0 {
+            f32::NEG_INFINITY
+        } else {
+            f32::INFINITY
+        };
+    }
     let (mut built, mut end_of) = (0usize, base);
     let (mut below_base, mut below_n, mut size) = (0usize, s, 1usize);
     for level in 1..=LEVELS {
@@ -258,13 +268,22 @@ fn build_levels<const W: usize>(
         let Some(end) = base.checked_add(W * n).filter(|&e| e <= tree.len()) else {
             break;
         };
-        for k in 0..n {
-            if k % (CHUNK / FAN) == CHUNK / FAN - 1 && expired(tick) {
-                return None;
+        if level == 1 {
+            // (The same blocks, written in order.)
+            let blocks = tree.get_mut(base..end).unwrap_or_default();
+            for (k, t) in blocks.chunks_exact_mut(W).enumerate() {
+                if k % (CHUNK / FAN) == CHUNK / FAN - 1 && expired(tick) {
+                    return None;
+                }
+                for (t, v) in t.iter_mut().zip(leaves.next().unwrap_or(widest)) {
+                    *t = v;
+                }
             }
-            let q = if level == 1 {
-                leaf(k * FAN, ((k + 1) * FAN).min(s))
-            } else {
+        } else {
+            for k in 0..n {
+                if k % (CHUNK / FAN) == CHUNK / FAN - 1 && expired(tick) {
+                    return None;
+                }
                 let mut q = [0.0f32; W];
                 for (i, v) in q.iter_mut().enumerate() {
                     *v = if i % 2 == 0 {
@@ -283,11 +302,10 @@ fn build_levels<const W: usize>(
                         };
                     }
                 }
-                q
-            };
-            if let Some(t) = tree.get_mut(base + W * k..base + W * (k + 1)) {
-                for (t, v) in t.iter_mut().zip(q) {
-                    *t = v;
+                if let Some(t) = tree.get_mut(base + W * k..base + W * (k + 1)) {
+                    for (t, v) in t.iter_mut().zip(q) {
+                        *t = v;
+                    }
                 }
             }
         }

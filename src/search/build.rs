@@ -171,13 +171,18 @@ impl<const N: usize> Index<N> {
     /// when `tick`'s clock stopped it.
     fn build_tree(&mut self, tick: &mut Tick<'_>) -> bool {
         let s = self.segments;
-        let leaves = self.seg.get(..s).unwrap_or(&[]).chunks(FAN).map(|c| {
+        let hull = |c: &[Seg]| {
             let mut q = [f32::INFINITY, f32::NEG_INFINITY];
             for g in c {
                 q = [fmin(q[0], g.lo), fmax(q[1], g.hi)];
             }
             q
-        });
+        };
+        // (Whole blocks, then the short last one: the same blocks as
+        // `chunks(FAN)`, the whole ones each in one straight run.)
+        let blocks = self.seg.get(..s).unwrap_or(&[]).chunks_exact(FAN);
+        let last = Some(blocks.remainder()).filter(|r| !r.is_empty());
+        let leaves = blocks.map(hull).chain(last.map(hull));
         match build_levels(&mut self.tree, s, 0, leaves, tick) {
             Some(built) => {
                 (self.levels, self.tree_end) = built;

@@ -274,7 +274,9 @@ impl Keying {
 }
 
 /// The half-plane key of `q` ([`Pencil::Half`] with these fields) and its
-/// margin, or [`NO_KEY`] (and 0).
+/// margin, or [`NO_KEY`] (and 0). For a finite `q` and FOE (and `min_t >
+/// 0`, as [`Keying::choose`] makes it) a key is `d_u / (|d_u| + t)` with
+/// `t ≥ min_t`: finite and at most 1 in magnitude (and a rounding).
 #[inline(always)]
 pub(crate) fn half_key(
     q: [f32; 2],

@@ -787,7 +787,8 @@ fn frame2_keys<'a, const N: usize>(
         match keying.pencil {
             Pencil::Half { foe, side, min_t } => {
                 let ks = keying.key_scale;
-                builder.push_all(b2.iter().map(|p| half_key(p.arr(), (foe, side, min_t), ks)));
+                builder
+                    .push_all_bounded(b2.iter().map(|p| half_key(p.arr(), (foe, side, min_t), ks)));
             }
             _ => builder.push_all(b2.iter().map(|p| keying.key(p.arr()))),
         }

@@ -553,7 +553,22 @@ impl<const N: usize> Builder<'_, N> {
     #[inline(always)]
     pub(crate) fn push_all(&mut self, keys: impl Iterator<Item = (f32, f32)>) {
         let mut keys = keys;
-        self.push_run(|m| {
+        self.push_run::<false>(|m| {
+            let (raw, e) = keys.next()?;
+            *m = e;
+            Some(raw)
+        });
+    }
+
+    /// [`Self::push_all`] for keys that are [`NO_KEY`] or finite and at
+    /// most 2 in magnitude (half-plane keys, [`crate::pencil::half_key`]):
+    /// then a key and the one before sum to a finite value exactly when the
+    /// key is not `NO_KEY`, the lean loop's test, asked that way (the same
+    /// index).
+    #[inline(always)]
+    pub(crate) fn push_all_bounded(&mut self, keys: impl Iterator<Item = (f32, f32)>) {
+        let mut keys = keys;
+        self.push_run::<true>(|m| {
             let (raw, e) = keys.next()?;
             *m = e;
             Some(raw)
@@ -565,7 +580,7 @@ impl<const N: usize> Builder<'_, N> {
     #[inline(always)]
     pub(crate) fn push_all_stored(&mut self, keys: impl Iterator<Item = f32>) {
         let mut keys = keys;
-        self.push_run(|_| keys.next());
+        self.push_run::<false>(|_| keys.next());
     }
 
     /// Push vertices while `next` gives their raw keys, each with its
@@ -577,9 +592,11 @@ impl<const N: usize> Builder<'_, N> {
     /// from the first vertex it cannot take on, [`Self::push_stored`]. A
     /// polyline may come in parts (a caller's deadline asked between them):
     /// a part that follows a finite key goes on in the lean loop, with the
-    /// same values one call would give.
+    /// same values one call would give. `BOUNDED`: every key `next` gives
+    /// is [`NO_KEY`] or finite and at most 2 in magnitude
+    /// ([`Self::push_all_bounded`]).
     #[inline(always)]
-    fn push_run(&mut self, mut next: impl FnMut(&mut f32) -> Option<f32>) {
+    fn push_run<const BOUNDED: bool>(&mut self, mut next: impl FnMut(&mut f32) -> Option<f32>) {
         let mut pending = None;
         if self.period <= 0.0 {
             if self.n == 0 {
@@ -611,7 +628,13 @@ impl<const N: usize> Builder<'_, N> {
                     break;
                 };
                 let k = o * raw;
-                if !(k + prev).is_finite() {
+                // (Bounded keys: `prev` is at most 2 in magnitude too.)
+                let leave = if BOUNDED {
+                    raw == NO_KEY
+                } else {
+                    !(k + prev).is_finite()
+                };
+                if leave {
                     pending = Some(raw);
                     break;
                 }

@@ -37,14 +37,16 @@ use crate::structure::{PointResult, Status, FOLD_WINDOW};
 /// Step 2 for one boundary's points in `slots` (step 1's results: a point
 /// still to be matched holds its raw key in `z_far`, its margin in the
 /// index's margins), whose key order step 1 tracked in `order`, keys of
-/// the given `period` and likely orientation `orient`; each point brings
+/// the given `period` and likely orientation `orient` (`bounded`: every
+/// point is still to be matched, its key [`NO_KEY`] or finite with a finite
+/// margin ≥ 0, half-plane keys of a certified step 1); each point brings
 /// `allowance` units to `work`. Flags the points that fold; a point rule 3
 /// would query once `guard`'s deadline has expired is
 /// [`Status::OverBudget`].
 pub(crate) fn step<const N: usize, D: Deadline>(
     index: &mut Index<N>,
     slots: &mut [PointResult],
-    (order, period, orient): (&KeyOrder, f32, f32),
+    (order, period, orient, bounded): (&KeyOrder, f32, f32, bool),
     allowance: u32,
     work: &mut Work,
     guard: &mut Guard<'_, D>,
@@ -56,7 +58,13 @@ pub(crate) fn step<const N: usize, D: Deadline>(
         return;
     }
     if period <= 0.0 {
-        match by_hulls(slots, index.margins(), || guard.check()) {
+        let margins = index.margins();
+        let hulls = if bounded {
+            by_hulls::<true>(slots, margins, || guard.check())
+        } else {
+            by_hulls::<false>(slots, margins, || guard.check())
+        };
+        match hulls {
             Hulls::Decided => {
                 work.grant(allowance.saturating_mul(n));
                 return;
@@ -144,12 +152,16 @@ enum Hulls {
 /// clock); [`Hulls::Undecided`], with nothing changed, when a point has no
 /// key. The points marked are flagged (also when the clock stopped the
 /// test: they do fold).
-fn by_hulls(slots: &mut [PointResult], margins: &[f32], expired: impl FnMut() -> bool) -> Hulls {
+fn by_hulls<const BOUNDED: bool>(
+    slots: &mut [PointResult],
+    margins: &[f32],
+    expired: impl FnMut() -> bool,
+) -> Hulls {
     let valid = |r: &PointResult| r.status == Status::NoIntersection;
     // Marked points keep their key (`z_far`) until both passes are done.
     let mark = |r: &mut PointResult| r.status = Status::Folded;
     let unmark = |r: &mut PointResult| r.status = Status::NoIntersection;
-    let hulls = folds_by_hulls(
+    let hulls = folds_by_hulls::<_, BOUNDED>(
         slots,
         margins,
         FOLD_WINDOW,
@@ -179,7 +191,10 @@ fn by_hulls(slots: &mut [PointResult], margins: &[f32], expired: impl FnMut() ->
 /// [`Hulls::Undecided`]. `expired` (the caller's clock) is asked before
 /// every [`CHUNK`] items of each pass: once it says yes the test stops,
 /// [`Hulls::Stopped`], the items marked so far marked (they fold: each
-/// pass marks only those that do).
+/// pass marks only those that do). `BOUNDED`: the caller knows every item
+/// valid and its key [`NO_KEY`] or finite with a finite margin `≥ 0`
+/// (then an item passes those checks exactly when its key is not
+/// `NO_KEY`, which is all the forward pass asks).
 ///
 /// Vertex `i` folds when its widened key `[k − e, k + e]` meets the
 /// interval of a segment `j ≤ i − w − 1` or `j ≥ i + w` (segment `j` from
@@ -198,7 +213,7 @@ fn by_hulls(slots: &mut [PointResult], margins: &[f32], expired: impl FnMut() ->
 /// vertex. Orientation does not matter (negating every key negates every
 /// interval exactly); `folds_by_hulls_equals_brute_force` compares it
 /// with the segments' brute force.
-fn folds_by_hulls<T>(
+fn folds_by_hulls<T, const BOUNDED: bool>(
     items: &mut [T],
     margins: &[f32],
     w: usize,
@@ -229,10 +244,17 @@ fn folds_by_hulls<T>(
             return Hulls::Stopped;
         }
         let e = margins.get(i).copied().unwrap_or(f32::NAN);
-        let checked = items.get(i).filter(|&it| valid(it)).map(&key);
-        // (A NaN fails.)
-        // (`k + e` finite with `e ≥ 0`: both finite, and no overflow.)
-        let Some(wi) = checked.filter(|k| e >= 0.0 && (k + e).is_finite()) else {
+        let checked = if BOUNDED {
+            // (Every item valid, each key NO_KEY or finite with a finite
+            // margin ≥ 0: the test below, asked that way.)
+            items.get(i).map(&key).filter(|&k| k != NO_KEY)
+        } else {
+            // (A NaN fails.)
+            // (`k + e` finite with `e ≥ 0`: both finite, and no overflow.)
+            let checked = items.get(i).filter(|&it| valid(it)).map(&key);
+            checked.filter(|k| e >= 0.0 && (k + e).is_finite())
+        };
+        let Some(wi) = checked else {
             // Undo: every item before `i` was valid, so those that are
             // no longer are the ones marked here.
             for it in items.iter_mut().take(i).filter(|it| !valid(it)) {
@@ -316,9 +338,30 @@ mod tests {
                 asked > q
             };
             let mut cut = items.clone();
-            let stopped = folds_by_hulls(&mut cut, &margins, w, (valid, |it| it.0), marks, clock);
-            let took = folds_by_hulls(&mut items, &margins, w, (valid, |it| it.0), marks, || false)
-                == Hulls::Decided;
+            let stopped =
+                folds_by_hulls::<_, false>(&mut cut, &margins, w, (valid, |it| it.0), marks, clock);
+            // The items here are valid but where the key is NO_KEY, their
+            // keys small and margins ≥ 0: the bounded test is the same.
+            let mut bounded = items.clone();
+            let took_bounded = folds_by_hulls::<_, true>(
+                &mut bounded,
+                &margins,
+                w,
+                (valid, |it| it.0),
+                marks,
+                || false,
+            );
+            let took = folds_by_hulls::<_, false>(
+                &mut items,
+                &margins,
+                w,
+                (valid, |it| it.0),
+                marks,
+                || false,
+            );
+            assert_eq!(took, took_bounded, "case {case}: bounded");
+            assert_eq!(items, bounded, "case {case}: bounded");
+            let took = took == Hulls::Decided;
             let brute = |i: usize, (k, e): (f32, f32)| {
                 ivs.iter().enumerate().any(|(j, iv)| {
                     let outside = j + w < i || j > i + w - 1;
@@ -368,9 +411,14 @@ mod tests {
                 |it: &mut (f32, u32)| it.1 -= 1,
             );
             let valid = |it: &(f32, u32)| it.1 == 0;
-            let r = folds_by_hulls(&mut items, &[0.5; 5], w, (valid, |it| it.0), marks, || {
-                false
-            });
+            let r = folds_by_hulls::<_, false>(
+                &mut items,
+                &[0.5; 5],
+                w,
+                (valid, |it| it.0),
+                marks,
+                || false,
+            );
             assert_eq!(r, Hulls::Decided);
             assert!(items.iter().all(|it| it.1 == 0), "w = {w}: nothing folds");
         }

@@ -394,11 +394,16 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 flag_pending(slots, Status::OverBudget);
                 continue;
             }
+            // (Step 1's half-plane keys on a certified pair: every point
+            // still to be matched, each key NO_KEY or at most 1 in
+            // magnitude with a finite margin > 0, `half_key`.)
+            let bounded =
+                pair.certified_r1.is_some() && matches!(keying.pencil, Pencil::Half { .. });
             #[cfg(not(any(test, feature = "_reference")))]
             crate::fold::step(
                 index,
                 slots,
-                (&order, keying.period, orient),
+                (&order, keying.period, orient, bounded),
                 config.work_per_point,
                 &mut work,
                 &mut guard,
@@ -410,7 +415,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 crate::fold::step(
                     index,
                     slots,
-                    (&order, keying.period, orient),
+                    (&order, keying.period, orient, bounded),
                     config.work_per_point,
                     &mut work,
                     &mut guard,

@@ -355,13 +355,13 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                     let ks = keying.key_scale;
                     let key = |p| half_key(p, (foe, side, min_t), ks);
                     let points = (&mut *slots, b1, &mut margins[..]);
-                    step1_certified(&pair, r1, points, &mut order, key, &mut guard);
+                    step1_certified::<D, true>(&pair, r1, points, &mut order, key, &mut guard);
                     r1_max = if slots.is_empty() { 0.0 } else { r1 };
                 }
                 (Some(r1), _) => {
                     let key = |p| keying.key(p);
                     let points = (&mut *slots, b1, &mut margins[..]);
-                    step1_certified(&pair, r1, points, &mut order, key, &mut guard);
+                    step1_certified::<D, false>(&pair, r1, points, &mut order, key, &mut guard);
                     r1_max = if slots.is_empty() { 0.0 } else { r1 };
                 }
                 (None, _) => {
@@ -686,7 +686,7 @@ fn compensate_point(
 /// (the key order followed on from part to part): once it says yes, the
 /// points not reached are `over_budget`.
 #[inline(always)]
-fn step1_certified<D: Deadline>(
+fn step1_certified<D: Deadline, const BOUNDED: bool>(
     pair: &Pair,
     r1: f32,
     (slots, b1, margins): (&mut [PointResult], &[Pixel], &mut [f32]),
@@ -695,7 +695,7 @@ fn step1_certified<D: Deadline>(
     guard: &mut Guard<'_, D>,
 ) {
     if D::NEVER {
-        return compensate_all_certified(pair, r1, (slots, b1, margins), order, key);
+        return compensate_all_certified::<BOUNDED>(pair, r1, (slots, b1, margins), order, key);
     }
     let mut parts = slots
         .chunks_mut(CHUNK)
@@ -713,7 +713,7 @@ fn step1_certified<D: Deadline>(
             }
             return;
         }
-        compensate_all_certified(pair, r1, (s, b, m), order, &key);
+        compensate_all_certified::<BOUNDED>(pair, r1, (s, b, m), order, &key);
         first = false;
     }
 }
@@ -724,9 +724,10 @@ fn step1_certified<D: Deadline>(
 /// `margins`, the key order in `order` (followed only until it cannot be
 /// strict any more, [`KeyOrder::settled`]: the rest of the points leave
 /// [`KeyOrder::strict`] as it is), in a pass over the written keys after
-/// the compensation's.
+/// the compensation's. `BOUNDED`: `key` gives [`NO_KEY`] or a key at most
+/// 1 in magnitude ([`half_key`]; [`KeyOrder::push_until_settled`]).
 #[inline(always)]
-fn compensate_all_certified(
+fn compensate_all_certified<const BOUNDED: bool>(
     pair: &Pair,
     r1: f32,
     (slots, b1, margins): (&mut [PointResult], &[Pixel], &mut [f32]),
@@ -757,7 +758,7 @@ fn compensate_all_certified(
     // as before, the representative window measured 675.9 instructions a
     // point against 673.7, every other window dearer too.)
     let keys = slots.iter().zip(margins.iter()).take(n);
-    order.push_until_settled(keys.map(|(slot, &e)| (slot.z_far, e)));
+    order.push_until_settled::<BOUNDED>(keys.map(|(slot, &e)| (slot.z_far, e)));
 }
 
 /// Step 3: index the frame-2 polyline; with `W' < 0` and the FOE near, the

@@ -453,9 +453,15 @@ impl KeyOrder {
     /// until [`Self::settled`] (pushes after it cannot change
     /// [`Self::strict`]): the same state as those pushes (but `prev`,
     /// `plo`, `phi` once settled). Once one direction is left, a loop that
-    /// tests only it.
+    /// tests only it. `BOUNDED`: every key is [`NO_KEY`] or finite and at
+    /// most 2 in magnitude (half-plane keys, [`crate::pencil::half_key`]),
+    /// so that a key is finite with the one before exactly when it is not
+    /// `NO_KEY`: that loop asks so.
     #[inline(always)]
-    pub(crate) fn push_until_settled(&mut self, keys: impl Iterator<Item = (f32, f32)>) {
+    pub(crate) fn push_until_settled<const BOUNDED: bool>(
+        &mut self,
+        keys: impl Iterator<Item = (f32, f32)>,
+    ) {
         let mut keys = keys;
         while !self.settled() && (self.first || (self.up && self.down)) {
             let Some((k, e)) = keys.next() else {
@@ -476,7 +482,12 @@ impl KeyOrder {
             let mut r = (false, false);
             for (k, e) in keys.by_ref() {
                 let (vlo, vhi) = (k - e, k + e);
-                let both = (k + prev).is_finite();
+                // (`prev` keyed: one direction is left.)
+                let both = if BOUNDED {
+                    k != NO_KEY
+                } else {
+                    (k + prev).is_finite()
+                };
                 let o = vlo > phi;
                 (prev, plo, phi) = (k, vlo, vhi);
                 if !both {
@@ -493,7 +504,12 @@ impl KeyOrder {
             let mut r = (false, false);
             for (k, e) in keys.by_ref() {
                 let (vlo, vhi) = (k - e, k + e);
-                let both = (k + prev).is_finite();
+                // (`prev` keyed: one direction is left.)
+                let both = if BOUNDED {
+                    k != NO_KEY
+                } else {
+                    (k + prev).is_finite()
+                };
                 let o = vhi < plo;
                 (prev, plo, phi) = (k, vlo, vhi);
                 if !both {

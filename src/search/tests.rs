@@ -449,9 +449,17 @@ fn key_order_pass_is_the_pushes() {
         let parts = 1 + (case % 3) as usize;
         let cut = |p: usize| (p * ks.len()) / parts;
         let mut pass = KeyOrder::NEW;
+        let mut bounded = KeyOrder::NEW;
         for p in 0..parts {
-            pass.push_until_settled(ks[cut(p)..cut(p + 1)].iter().copied());
+            pass.push_until_settled::<false>(ks[cut(p)..cut(p + 1)].iter().copied());
+            // (These keys are NO_KEY or a few units at most.)
+            bounded.push_until_settled::<true>(ks[cut(p)..cut(p + 1)].iter().copied());
         }
+        assert_eq!(
+            std::format!("{pass:?}"),
+            std::format!("{bounded:?}"),
+            "case {case}: bounded"
+        );
         assert_eq!(pass.strict(0.0), one.strict(0.0), "case {case}: {ks:?}");
         assert_eq!(pass.settled(), one.settled(), "case {case}");
         if !one.settled() {

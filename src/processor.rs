@@ -395,8 +395,8 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 continue;
             }
             // (Step 1's half-plane keys on a certified pair: every point
-            // still to be matched, each key NO_KEY or at most 1 in
-            // magnitude with a finite margin > 0, `half_key`.)
+            // still to be matched, each key NO_KEY (margin 0) or at most 1
+            // in magnitude with a finite margin > 0, `half_key`.)
             let bounded =
                 pair.certified_r1.is_some() && matches!(keying.pencil, Pencil::Half { .. });
             #[cfg(not(any(test, feature = "_reference")))]

@@ -101,6 +101,11 @@ pub struct Processor<const N: usize, const B: usize> {
     /// `has_previous`'s padding).
     #[cfg(any(test, feature = "_reference"))]
     fold_test: bool,
+    /// Whether steps 1–3 take the checking forms of the loops that have a
+    /// bounded form on certified half-plane keys: only in the tests of
+    /// [`Self::set_checking_forms`] (padding too).
+    #[cfg(any(test, feature = "_reference"))]
+    checking: bool,
     index: Index<N>,
     output: Structure<N, B>,
 }
@@ -114,6 +119,8 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             has_previous: false,
             #[cfg(any(test, feature = "_reference"))]
             fold_test: true,
+            #[cfg(any(test, feature = "_reference"))]
+            checking: false,
             index: Index::new(),
             output: Structure::EMPTY,
         }
@@ -294,6 +301,20 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         Ok(&self.output)
     }
 
+    /// Steps 1–3 with the checking forms (`on`) of the loops that have a
+    /// bounded one, for the tests only, behind the private `_reference`
+    /// feature. On a certified pair with half-plane keys step 1's key
+    /// order, the fold test's forward pass and frame 2's lean key loop
+    /// leave out their finiteness checks (`BOUNDED`: every key there is
+    /// `NO_KEY` or finite and at most 1 in magnitude, `half_key`, with the
+    /// arguments where they are used); the fuzz target's shadow processor
+    /// runs the checking forms, so every call compares the two bit for bit.
+    #[cfg(any(test, feature = "_reference"))]
+    #[doc(hidden)]
+    pub fn set_checking_forms(&mut self, on: bool) {
+        self.checking = on;
+    }
+
     /// Steps 1–4 of the module docs for every boundary of the kept frame;
     /// whether `deadline` expired before they were done goes into the
     /// output ([`Structure::deadline_expired`]).
@@ -306,6 +327,10 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     ) {
         #[cfg(any(test, feature = "_reference"))]
         let fold_test = self.fold_test;
+        #[cfg(any(test, feature = "_reference"))]
+        let checking = self.checking;
+        #[cfg(not(any(test, feature = "_reference")))]
+        let checking = false;
         let Self {
             config,
             previous,
@@ -355,7 +380,11 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                     let ks = keying.key_scale;
                     let key = |p| half_key(p, (foe, side, min_t), ks);
                     let points = (&mut *slots, b1, &mut margins[..]);
-                    step1_certified::<D, true>(&pair, r1, points, &mut order, key, &mut guard);
+                    if checking {
+                        step1_certified::<D, false>(&pair, r1, points, &mut order, key, &mut guard);
+                    } else {
+                        step1_certified::<D, true>(&pair, r1, points, &mut order, key, &mut guard);
+                    }
                     r1_max = if slots.is_empty() { 0.0 } else { r1 };
                 }
                 (Some(r1), _) => {
@@ -397,8 +426,9 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             // (Step 1's half-plane keys on a certified pair: every point
             // still to be matched, each key NO_KEY (margin 0) or at most 1
             // in magnitude with a finite margin > 0, `half_key`.)
-            let bounded =
-                pair.certified_r1.is_some() && matches!(keying.pencil, Pencil::Half { .. });
+            let bounded = !checking
+                && pair.certified_r1.is_some()
+                && matches!(keying.pencil, Pencil::Half { .. });
             #[cfg(not(any(test, feature = "_reference")))]
             crate::fold::step(
                 index,
@@ -438,10 +468,12 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             // vertices or segments of each pass of the build.
             let mut ask = || guard.check();
             let mut tick: Tick = if D::NEVER { None } else { Some(&mut ask) };
-            let built = frame2_keys(index, &keying, b2, orient, &mut tick).is_some_and(|builder| {
-                let radius = near_foe + 2.0 * (r1_max + pair.e2());
-                frame2_index(builder, &pair, &keying, b2, radius, &mut tick)
-            });
+            let built = frame2_keys(index, &keying, b2, (orient, checking), &mut tick).is_some_and(
+                |builder| {
+                    let radius = near_foe + 2.0 * (r1_max + pair.e2());
+                    frame2_index(builder, &pair, &keying, b2, radius, &mut tick)
+                },
+            );
             if !built {
                 // The time ran out in the build: the index unfit, unused.
                 flag_pending(slots, Status::OverBudget);
@@ -770,12 +802,14 @@ fn compensate_all_certified<const BOUNDED: bool>(
 /// ([`frame2_index`]), so that a deadline can be asked in between.
 /// `None` when `tick`'s clock stopped the keys (asked between parts of
 /// [`CHUNK`] vertices; the builder takes each part where the last one
-/// ended).
+/// ended). Half-plane keys go through the lean loop's bounded form
+/// ([`Builder::push_all_bounded`]) but with `checking`, the tests' switch
+/// ([`Processor::set_checking_forms`]).
 fn frame2_keys<'a, const N: usize>(
     index: &'a mut Index<N>,
     keying: &Keying,
     b2: &[Pixel],
-    orient: f32,
+    (orient, checking): (f32, bool),
     tick: &mut Tick<'_>,
 ) -> Option<Builder<'a, N>> {
     let mut builder = index.builder((keying.period, orient), Unkeyed::MeetAll);
@@ -793,8 +827,12 @@ fn frame2_keys<'a, const N: usize>(
         match keying.pencil {
             Pencil::Half { foe, side, min_t } => {
                 let ks = keying.key_scale;
-                builder
-                    .push_all_bounded(b2.iter().map(|p| half_key(p.arr(), (foe, side, min_t), ks)));
+                let keys = b2.iter().map(|p| half_key(p.arr(), (foe, side, min_t), ks));
+                if checking {
+                    builder.push_all(keys);
+                } else {
+                    builder.push_all_bounded(keys);
+                }
             }
             _ => builder.push_all(b2.iter().map(|p| keying.key(p.arr()))),
         }

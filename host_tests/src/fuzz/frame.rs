@@ -23,7 +23,10 @@
 //!   per kept point naming that point;
 //! * errors exactly when the API says, and then the state untouched: a
 //!   shadow processor gets only the calls that succeeded, and both agree
-//!   bit for bit after every call (which also checks determinism);
+//!   bit for bit after every call (which also checks determinism, and,
+//!   the shadow taking the checking forms of the loops that have a bounded
+//!   one, `Processor::set_checking_forms`, that the bounded forms give
+//!   the same results);
 //! * the indexed matcher with [`Config::MAX_WORK_PER_POINT`] equals the
 //!   reference matcher bit for bit (but for the known findings of the
 //!   matching stage, counted: see `known`), and with the case's own
@@ -1135,6 +1138,9 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
     // `a` gets every call; `shadow` only those that succeed.
     let mut a = Box::new(Processor::<N, B>::new(config));
     let mut shadow = Box::new(Processor::<N, B>::new(config));
+    // (The shadow takes the checking forms of the loops that have a
+    // bounded one: every call compares the two bit for bit.)
+    shadow.set_checking_forms(true);
     let mut calls = 0;
     let mut reconstructions = 0;
     let mut points = [0u64; 2];

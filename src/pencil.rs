@@ -274,9 +274,14 @@ impl Keying {
 }
 
 /// The half-plane key of `q` ([`Pencil::Half`] with these fields) and its
-/// margin, or [`NO_KEY`] (and 0). For a finite `q` and FOE (and `min_t >
+/// margin, or [`NO_KEY`] (and 0). For a finite `q − foe` (and `min_t >
 /// 0`, as [`Keying::choose`] makes it) a key is `d_u / (|d_u| + t)` with
-/// `t ≥ min_t`: finite and at most 1 in magnitude (and a rounding).
+/// `t ≥ min_t`: finite and at most 1 in magnitude (and a rounding). The
+/// callers' `q` is a validated pixel (within the image's margin) or step
+/// 1's compensated point on a certified pair (within three image sizes,
+/// `certifies_image`), and a half-plane keying's FOE is within two
+/// reaches of the principal point ([`Keying::choose`]), so `q − foe` is
+/// finite there; an infinite `q` would give a NaN key, not `NO_KEY`.
 #[inline(always)]
 pub(crate) fn half_key(
     q: [f32; 2],

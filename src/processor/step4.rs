@@ -776,12 +776,15 @@ pub(super) fn wedge_run_aside<const SKIP: bool>(
         // point. On a tight index the same form made the usual walk
         // beside it dearer, `demo_15` +0.6 %: there the test is as before,
         // and `next_at` unused.)
-        while if SKIP {
-            next_at < j
-        } else {
-            next.is_some_and(|e| usize::from(e.0) < j)
-        } {
-            let Some(&(k, l, h)) = next else {
+        loop {
+            // (`next_at` is `next`'s segment index, `usize::MAX` when none
+            // is left: the two change together.)
+            let due = if SKIP {
+                next_at < j
+            } else {
+                next.is_some_and(|e| usize::from(e.0) < j)
+            };
+            let (true, Some(&(k, l, h))) = (due, next) else {
                 break;
             };
             let k = usize::from(k);

@@ -43,11 +43,17 @@ impl<const N: usize> Index<N> {
 
     /// The suffix minima `sm`; whether somewhere the envelopes are more
     /// than `wide` apart (`None`: `tick`'s clock stopped the pass). With
-    /// `answer`, only that answer is wanted where it is yes (a rebuild
-    /// follows, which computes them anew): without a clock the pass stops
-    /// when the last two segments tell (an outlier at a boundary's far
-    /// end, often), the minima before them left as they were.
-    fn suffix_minima(&mut self, wide: f32, tick: &mut Tick<'_>, answer: bool) -> Option<bool> {
+    /// `stop_once_loose` only that answer is wanted where it is yes (a
+    /// rebuild follows, which computes the minima anew, to the end: it
+    /// has no clock here either): without a clock the pass stops when the
+    /// last two segments tell (an outlier at a boundary's far end, often),
+    /// the minima before them left as they were.
+    fn suffix_minima(
+        &mut self,
+        wide: f32,
+        tick: &mut Tick<'_>,
+        stop_once_loose: bool,
+    ) -> Option<bool> {
         let s = self.segments;
         let Some(seg) = self.seg.get_mut(..s) else {
             return Some(false);
@@ -66,12 +72,17 @@ impl<const N: usize> Index<N> {
                 let head = match seg {
                     [head @ .., a, b] => {
                         one(b);
-                        // (The gap only grows from here, unless a NaN
-                        // comes, which needs an empty interval, an unkeyed
-                        // vertex's in the fold test's index: then the
-                        // rebuild is taken anyway, `Builder::finish`. A
-                        // NaN here goes on.)
-                        if one(a) > wide && answer {
+                        // (The gap only grows from here: `fmax` keeps the
+                        // larger of two numbers, and `pm − run` is never
+                        // NaN in a first pass, which needs `pm` and `run`
+                        // the same infinity. In frame 2's index the
+                        // intervals are finite or `(−∞, ∞)`, so `pm` is
+                        // finite or `+∞` and `run` finite or `−∞`; in the
+                        // fold test's they are finite or empty, `(∞, −∞)`,
+                        // so `pm` is finite or `−∞` and `run` finite or
+                        // `+∞`. Once over `wide` the whole pass's answer
+                        // is yes.)
+                        if one(a) > wide && stop_once_loose {
                             return Some(true);
                         }
                         head
@@ -577,7 +588,8 @@ impl<const N: usize> Builder<'_, N> {
     }
 
     /// [`Self::push_all`] for keys that are [`NO_KEY`] or finite and at
-    /// most 2 in magnitude (half-plane keys, [`crate::pencil::half_key`]):
+    /// most 2 in magnitude (half-plane keys, [`crate::pencil::half_key`],
+    /// are at most 1; any bound far below `f32::MAX / 2` would do):
     /// then a key and the one before sum to a finite value exactly when the
     /// key is not `NO_KEY`, the lean loop's test, asked that way (the same
     /// index).

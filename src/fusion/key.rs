@@ -44,7 +44,7 @@ use super::code::DepthScale;
 use crate::boundary::Frame;
 use crate::depth::DepthInterval;
 use crate::math::{fmax, fmin};
-use crate::structure::{Status, Structure};
+use crate::structure::{PointResult, Status, Structure};
 
 /// What the fusion knows about a key-frame point.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -284,6 +284,43 @@ fn count(added: Added, c: &Cell, min: u8, admitted: &mut u16, inconsistent: &mut
     }
 }
 
+/// The first pair of a fresh key frame on one boundary ([`KeyFrame::fuse`]):
+/// every cell written, an `Ok` point's as what [`Cell::add`] makes of an
+/// empty cell (its stick, one agreeing pair: admitted when `min` is 1),
+/// any other as [`Cell::EMPTY`].
+fn first_pair(
+    cells: &mut [Cell],
+    results: &[PointResult],
+    min: u8,
+    adm: &mut u16,
+    out: &mut PairFused,
+) {
+    let mut matched = 0u32;
+    let n = cells.len().min(results.len());
+    let (head, tail) = cells.split_at_mut(n);
+    for (c, r) in head.iter_mut().zip(results) {
+        *c = if r.status == Status::Ok {
+            matched += 1;
+            Cell {
+                near: r.z_near,
+                far: r.z_far,
+                major: 1,
+                ..Cell::EMPTY
+            }
+        } else {
+            Cell::EMPTY
+        };
+    }
+    for c in tail {
+        *c = Cell::EMPTY;
+    }
+    out.matched += matched;
+    if min == 1 {
+        // (At most `N` points: no saturation before the sum.)
+        *adm = adm.saturating_add(u16::try_from(matched).unwrap_or(u16::MAX));
+    }
+}
+
 /// What fusing one pair's structure did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -329,6 +366,9 @@ pub struct KeyFrame<const N: usize, const B: usize> {
     /// The most points any of its pairs matched.
     best_matched: u32,
     scale: DepthScale,
+    /// Since [`KeyFrame::start`], no pair and no range constraint: every
+    /// point is unmatched, whatever its cell holds.
+    fresh: bool,
 }
 
 impl<const N: usize, const B: usize> KeyFrame<N, B> {
@@ -343,11 +383,15 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
             partners: 0,
             best_matched: 0,
             scale,
+            fresh: false,
         }
     }
 
     /// Start over for the key frame with id `id` whose boundaries have
-    /// `lens` points: every point [`FusedStatus::Unmatched`].
+    /// `lens` points: every point [`FusedStatus::Unmatched`]. The cells
+    /// are not cleared here: the key frame is *fresh* until its first pair
+    /// writes every cell ([`KeyFrame::fuse`]) or a range constraint clears
+    /// them; until then every reader takes its cells as empty.
     pub(crate) fn start(&mut self, id: u32, lens: [u16; B]) {
         self.id = id;
         self.partners = 0;
@@ -355,6 +399,15 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
         self.lens = lens;
         self.admitted = [0; B];
         self.inconsistent = [0; B];
+        self.fresh = true;
+    }
+
+    /// Clear a fresh key frame's cells (before a range constraint, the one
+    /// change to a fresh key frame other than its first pair).
+    fn unfresh(&mut self) {
+        if !core::mem::replace(&mut self.fresh, false) {
+            return;
+        }
         for (&len, cells) in self.lens.iter().zip(self.cells.iter_mut()) {
             for c in cells.iter_mut().take(usize::from(len)) {
                 *c = Cell::EMPTY;
@@ -372,7 +425,10 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
     }
 
     /// Fuse one pair's reconstruction (the key frame against a later
-    /// frame): every `Ok` point's stick into its cell.
+    /// frame): every `Ok` point's stick into its cell. The first pair of a
+    /// fresh key frame writes every cell instead: an `Ok` point's stick as
+    /// its one agreeing pair, any other point empty (what fusing it into
+    /// cleared cells gives, without clearing them first).
     ///
     /// Work: one pass over the structure's points (at most `B·N`), `O(1)`
     /// each.
@@ -380,16 +436,26 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
         let mut out = PairFused::default();
         let scale = self.scale;
         let min = self.min_pairs;
-        for ((((cells, len), adm), inc), b) in self
+        let fresh = core::mem::replace(&mut self.fresh, false);
+        for (k, (((cells, len), adm), inc)) in self
             .cells
             .iter_mut()
             .zip(self.lens.iter())
             .zip(self.admitted.iter_mut())
             .zip(self.inconsistent.iter_mut())
-            .zip(s.boundaries())
+            .enumerate()
         {
             let cells = cells.get_mut(..usize::from(*len)).unwrap_or(&mut []);
-            for (c, r) in cells.iter_mut().zip(b.points()) {
+            let results = s.boundaries().get(k).map_or(&[][..], |b| b.points());
+            if fresh {
+                first_pair(cells, results, min, adm, &mut out);
+                continue;
+            }
+            let n = cells.len().min(results.len());
+            let (Some(cells), Some(results)) = (cells.get_mut(..n), results.get(..n)) else {
+                continue;
+            };
+            for (c, r) in cells.iter_mut().zip(results) {
                 if r.status != Status::Ok {
                     continue;
                 }
@@ -420,6 +486,7 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
         if index >= len {
             return None;
         }
+        self.unfresh();
         let (scale, min) = (self.scale, self.min_pairs);
         let c = self.cells.get_mut(boundary)?.get_mut(index)?;
         let added = c.add(near, far, &scale);
@@ -480,9 +547,10 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
         Some(self.cell(boundary, index)?.public())
     }
 
-    /// The cells of `boundary`'s points.
+    /// The cells of `boundary`'s points (none while the key frame is
+    /// fresh: no point has an interval).
     pub(crate) fn cells(&self, boundary: usize) -> &[Cell] {
-        let n = self.len(boundary);
+        let n = if self.fresh { 0 } else { self.len(boundary) };
         self.cells
             .get(boundary)
             .and_then(|c| c.get(..n))
@@ -493,17 +561,22 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
         if index >= self.len(boundary) {
             return None;
         }
+        if self.fresh {
+            return Some(&Cell::EMPTY);
+        }
         self.cells.get(boundary)?.get(index)
     }
 
     /// The points of `boundary`, in order.
     pub fn points(&self, boundary: usize) -> impl Iterator<Item = FusedPoint> + '_ {
         let n = self.len(boundary);
+        let fresh = self.fresh;
         self.cells
             .get(boundary)
             .map(|c| c.get(..n).unwrap_or(&[]))
             .unwrap_or(&[])
             .iter()
+            .map(move |c| if fresh { &Cell::EMPTY } else { c })
             .map(Cell::public)
     }
 
@@ -530,6 +603,7 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
             eat(0xCE11_0000 | self.len(k) as u32);
             if let Some(cells) = self.cells.get(k) {
                 for c in cells.iter().take(self.len(k)) {
+                    let c = if self.fresh { &Cell::EMPTY } else { c };
                     for w in c.words() {
                         eat(w);
                     }

@@ -247,6 +247,10 @@ struct View {
     rho: f32,
     phi: f32,
     lat: f32,
+    /// `ρ` and `φ` are zero and every entry's `|P_K|` bound is finite: the
+    /// radius is `zf λ` rounded up, bit for bit what [`radius`] gives
+    /// (`zf λ + ±0 + ±0 · reach` is `zf λ` for a finite `reach`).
+    lat_only: bool,
 }
 
 impl View {
@@ -261,6 +265,9 @@ impl View {
             rho: b.rho,
             phi: b.phi,
             lat: b.lat,
+            // (`reach` bounds every entry's `|P_K|` bound within 2⁻¹⁰ of
+            // it: below 10³⁰ they are all finite.)
+            lat_only: b.rho == 0.0 && b.phi == 0.0 && b.reach < 1.0e30,
         }
     }
 
@@ -278,14 +285,22 @@ impl View {
         }
     }
 
-    /// Whether a point's whole stick, widened by its radius, is behind.
+    /// Whether a live point's whole stick, widened by its radius, is
+    /// behind. (A live entry's far code is 1 to `UNBOUNDED − 1`,
+    /// [`RoadMap::retire`]: its depth needs no test of the range's ends.)
     #[inline]
     fn behind(&self, e: &Entry, scale: &DepthScale) -> bool {
         let dir = self.g[0] * e.x + self.g[1] * e.y + self.g[2];
+        let zf = scale.depth_inner(e.far);
         // The stick's forward coordinate is largest at its far end when it
         // points forward, at its near end otherwise.
-        let ahead = dir * scale.depth(if dir >= 0.0 { e.far } else { e.near }) + self.g0;
-        ahead + radius(self.rho, self.phi, self.lat, e, scale.depth(e.far)) < 0.0
+        let ahead = dir * if dir >= 0.0 { zf } else { scale.depth(e.near) } + self.g0;
+        let radius = if self.lat_only {
+            zf * self.lat * ROUND_UP
+        } else {
+            radius(self.rho, self.phi, self.lat, e, zf)
+        };
+        ahead + radius < 0.0
     }
 }
 

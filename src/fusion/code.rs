@@ -118,6 +118,14 @@ impl DepthScale {
         if code == UNBOUNDED {
             return f32::INFINITY;
         }
+        self.depth_inner(code)
+    }
+
+    /// [`DepthScale::depth`] of a code from 1 to `UNBOUNDED − 1` (a live
+    /// map entry's far end), without the tests of the range's two ends:
+    /// the same value for those codes.
+    #[inline]
+    pub(crate) fn depth_inner(&self, code: u16) -> f32 {
         let c = u32::from(code);
         f32::from_bits((((c >> 12) + EXP_BASE) << 23) | ((c & 0xFFF) << 11)) * self.s
     }

@@ -829,13 +829,21 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             return (0, 0);
         };
         let (mut n, mut unbounded) = (0usize, 0u32);
-        for (c, r) in key.cells(k).iter().zip(results.points()) {
-            if n >= w {
+        let (cells, points) = (key.cells(k), results.points());
+        // From one admitted point to the next (a tight scan: most are not).
+        let mut at = 0;
+        while n < w {
+            let Some(skip) = cells
+                .get(at..)
+                .and_then(|rest| rest.iter().position(|c| c.admit(min_pairs) == Admit::Yes))
+            else {
                 break;
-            }
-            if c.admit(min_pairs) != Admit::Yes {
-                continue;
-            }
+            };
+            at += skip;
+            let (Some(c), Some(r)) = (cells.get(at), points.get(at)) else {
+                break;
+            };
+            at += 1;
             let [x, y] = cam.normalise(r.pixel1());
             let (z_near, z_far) = c.ends();
             let far = scale.up(z_far);

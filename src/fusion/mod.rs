@@ -456,40 +456,40 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             out.new_key = self.start_key(id, frame, KeyReason::First, false);
             return Ok(out);
         }
-        // 2. The motion from the key frame, and the pair.
-        let chain = self.chain.then(&m.motion, &bounds);
-        let pair = match chain.motion() {
-            Err(_) => Err(KeyReason::MotionLimit),
-            Ok(motion) => match chain.config(&self.base) {
-                Err(_) => Err(KeyReason::ErrorLimit),
-                Ok(cfg) => Ok((motion, cfg)),
-            },
+        // 2. The motion from the key frame, and the pair. (The chain is
+        // kept from here on: every path below either keeps it or starts it
+        // anew after retiring the key frame with it.)
+        self.chain = self.chain.then(&m.motion, &bounds);
+        let motion = self.chain.motion();
+        let cfg = self.chain.config(&self.base);
+        let limit = match (&motion, &cfg) {
+            (Err(_), _) => Some(KeyReason::MotionLimit),
+            (Ok(_), Err(_)) => Some(KeyReason::ErrorLimit),
+            (Ok(_), Ok(_)) => None,
         };
         let last_partner = self.due && has_points(frame);
         // 3. The map follows the vehicle; its sweep rests in a frame where
         // a key frame retires (that frame copies its points instead).
         self.map
-            .carry(&m.motion, &bounds, !(last_partner || pair.is_err()));
-        let (motion, cfg) = match pair {
-            Ok(p) => p,
-            Err(reason) => {
-                // No last pair: retire what the key frame has, start anew.
-                out.retired = self.retire(&chain);
-                let shown = out.retired.is_some();
-                out.new_key = self.start_key(id, frame, reason, shown);
-                return Ok(out);
-            }
+            .carry(&m.motion, &bounds, !(last_partner || limit.is_some()));
+        let (Ok(motion), Ok(cfg), None) = (&motion, &cfg, limit) else {
+            // No last pair: retire what the key frame has, start anew.
+            out.retired = self.retire();
+            let shown = out.retired.is_some();
+            let reason = limit.unwrap_or(KeyReason::MotionLimit);
+            out.new_key = self.start_key(id, frame, reason, shown);
+            return Ok(out);
         };
         if bounds.any() {
-            self.processor.set_config(cfg);
+            self.processor.set_config(*cfg);
         }
-        let fused = self.fuse_pair(frame, &motion, last_partner, deadline);
+        let fused = self.fuse_pair(frame, motion, last_partner, deadline);
         let cut = self.processor.deadline_expired();
         // 4. The pair fused; a last partner retires the key frame.
         out.paired = Some(fused);
         out.partner = self.key.partners();
         if last_partner {
-            out.retired = self.retire(&chain);
+            out.retired = self.retire();
             out.new_key = Some(if self.key.partners() >= self.config.max_partners {
                 KeyReason::Partners
             } else {
@@ -503,7 +503,6 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             self.due = self.config.max_partners <= 1;
             return Ok(out);
         }
-        self.chain = chain;
         // 5. The policy: is the next frame the last partner?
         let p = self.key.partners();
         let best = self.key.best_matched();
@@ -589,15 +588,18 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         }
     }
 
-    /// Move the key frame's fused points into the map, posed by `chain`.
-    fn retire(&mut self, chain: &Chain) -> Option<Retired> {
+    /// Move the key frame's fused points into the map, posed by the chain
+    /// (the key frame's motion to the current frame).
+    fn retire(&mut self) -> Option<Retired> {
         if !self.has_key || self.key.partners() == 0 {
             return None;
         }
-        Some(
-            self.map
-                .retire(&self.key, self.processor.structure(), chain, self.base.e1()),
-        )
+        Some(self.map.retire(
+            &self.key,
+            self.processor.structure(),
+            &self.chain,
+            self.base.e1(),
+        ))
     }
 
     /// Intersect point `index` of key-frame boundary `boundary` with a

@@ -60,7 +60,7 @@
 //! `76 + 4·B` bytes (13 000 bytes in all for `B = 2`, `M = 512`).
 
 use crate::fusion::code::{DepthScale, UNBOUNDED};
-use crate::fusion::{Admit, Chain, KeyFrame, StepBounds};
+use crate::fusion::{Chain, KeyFrame, StepBounds};
 use crate::geometry::Sample;
 use crate::math::{fmax, fmin, mat3_mul, mat3_transpose, mat3_vec, sqrt, Mat3};
 use crate::motion::Motion;
@@ -835,7 +835,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         while n < w {
             let Some(skip) = cells
                 .get(at..)
-                .and_then(|rest| rest.iter().position(|c| c.admit(min_pairs) == Admit::Yes))
+                .and_then(|rest| rest.iter().position(|c| c.admitted(min_pairs)))
             else {
                 break;
             };

@@ -109,14 +109,6 @@ pub(crate) enum Added {
     Conflict { was_clean: bool, was_major: u8 },
 }
 
-/// Whether a point enters the map ([`Cell::admit`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Admit {
-    Yes,
-    Inconsistent,
-    Unverified,
-}
-
 /// The state of one point (16 bytes).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -125,12 +117,17 @@ pub(crate) struct Cell {
     far: f32,
     /// Rival interval, codes.
     rival: [u16; 2],
-    /// Pairs in the majority (0: no interval yet).
-    major: u8,
-    /// Pairs in the rival (0: none).
-    rival_n: u8,
-    /// Pairs that missed both.
-    others: u8,
+    /// The pair counts, a byte each: bits 0–7 the pairs in the majority
+    /// (0: no interval yet), 8–15 the pairs in the rival (0: none), 16–23
+    /// the pairs that missed both; bits 24–31 zero. Packed so that one
+    /// comparison tells a clean point with a given majority
+    /// ([`Cell::is_clean_with`]).
+    counts: u32,
+}
+
+/// The pair counts of a [`Cell`], packed.
+const fn pack(major: u8, rival_n: u8, others: u8) -> u32 {
+    major as u32 | (rival_n as u32) << 8 | (others as u32) << 16
 }
 
 impl Cell {
@@ -138,69 +135,98 @@ impl Cell {
         near: 0.0,
         far: 0.0,
         rival: [0; 2],
-        major: 0,
-        rival_n: 0,
-        others: 0,
+        counts: 0,
     };
+
+    /// Pairs in the majority.
+    #[inline(always)]
+    fn major(&self) -> u8 {
+        (self.counts & 0xFF) as u8
+    }
+
+    /// Pairs in the rival.
+    #[inline(always)]
+    fn rival_n(&self) -> u8 {
+        (self.counts >> 8 & 0xFF) as u8
+    }
+
+    /// Pairs that missed both.
+    #[inline(always)]
+    fn others(&self) -> u8 {
+        (self.counts >> 16 & 0xFF) as u8
+    }
 
     /// Fuse the interval `[near, far]` (`near ≤ far`, both finite).
     #[inline(always)]
     pub(crate) fn add(&mut self, near: f32, far: f32, scale: &DepthScale) -> Added {
-        if self.major == 0 {
+        let major = self.major();
+        if major == 0 {
             self.near = near;
             self.far = far;
-            self.major = 1;
+            // (The majority byte 0 to 1.)
+            self.counts += 1;
             return Added::Agreed;
         }
         let (lo, hi) = (fmax(self.near, near), fmin(self.far, far));
         if lo <= hi {
             self.near = lo;
             self.far = hi;
-            self.major = self.major.saturating_add(1);
+            // (The majority byte saturating at 255.)
+            if major < u8::MAX {
+                self.counts += 1;
+            }
             return Added::Agreed;
         }
-        let (was_clean, was_major) = (self.clean(), self.major);
+        let was_clean = self.clean();
         self.conflict(near, far, scale);
         Added::Conflict {
             was_clean,
-            was_major,
+            was_major: major,
         }
     }
 
     /// No interval has missed the majority.
     #[inline(always)]
     fn clean(&self) -> bool {
-        self.rival_n == 0 && self.others == 0
+        self.counts >> 8 == 0
+    }
+
+    /// No interval has missed the majority, and `major` pairs are in it.
+    #[inline(always)]
+    fn is_clean_with(&self, major: u8) -> bool {
+        self.counts == u32::from(major)
     }
 
     /// An interval that missed the majority (out of line: rare).
     #[inline(never)]
     fn conflict(&mut self, near: f32, far: f32, scale: &DepthScale) {
+        let (mut major, mut rival_n, mut others) = (self.major(), self.rival_n(), self.others());
         let code = [scale.down(near), scale.up(far)];
-        if self.rival_n == 0 {
+        if rival_n == 0 {
             self.rival = code;
-            self.rival_n = 1;
+            rival_n = 1;
         } else {
             let lo = self.rival[0].max(code[0]);
             let hi = self.rival[1].min(code[1]);
             if lo <= hi {
                 self.rival = [lo, hi];
-                self.rival_n = self.rival_n.saturating_add(1);
+                rival_n = rival_n.saturating_add(1);
             } else {
-                self.others = self.others.saturating_add(1);
+                others = others.saturating_add(1);
             }
         }
-        if self.rival_n > self.major {
+        if rival_n > major {
             let old = [scale.down(self.near), scale.up(self.far)];
             self.near = scale.depth(self.rival[0]);
             self.far = scale.depth(self.rival[1]);
             self.rival = old;
-            core::mem::swap(&mut self.major, &mut self.rival_n);
+            core::mem::swap(&mut major, &mut rival_n);
         }
+        self.counts = pack(major, rival_n, others);
     }
 
     pub(crate) fn status(&self) -> FusedStatus {
-        match (self.major, self.rival_n, self.others) {
+        match (self.major(), self.rival_n(), self.others()) {
             (0, _, _) => FusedStatus::Unmatched,
             (1, 0, 0) => FusedStatus::Single,
             (_, 0, 0) => FusedStatus::Consistent,
@@ -209,19 +235,14 @@ impl Cell {
     }
 
     /// Whether the point goes into the map with at least `min_pairs`
-    /// agreeing pairs (no disagreeing one, a bounded interval).
-    /// (Every interval fused is finite, so a fused interval is bounded.)
-    #[inline]
-    pub(crate) fn admit(&self, min_pairs: u8) -> Admit {
-        if self.major == 0 {
-            Admit::Unverified
-        } else if !self.clean() {
-            Admit::Inconsistent
-        } else if self.major >= min_pairs {
-            Admit::Yes
-        } else {
-            Admit::Unverified
-        }
+    /// agreeing pairs (no disagreeing one, a bounded interval), in one
+    /// range test on the packed counts: clean (nothing above the majority
+    /// byte) with at least `min_pairs`, and at least one, pairs in the
+    /// majority. (Every interval fused is finite, so a fused interval is
+    /// bounded.)
+    #[inline(always)]
+    pub(crate) fn admitted(&self, min_pairs: u8) -> bool {
+        (u32::from(min_pairs.max(1))..=0xFF).contains(&self.counts)
     }
 
     /// The fused interval's ends (meaningful when there is one).
@@ -231,18 +252,18 @@ impl Cell {
     }
 
     pub(crate) fn interval(&self) -> Option<DepthInterval> {
-        (self.major > 0).then_some(DepthInterval {
+        (self.major() > 0).then_some(DepthInterval {
             z_near: self.near,
             z_far: self.far,
         })
     }
 
     pub(crate) fn public(&self) -> FusedPoint {
-        let disagreeing = self.rival_n.saturating_add(self.others);
+        let disagreeing = self.rival_n().saturating_add(self.others());
         FusedPoint {
             status: self.status(),
             interval: self.interval(),
-            pairs: self.major.saturating_add(disagreeing),
+            pairs: self.major().saturating_add(disagreeing),
             disagreeing,
         }
     }
@@ -253,7 +274,7 @@ impl Cell {
             self.near.to_bits(),
             self.far.to_bits(),
             u32::from(self.rival[0]) | u32::from(self.rival[1]) << 16,
-            u32::from(self.major) | u32::from(self.rival_n) << 8 | u32::from(self.others) << 16,
+            pack(self.major(), self.rival_n(), self.others()),
         ]
     }
 }
@@ -267,7 +288,7 @@ impl Cell {
 fn count(added: Added, c: &Cell, min: u8, admitted: &mut u16, inconsistent: &mut u16) {
     match added {
         Added::Agreed => {
-            if c.major == min && c.clean() {
+            if c.is_clean_with(min) {
                 *admitted = admitted.saturating_add(1);
             }
         }
@@ -304,7 +325,7 @@ fn first_pair(
             Cell {
                 near: r.z_near,
                 far: r.z_far,
-                major: 1,
+                counts: pack(1, 0, 0),
                 ..Cell::EMPTY
             }
         } else {

@@ -82,7 +82,6 @@ mod key;
 use core::fmt;
 
 pub(crate) use chain::{Chain, StepBounds};
-pub(crate) use key::Admit;
 pub use key::{FusedCounts, FusedPoint, FusedStatus, KeyFrame, PairFused};
 
 use crate::boundary::Frame;

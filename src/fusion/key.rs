@@ -476,17 +476,29 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
             let (Some(cells), Some(results)) = (cells.get_mut(..n), results.get(..n)) else {
                 continue;
             };
-            for (c, r) in cells.iter_mut().zip(results) {
-                if r.status != Status::Ok {
-                    continue;
+            let mut fuse_run = |cells: &mut [Cell], results: &[PointResult]| {
+                for (c, r) in cells.iter_mut().zip(results) {
+                    if r.status != Status::Ok {
+                        continue;
+                    }
+                    out.matched += 1;
+                    let added = c.add(r.z_near, r.z_far, &scale);
+                    if let Added::Conflict { .. } = added {
+                        out.conflicts += 1;
+                    }
+                    count(added, c, min, adm, inc);
                 }
-                out.matched += 1;
-                let added = c.add(r.z_near, r.z_far, &scale);
-                if let Added::Conflict { .. } = added {
-                    out.conflicts += 1;
+            };
+            // Four points at a time, skipping fours with no `Ok` point
+            // (most points of a pair are flagged, in runs).
+            let mut cs = cells.chunks_exact_mut(4);
+            let mut rs = results.chunks_exact(4);
+            for (c4, r4) in cs.by_ref().zip(rs.by_ref()) {
+                if r4.iter().any(|r| r.status == Status::Ok) {
+                    fuse_run(c4, r4);
                 }
-                count(added, c, min, adm, inc);
             }
+            fuse_run(cs.into_remainder(), rs.remainder());
         }
         self.partners = self.partners.saturating_add(1);
         if out.matched > self.best_matched {

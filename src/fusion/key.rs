@@ -318,8 +318,7 @@ fn first_pair(
 ) {
     let mut matched = 0u32;
     let n = cells.len().min(results.len());
-    let (head, tail) = cells.split_at_mut(n);
-    for (c, r) in head.iter_mut().zip(results) {
+    for (c, r) in cells.iter_mut().zip(results) {
         *c = if r.status == Status::Ok {
             matched += 1;
             Cell {
@@ -332,7 +331,8 @@ fn first_pair(
             Cell::EMPTY
         };
     }
-    for c in tail {
+    // (A boundary without results: its cells empty too.)
+    for c in cells.iter_mut().skip(n) {
         *c = Cell::EMPTY;
     }
     out.matched += matched;

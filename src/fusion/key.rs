@@ -40,6 +40,8 @@
 //! nothing has checked (a wrong two-view match cannot be told there); two
 //! or more agreeing pairs make it [`FusedStatus::Consistent`].
 
+use core::fmt;
+
 use super::code::DepthScale;
 use crate::boundary::Frame;
 use crate::depth::DepthInterval;
@@ -370,7 +372,11 @@ pub struct FusedCounts {
 ///
 /// Size: `16·B·N` bytes and a few words (`8 KiB + 32 B` for `N = 256`,
 /// `B = 2`).
-#[derive(Debug, Clone)]
+///
+/// Its `Debug` shows each boundary's live cells only (none while the key
+/// frame is fresh: a fresh key frame's cells still hold the previous one's,
+/// which no reader sees).
+#[derive(Clone)]
 pub struct KeyFrame<const N: usize, const B: usize> {
     cells: [[Cell; N]; B],
     lens: [u16; B],
@@ -390,6 +396,35 @@ pub struct KeyFrame<const N: usize, const B: usize> {
     /// Since [`KeyFrame::start`], no pair and no range constraint: every
     /// point is unmatched, whatever its cell holds.
     fresh: bool,
+}
+
+/// The live cells of a key frame, boundary by boundary ([`KeyFrame`]'s
+/// `Debug`).
+struct LiveCells<'a, const N: usize, const B: usize>(&'a KeyFrame<N, B>);
+
+impl<const N: usize, const B: usize> fmt::Debug for LiveCells<'_, N, B> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_list()
+            .entries((0..B).map(|k| self.0.cells(k)))
+            .finish()
+    }
+}
+
+impl<const N: usize, const B: usize> fmt::Debug for KeyFrame<N, B> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("KeyFrame")
+            .field("id", &self.id)
+            .field("lens", &self.lens)
+            .field("partners", &self.partners)
+            .field("fresh", &self.fresh)
+            .field("admitted", &self.admitted)
+            .field("inconsistent", &self.inconsistent)
+            .field("min_pairs", &self.min_pairs)
+            .field("best_matched", &self.best_matched)
+            .field("scale", &self.scale)
+            .field("cells", &LiveCells(self))
+            .finish()
+    }
 }
 
 impl<const N: usize, const B: usize> KeyFrame<N, B> {
@@ -712,6 +747,35 @@ mod tests {
         // The rival's coded interval, rounded outwards: holds [3.2, 3.9].
         assert!(iv.z_near <= 3.2 && iv.z_near > 3.19 && iv.z_far >= 3.9 && iv.z_far < 3.91);
         assert_eq!(p.status, FusedStatus::Inconsistent);
+    }
+
+    #[test]
+    fn a_fresh_key_frame_shows_none_of_the_previous_ones_cells() {
+        extern crate std;
+        use std::format;
+        let mut k = KeyFrame::<4, 1>::new(sc(), 1);
+        k.start(1, [3]);
+        for i in 0..3 {
+            k.constrain(0, i, 7.0, 7.5 + i as f32);
+        }
+        assert_eq!(k.point(0, 2).unwrap().status, FusedStatus::Single);
+        // The next key frame: its cells are not cleared, but nothing sees
+        // the old ones, neither the readers nor `Debug`.
+        k.start(2, [3]);
+        assert!(k.points(0).all(|p| p.status == FusedStatus::Unmatched));
+        assert!(k.cells(0).is_empty());
+        let shown = format!("{k:?}");
+        assert!(
+            shown.contains("fresh: true") && !shown.contains("7.5"),
+            "{shown}"
+        );
+        // A range constraint on a fresh key frame: that point only.
+        k.constrain(0, 1, 3.0, 4.0);
+        let st: [FusedStatus; 3] = core::array::from_fn(|i| k.point(0, i).unwrap().status);
+        let (u, s1) = (FusedStatus::Unmatched, FusedStatus::Single);
+        assert_eq!(st, [u, s1, u]);
+        assert_eq!(k.admission(0), (1, 0));
+        assert!(!format!("{k:?}").contains("7.5"));
     }
 
     #[test]

@@ -61,12 +61,70 @@ impl fmt::Display for MotionError {
 }
 
 /// Validated motion from frame 1 to frame 2 (see the module docs for conventions).
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+///
+/// A motion made from a matrix ([`Motion::then`]) recovers its angles
+/// only when asked ([`Motion::angles`]): its `angles` field holds NaN
+/// (never a valid angle) until then, and equality, `Debug` and `defmt`
+/// use [`Motion::angles`], so the motion behaves as if they were stored.
+#[derive(Clone, Copy)]
 pub struct Motion {
     translation: [f32; 3],
+    /// The angles given to [`Motion::new`]; all NaN for a motion made
+    /// from its matrix (recovered by [`Motion::angles`]).
     angles: [f32; 3],
     rotation: [[f32; 3]; 3],
+}
+
+impl PartialEq for Motion {
+    fn eq(&self, other: &Self) -> bool {
+        self.translation == other.translation
+            && self.angles() == other.angles()
+            && self.rotation == other.rotation
+    }
+}
+
+impl fmt::Debug for Motion {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Motion")
+            .field("translation", &self.translation)
+            .field("angles", &self.angles())
+            .field("rotation", &self.rotation)
+            .finish()
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Motion {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "Motion {{ translation: {}, angles: {}, rotation: {} }}",
+            self.translation,
+            self.angles(),
+            self.rotation
+        )
+    }
+}
+
+/// The angles `(α, β, γ)` of the rotation matrix `r`
+/// (`R = R_y(β) R_x(α) R_z(γ)`: `α = asin(−R₁₂)`, `β = atan2(R₀₂, R₂₂)`,
+/// `γ = atan2(R₁₀, R₁₁)`).
+fn angles_of(r: &[[f32; 3]; 3]) -> [f32; 3] {
+    let [[_, _, r02], [r10, r11, r12], [_, _, r22]] = *r;
+    [asin(-r12), atan2(r02, r22), atan2(r10, r11)]
+}
+
+/// Whether the angles [`angles_of`] recovers from `r` are certainly all
+/// within [`MAX_ROTATION_RAD`], from the matrix alone: `|R₁₂| ≤ 0.85`
+/// (`asin 0.85 = 1.0160`), and for each `atan2(y, x)` a positive `x`
+/// with `|y| ≤ 1.7 x` (`atan 1.7 = 1.0391`), against the limit `1.0472`.
+/// The margins (at least `0.008` rad) dwarf the recovery's rounding
+/// (`asin`, `atan2` within `1e-6` here, the quotient's rounding `1e-7`
+/// relative), so a `true` here never changes the check's decision; a
+/// `false` sends the check to the angles themselves.
+fn surely_within_limit(r: &[[f32; 3]; 3]) -> bool {
+    let [[_, _, r02], [r10, r11, r12], [_, _, r22]] = *r;
+    r12.abs() <= 0.85 && r22 > 0.0 && r02.abs() <= 1.7 * r22 && r11 > 0.0 && r10.abs() <= 1.7 * r11
 }
 
 impl Motion {
@@ -172,14 +230,19 @@ impl Motion {
         if u * u + v * v + w * w < MIN_TRANSLATION * MIN_TRANSLATION {
             return Err(MotionError::ZeroTranslation);
         }
-        let [[_, _, r02], [r10, r11, r12], [_, _, r22]] = rotation;
-        let angles = [asin(-r12), atan2(r02, r22), atan2(r10, r11)];
-        if angles.iter().any(|x| x.abs() > MAX_ROTATION_RAD) {
+        // The angles are recovered only where the matrix alone cannot
+        // show them within the limit (the same decision either way), and
+        // otherwise only when asked for.
+        if !surely_within_limit(&rotation)
+            && angles_of(&rotation)
+                .iter()
+                .any(|x| x.abs() > MAX_ROTATION_RAD)
+        {
             return Err(MotionError::RotationTooLarge);
         }
         Ok(Self {
             translation,
-            angles,
+            angles: [f32::NAN; 3],
             rotation,
         })
     }
@@ -189,9 +252,14 @@ impl Motion {
         self.translation
     }
 
-    /// Rotation angles `(α, β, γ)`, radians.
+    /// Rotation angles `(α, β, γ)`, radians (for a motion made from its
+    /// matrix, recovered from it here, the same each time).
     pub fn angles(&self) -> [f32; 3] {
-        self.angles
+        if self.angles[0].is_nan() {
+            angles_of(&self.rotation)
+        } else {
+            self.angles
+        }
     }
 
     /// Rotation matrix `R` (frame-2 axes as columns, in frame-1 coordinates).

@@ -290,18 +290,47 @@ impl View {
     /// [`RoadMap::retire`]: its depth needs no test of the range's ends.)
     #[inline]
     fn behind(&self, e: &Entry, scale: &DepthScale) -> bool {
+        self.behind_with(e, scale, self.lat_only)
+    }
+
+    /// [`View::behind`] with the view's `lat_only` passed in (a constant
+    /// in the sweep's loops, [`sweep_run`]).
+    #[inline(always)]
+    fn behind_with(&self, e: &Entry, scale: &DepthScale, lat_only: bool) -> bool {
         let dir = self.g[0] * e.x + self.g[1] * e.y + self.g[2];
         let zf = scale.depth_inner(e.far);
         // The stick's forward coordinate is largest at its far end when it
         // points forward, at its near end otherwise.
         let ahead = dir * if dir >= 0.0 { zf } else { scale.depth(e.near) } + self.g0;
-        let radius = if self.lat_only {
+        let radius = if lat_only {
             zf * self.lat * ROUND_UP
         } else {
             radius(self.rho, self.phi, self.lat, e, zf)
         };
         ahead + radius < 0.0
     }
+}
+
+/// The sweep's test of `n` ring slots from slot `start` (modulo `M`):
+/// each live entry behind the camera ([`View::behind`], `LAT_ONLY` the
+/// view's `lat_only`, fixed for the run) is dropped; returns how many were.
+/// (Out of line, one loop per case: the test's registers stay its own.)
+#[inline(never)]
+fn sweep_run<const M: usize, const LAT_ONLY: bool>(
+    (ring, start, n): (&mut [Entry; M], usize, usize),
+    view: &View,
+    scale: &DepthScale,
+) -> u16 {
+    let mut dropped = 0u16;
+    for j in start..start + n {
+        if let Some(e) = ring.get_mut(j % M) {
+            if e.live() && view.behind_with(e, scale, LAT_ONLY) {
+                *e = Entry::DEAD;
+                dropped += 1;
+            }
+        }
+    }
+    dropped
 }
 
 /// The radius of an entry `e` whose far end is `zf` in a batch with the
@@ -579,14 +608,12 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             let n = (end - pos).min(left);
             let mut dropped = 0u16;
             if let Some(ring) = self.entries.get_mut(boundary) {
-                for j in pos..pos + n {
-                    if let Some(e) = ring.get_mut((tail + j) % M) {
-                        if e.live() && view.behind(e, &self.scale) {
-                            *e = Entry::DEAD;
-                            dropped += 1;
-                        }
-                    }
-                }
+                let run = (ring, tail + pos, n);
+                dropped = if view.lat_only {
+                    sweep_run::<M, true>(run, &view, &self.scale)
+                } else {
+                    sweep_run::<M, false>(run, &view, &self.scale)
+                };
             }
             if let Some(lv) = self
                 .batches

@@ -321,6 +321,50 @@ mod tests {
     }
 
     #[test]
+    fn the_matrix_shortcut_never_overrides_the_angles() {
+        // Rotations from composed random turns, many near and past the
+        // limit: wherever the shortcut says "within", the recovered
+        // angles are within; and a composed motion's lazily recovered
+        // angles are the angles `from_matrix` used to store.
+        let mut g = crate::test_rng::Rng(0x2468_ace1);
+        let mut shortcut = 0;
+        for i in 0..20_000 {
+            let reach = if i % 2 == 0 { 1.2 } else { 0.7 };
+            let mut ang = || (g.next() * 2.0 - 1.0) * reach;
+            let (Ok(a), Ok(b)) = (
+                Motion::new([0.0, 0.0, 1.0], [ang(), ang(), ang()]),
+                Motion::new([0.1, 0.0, 1.0], [ang(), ang(), ang()]),
+            ) else {
+                continue;
+            };
+            let r = mat3_mul(&a.rotation_matrix(), &b.rotation_matrix());
+            let angles = angles_of(&r);
+            let within = !angles.iter().any(|x| x.abs() > MAX_ROTATION_RAD);
+            if surely_within_limit(&r) {
+                shortcut += 1;
+                assert!(within, "{r:?} {angles:?}");
+            }
+            match a.then(&b) {
+                Ok(m) => {
+                    assert!(within);
+                    assert_eq!(m.angles(), angles);
+                    assert_eq!(m, m);
+                }
+                Err(e) => {
+                    assert_eq!(e, MotionError::RotationTooLarge);
+                    assert!(!within);
+                }
+            }
+        }
+        assert!(shortcut > 1_000, "{shortcut}");
+        // At the shortcut's own edges the angles keep their margin.
+        for x in [0.85f32, -0.85] {
+            assert!(asin(x).abs() < MAX_ROTATION_RAD - 0.03);
+        }
+        assert!(atan2(1.7, 1.0) < MAX_ROTATION_RAD - 0.008);
+    }
+
+    #[test]
     fn rejects_bad_motion() {
         assert_eq!(
             Motion::new([f32::NAN, 0.0, 1.0], [0.0; 3]),

@@ -475,6 +475,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             // No last pair: retire what the key frame has, start anew.
             out.retired = self.retire();
             let shown = out.retired.is_some();
+            // (`limit` is `Some` here: `None` only with both `Ok`.)
             let reason = limit.unwrap_or(KeyReason::MotionLimit);
             out.new_key = self.start_key(id, frame, reason, shown);
             return Ok(out);

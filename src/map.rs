@@ -763,6 +763,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             return out;
         }
         // 2. Room: a batch slot, then ring slots, oldest first.
+        let admitted = want;
         self.make_room(&mut want, &mut out);
         // 3. The batch: its pose, each boundary's points, the forward
         // extent and reach of all of them.
@@ -784,6 +785,11 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         for (k, &w) in want.iter().enumerate() {
             let (n, unbounded) = self.enter(k, w, (key, s, batch.lat), &mut extent);
             out.unbounded += unbounded;
+            // The admitted points the scan did not reach: an unbounded
+            // point it passed over left room for one more (each point is
+            // counted once, under one reason).
+            let a = admitted.get(k).copied().unwrap_or(0);
+            out.unfit += a.saturating_sub(n + unbounded as usize) as u32;
             let n16 = n as u16;
             if let (Some(l), Some(lv), Some(u)) = (
                 batch.len.get_mut(k),
@@ -811,7 +817,8 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
 
     /// [`Self::retire`]'s room: a batch slot (the oldest batch goes when
     /// all are taken), then on each boundary the ring slots for its
-    /// `want` points (at most `M`; the rest counted unfit), oldest first.
+    /// `want` points (cut to at most `M`: the caller counts what its scan
+    /// does not reach unfit), oldest first.
     fn make_room(&mut self, want: &mut [usize; B], out: &mut Retired) {
         if usize::from(self.count) >= MAP_BATCHES {
             if let Some(b) = self.batches.get(usize::from(self.first)).copied() {
@@ -820,10 +827,8 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             }
         }
         for (k, w) in want.iter_mut().enumerate() {
-            if *w > M {
-                out.unfit += (*w - M) as u32;
-                *w = M;
-            }
+            // (The points beyond `M` are counted unfit by the caller.)
+            *w = (*w).min(M);
             let used = self.used.get(k).map_or(0, |&u| usize::from(u));
             let free = M - used.min(M);
             if free < *w {

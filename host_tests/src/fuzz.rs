@@ -1,7 +1,8 @@
 //! The project's own fuzzing (issue 15): structured cases for the frame
 //! path ([`frame`]), the calibration entry points ([`calibration`]),
-//! [`roadstereo::geometry::road_geometry`] ([`geometry`]) and the replay
-//! parser ([`replay`]), each run against its oracles.
+//! [`roadstereo::geometry::road_geometry`] ([`geometry`]), the replay
+//! parser ([`replay`]) and the key-frame fusion with its road map
+//! ([`fusion`]), each run against its oracles.
 //!
 //! A case is a pure function of a [`Source`] of 32-bit draws: a seeded
 //! generator for the stable pass (`src/bin/fuzz.rs`, `cargo xtask fuzz`)
@@ -13,6 +14,7 @@
 
 pub mod calibration;
 pub mod frame;
+pub mod fusion;
 pub mod geometry;
 pub mod replay;
 
@@ -220,15 +222,18 @@ pub enum Target {
     Geometry,
     /// [`replay`].
     Replay,
+    /// [`fusion`].
+    Fusion,
 }
 
 impl Target {
     /// Every target.
-    pub const ALL: [Target; 4] = [
+    pub const ALL: [Target; 5] = [
         Target::Frame,
         Target::Calibration,
         Target::Geometry,
         Target::Replay,
+        Target::Fusion,
     ];
 
     /// Its name (also the corpus folder's and the cargo-fuzz target's).
@@ -238,6 +243,7 @@ impl Target {
             Target::Calibration => "calibration",
             Target::Geometry => "geometry",
             Target::Replay => "replay",
+            Target::Fusion => "fusion",
         }
     }
 
@@ -253,6 +259,7 @@ impl Target {
             Target::Calibration => calibration::run(src),
             Target::Geometry => geometry::run(src),
             Target::Replay => replay::run(src),
+            Target::Fusion => fusion::run(src),
         }
     }
 
@@ -263,6 +270,7 @@ impl Target {
             Target::Calibration => format!("{:#?}", calibration::generate(src)),
             Target::Geometry => format!("{:#?}", geometry::generate(src)),
             Target::Replay => replay::describe(src),
+            Target::Fusion => format!("{:#?}", fusion::generate(src)),
         }
     }
 }

@@ -66,6 +66,11 @@ fn saved_replay_cases() {
     assert!(replay_corpus(Target::Replay) >= 2);
 }
 
+#[test]
+fn saved_fusion_cases() {
+    assert!(replay_corpus(Target::Fusion) >= 20);
+}
+
 /// A recorded case replays as the same case: the corpus format is the
 /// generator's draws.
 #[test]
@@ -88,6 +93,7 @@ fn seeded_smoke_pass() {
         (Target::Calibration, 3000),
         (Target::Geometry, 300),
         (Target::Replay, 1000),
+        (Target::Fusion, 3000),
     ] {
         for seed in 0..n {
             let r = std::panic::catch_unwind(|| target.run(&mut Source::seeded(seed)));
@@ -112,4 +118,24 @@ fn a_case_past_the_time_limit_is_a_failure() {
     });
     let msg = host_tests::fuzz::panic_message(&*r.expect_err("must time out"));
     assert!(msg.contains("hang"), "{msg}");
+}
+
+/// The fusion target's generator reaches every path its feature bits
+/// name (errors, key-frame reasons, retirements, the map's drops, cut
+/// pairs, conflicts, saturated counts, ...): a change of the generator or
+/// of the fusion that leaves one unreached fails here.
+#[test]
+fn fusion_cases_reach_every_path() {
+    use host_tests::fuzz::fusion::bit;
+    let mut seen = 0u128;
+    for seed in 0..6000 {
+        seen |= Target::Fusion.run(&mut Source::seeded(seed)).features;
+    }
+    let missing: Vec<u32> = (bit::FUSION_ERR..bit::END)
+        .filter(|b| seen & (1u128 << b) == 0)
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "fusion feature bits never set: {missing:?}"
+    );
 }

@@ -94,6 +94,10 @@ pub struct FusedPoint {
     /// The status.
     pub status: FusedStatus,
     /// The fused interval (the majority's for an inconsistent point), if any.
+    /// Finite, but for an inconsistent point whose majority was the rival
+    /// interval: that one is kept in 16-bit codes rounded outwards (module
+    /// docs), and a far end from about twice `Config::max_depth` on (a
+    /// range constraint's, say) comes back as `f32::INFINITY`.
     pub interval: Option<DepthInterval>,
     /// Pairs (and range constraints) that gave the point an interval.
     pub pairs: u8,

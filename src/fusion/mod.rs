@@ -153,10 +153,15 @@ impl FusionConfig {
         Err(_) => panic!("the default fusion configuration is valid"),
     };
 
-    /// A key frame is given at most `max_partners` frames (1 to
-    /// [`MAX_PARTNERS`]), and none after a pair that matched fewer than
-    /// `keep_permille` ‰ of the most points a pair of it matched (0
-    /// switches the share rule off).
+    /// A key frame's last partner (the frame that becomes the next key
+    /// frame) is its `max_partners`-th (1 to [`MAX_PARTNERS`]), or the
+    /// frame after a pair that matched fewer than `keep_permille` ‰ of the
+    /// most points a pair of it matched (0 switches the share rule off),
+    /// whichever comes first. A frame without points cannot become a key
+    /// frame: while the last partner is due, such frames are paired too
+    /// and the switch waits for the next frame with points (module docs,
+    /// "Key-frame policy"), so a key frame has more than `max_partners`
+    /// partners exactly when frames without points came while it was due.
     ///
     /// ```
     /// use roadstereo::fusion::FusionConfig;

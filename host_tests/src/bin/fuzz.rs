@@ -1,5 +1,5 @@
 //! The seeded fuzz pass (issue 15): `fuzz [--seconds S] [--threads T]
-//! [--seed X] [--targets frame:6,calibration:1,...] [--cases N]
+//! [--seed X] [--targets frame:6,calibration:1,...,fusion:2] [--cases N]
 //! [--case-limit S] [--save DIR]`.
 //!
 //! Runs each target's structured generator (see `host_tests::fuzz`) on
@@ -25,6 +25,7 @@ fn main() -> std::process::ExitCode {
             (Target::Calibration, 1),
             (Target::Geometry, 1),
             (Target::Replay, 1),
+            (Target::Fusion, 2),
         ],
         seed: 0,
         time: Duration::from_secs(60),

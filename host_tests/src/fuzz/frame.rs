@@ -106,12 +106,12 @@ pub struct MotionIn {
 
 /// A camera pose in the scene: orientation (camera → world) and centre.
 #[derive(Debug, Clone, Copy)]
-struct Pose {
+pub(super) struct Pose {
     r: [[f64; 3]; 3],
     t: [f64; 3],
 }
 
-const IDENTITY: Pose = Pose {
+pub(super) const IDENTITY: Pose = Pose {
     r: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
     t: [0.0; 3],
 };
@@ -144,7 +144,7 @@ fn rotation(a: [f32; 3]) -> [[f64; 3]; 3] {
 
 impl Pose {
     /// The pose after `m` (given in this pose's camera axes).
-    fn then(&self, m: &MotionIn) -> Pose {
+    pub(super) fn then(&self, m: &MotionIn) -> Pose {
         let d = mat_vec(&self.r, m.t.map(f64::from));
         Pose {
             r: mat_mul(&self.r, &rotation(m.r)),
@@ -163,16 +163,16 @@ impl Pose {
 /// `Y cos θ + Z sin θ = h`; each edge is at lateral offset
 /// `a + b s + c s²` at distance `s` along the road.
 #[derive(Debug, Clone)]
-struct Scene {
+pub(super) struct Scene {
     h: f64,
-    tilt: f64,
-    edges: Vec<[f64; 3]>,
+    pub(super) tilt: f64,
+    pub(super) edges: Vec<[f64; 3]>,
     near: f64,
     far: f64,
 }
 
 impl Scene {
-    fn new(src: &mut Source) -> Scene {
+    pub(super) fn new(src: &mut Source) -> Scene {
         let n = 2 + src.index(2);
         let edges = (0..n)
             .map(|k| {
@@ -203,7 +203,7 @@ impl Scene {
 }
 
 /// A plausible camera, or one at the limits, or (rarely) an invalid one.
-fn camera(src: &mut Source) -> ([f32; 4], (u16, u16)) {
+pub(super) fn camera(src: &mut Source) -> ([f32; 4], (u16, u16)) {
     let (w, h): (u16, u16) = match src.below(16) {
         0 => (2, 2),
         1 => (16384, src.pick(&[2, 480, 16384])),
@@ -234,7 +234,7 @@ fn camera(src: &mut Source) -> ([f32; 4], (u16, u16)) {
     ([f, fy, cx, cy], (w, h))
 }
 
-fn config(src: &mut Source) -> ConfigIn {
+pub(super) fn config(src: &mut Source) -> ConfigIn {
     let e = |src: &mut Source| {
         src.mixed(|s| match s.below(8) {
             0 => s.pick(&[0.0, 100.0, 3.0, 0.25]),
@@ -289,7 +289,7 @@ fn config(src: &mut Source) -> ConfigIn {
 ///
 /// Driving is along the road: the camera is tilted down by `tilt`, so
 /// forward on the road is `(0, −sin θ, cos θ)` in its axes.
-fn motion(src: &mut Source, tilt: f64) -> MotionIn {
+pub(super) fn motion(src: &mut Source, tilt: f64) -> MotionIn {
     let (st, ct) = (tilt.sin() as f32, tilt.cos() as f32);
     let small = |s: &mut Source, a: f64| s.mixed(|s| s.f32_in(-a, a));
     let kind = src.below(16);
@@ -336,7 +336,7 @@ fn motion(src: &mut Source, tilt: f64) -> MotionIn {
 /// The points of one boundary: a road edge seen from `pose`, a random
 /// polyline, a radial line or a mutated copy, at most `cap + 2` points.
 #[allow(clippy::too_many_arguments)]
-fn boundary(
+pub(super) fn boundary(
     src: &mut Source,
     scene: &Scene,
     edge: usize,
@@ -604,7 +604,7 @@ mod bit {
     pub const LOOSER_STICK: u32 = 63;
 }
 
-fn set(f: &mut u128, b: u32) {
+pub(super) fn set(f: &mut u128, b: u32) {
     *f |= 1u128 << b;
 }
 
@@ -624,7 +624,7 @@ pub fn check(case: &Case) -> Outcome {
 
 /// The configuration of `c`, each rejected step checked against the
 /// documented rule and skipped.
-fn build_config(c: &ConfigIn, features: &mut u128) -> Config {
+pub(super) fn build_config(c: &ConfigIn, features: &mut u128) -> Config {
     let [e1, e2, angle, depth] = c.new;
     let mut config = match Config::new(e1, e2, angle, depth) {
         Ok(c) => c,
@@ -734,7 +734,7 @@ fn boundary_error_bit(e: &BoundaryError) -> u32 {
 
 /// The frame of `f`, or `None` when its camera is rejected. Every rejected
 /// boundary is checked: the right error, the frame unchanged.
-fn build_frame<const N: usize, const B: usize>(
+pub(super) fn build_frame<const N: usize, const B: usize>(
     f: &FrameIn,
     features: &mut u128,
 ) -> Option<Frame<N, B>> {
@@ -778,7 +778,7 @@ fn build_frame<const N: usize, const B: usize>(
     Some(frame)
 }
 
-fn build_motion(m: &MotionIn, features: &mut u128) -> Option<Motion> {
+pub(super) fn build_motion(m: &MotionIn, features: &mut u128) -> Option<Motion> {
     match Motion::new(m.t, m.r) {
         Ok(x) => {
             if m.t[2] < 0.0 {

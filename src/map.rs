@@ -39,6 +39,24 @@
 //! adversarial review found it: about `0.49 Z/800` missing with the
 //! key-frame pixels 0.49 px off, `host_tests/tests/fusion.rs`.)
 //!
+//! The `f32` arithmetic is bounded the same way, as a motion error that
+//! is always there, configured bounds or not (a second review found map
+//! points up to `1.8·10⁻⁶` outside a radius of 0 with `e₁ = 0` and exact
+//! motions). With `u = 2⁻²⁴`: a frame's rotation matrix from its `f32`
+//! angles is within about `18 u` of the rotation those angles name (as an
+//! operator), and the product `Rᵀ A` adds at most `3 u` per entry (rows
+//! and columns of unit length), `9 u` as an operator: below
+//! `2⁻¹⁹ = 32 u` per carried frame, added to `φ`. The
+//! position `Rᵀ (b − T)` is off by at most `(1 + 3 + 18) u √3 |b − T| <
+//! 2⁻¹⁸ (|b|₁ + |T|₁)`, added to `ρ`. A retiring key frame's pose comes
+//! from its composed motion, one such step per frame since the key frame,
+//! whose rounding the composition keeps the same way
+//! ([`crate::fusion`]'s chain): the batch starts with it. A point's own
+//! evaluation (its ray
+//! times the decoded depth, the pose, the tilt) is within `8 u (|P_K| +
+//! |b|)`, covered by `2⁻²⁰ |P_K|` in the radius (`EVAL_ROUNDING`) and
+//! by the `ρ` above (at least `2⁻¹⁸ |b|₁` from the first step on).
+//!
 //! # What leaves the map, all counted ([`MapDrops`])
 //! * **Behind**: a point whose whole stick, widened by its radius, is
 //!   behind the camera (negative forward coordinate in the vehicle frame)
@@ -60,7 +78,7 @@
 //! `76 + 4·B` bytes (13 000 bytes in all for `B = 2`, `M = 512`).
 
 use crate::fusion::code::{DepthScale, UNBOUNDED};
-use crate::fusion::{Chain, KeyFrame, StepBounds};
+use crate::fusion::{norm1, Chain, KeyFrame, StepBounds, STEP_ROUNDING};
 use crate::geometry::Sample;
 use crate::math::{fmax, fmin, mat3_mul, mat3_transpose, mat3_vec, sqrt, Mat3};
 use crate::motion::Motion;
@@ -75,6 +93,10 @@ pub const SWEEP_PER_FRAME: usize = 32;
 
 /// Rounding allowance of a bound's arithmetic.
 const ROUND_UP: f32 = 1.0 + 1.0 / 65_536.0;
+
+/// The `f32` rounding of a map point's evaluation, relative to `|P_K|`
+/// (`2⁻²⁰`, module docs).
+const EVAL_ROUNDING: f32 = 1.0 / 1_048_576.0;
 
 /// One stored point: its key-frame ray and coded interval (12 bytes).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -244,13 +266,12 @@ struct View {
     g: [f32; 3],
     g0: f32,
     dg: f32,
-    rho: f32,
-    phi: f32,
     lat: f32,
-    /// `ρ` and `φ` are zero and every entry's `|P_K|` bound is finite: the
-    /// radius is `zf λ` rounded up, bit for bit what [`radius`] gives
-    /// (`zf λ + ±0 + ±0 · reach` is `zf λ` for a finite `reach`).
-    lat_only: bool,
+    /// The radius less its `Z_far λ`, bounded over the whole batch: `(ρ +
+    /// (φ + 2⁻²⁰) reach)` rounded up twice (`reach` bounds every entry's
+    /// `|P_K|` bound, [`radius`]): a point's sweep test is then as cheap as
+    /// without motion errors, and no smaller than its own radius.
+    rest: f32,
 }
 
 impl View {
@@ -262,12 +283,8 @@ impl View {
             g,
             g0: dot3(w, b.b),
             dg: sqrt(dot3(d, d)) * 1.000_01 + 1e-7,
-            rho: b.rho,
-            phi: b.phi,
             lat: b.lat,
-            // (`reach` bounds every entry's `|P_K|` bound within 2⁻¹⁰ of
-            // it: below 10³⁰ they are all finite.)
-            lat_only: b.rho == 0.0 && b.phi == 0.0 && b.reach < 1.0e30,
+            rest: (b.rho + (b.phi + EVAL_ROUNDING) * b.reach) * (ROUND_UP * ROUND_UP),
         }
     }
 
@@ -275,7 +292,7 @@ impl View {
     fn whole<const B: usize>(&self, b: &Batch<B>) -> Whole {
         let slack = self.dg * b.reach;
         // (`reach` bounds `|P_K|`, and so `Z_far`, over the batch.)
-        let radius = self.rho + (self.phi + self.lat) * b.reach;
+        let radius = self.rest + self.lat * b.reach * ROUND_UP;
         if b.forward.1 + self.g0 + slack + radius < 0.0 {
             Whole::Behind
         } else if b.forward.0 + self.g0 - slack >= 0.0 {
@@ -285,38 +302,27 @@ impl View {
         }
     }
 
-    /// Whether a live point's whole stick, widened by its radius, is
-    /// behind. (A live entry's far code is 1 to `UNBOUNDED − 1`,
-    /// [`RoadMap::retire`]: its depth needs no test of the range's ends.)
-    #[inline]
-    fn behind(&self, e: &Entry, scale: &DepthScale) -> bool {
-        self.behind_with(e, scale, self.lat_only)
-    }
-
-    /// [`View::behind`] with the view's `lat_only` passed in (a constant
-    /// in the sweep's loops, [`sweep_run`]).
+    /// Whether a live point's whole stick, widened by its radius (its `Z_far
+    /// λ` and the batch's bound of the rest, `rest`), is behind. (A live
+    /// entry's far code is 1 to `UNBOUNDED − 1`, [`RoadMap::retire`]: its
+    /// depth needs no test of the range's ends.)
     #[inline(always)]
-    fn behind_with(&self, e: &Entry, scale: &DepthScale, lat_only: bool) -> bool {
+    fn behind(&self, e: &Entry, scale: &DepthScale) -> bool {
         let dir = self.g[0] * e.x + self.g[1] * e.y + self.g[2];
         let zf = scale.depth_inner(e.far);
         // The stick's forward coordinate is largest at its far end when it
         // points forward, at its near end otherwise.
         let ahead = dir * if dir >= 0.0 { zf } else { scale.depth(e.near) } + self.g0;
-        let radius = if lat_only {
-            zf * self.lat * ROUND_UP
-        } else {
-            radius(self.rho, self.phi, self.lat, e, zf)
-        };
-        ahead + radius < 0.0
+        ahead + zf * self.lat * ROUND_UP + self.rest < 0.0
     }
 }
 
 /// The sweep's test of `n` ring slots from slot `start` (modulo `M`):
-/// each live entry behind the camera ([`View::behind`], `LAT_ONLY` the
-/// view's `lat_only`, fixed for the run) is dropped; returns how many were.
-/// (Out of line, one loop per case: the test's registers stay its own.)
+/// each live entry behind the camera ([`View::behind`]) is dropped;
+/// returns how many were. (Out of line: the test's registers stay its
+/// own.)
 #[inline(never)]
-fn sweep_run<const M: usize, const LAT_ONLY: bool>(
+fn sweep_run<const M: usize>(
     (ring, start, n): (&mut [Entry; M], usize, usize),
     view: &View,
     scale: &DepthScale,
@@ -324,7 +330,7 @@ fn sweep_run<const M: usize, const LAT_ONLY: bool>(
     let mut dropped = 0u16;
     for j in start..start + n {
         if let Some(e) = ring.get_mut(j % M) {
-            if e.live() && view.behind_with(e, scale, LAT_ONLY) {
+            if e.live() && view.behind(e, scale) {
                 *e = Entry::DEAD;
                 dropped += 1;
             }
@@ -334,13 +340,13 @@ fn sweep_run<const M: usize, const LAT_ONLY: bool>(
 }
 
 /// The radius of an entry `e` whose far end is `zf` in a batch with the
-/// bounds `rho`, `phi`, `lat` (module docs): `zf λ + ρ + φ |P_K|`, `|P_K|`
-/// bounded on the true ray.
+/// bounds `rho`, `phi`, `lat` (module docs): `zf λ + ρ + φ |P_K|` and the
+/// evaluation's rounding, `|P_K|` bounded on the true ray.
 #[inline]
 fn radius(rho: f32, phi: f32, lat: f32, e: &Entry, zf: f32) -> f32 {
     let (x, y) = (e.x.abs() + lat, e.y.abs() + lat);
     let reach = zf * (1.0 + 0.5 * (x * x + y * y));
-    (zf * lat + rho + phi * reach) * ROUND_UP
+    (zf * lat + rho + (phi + EVAL_ROUNDING) * reach) * ROUND_UP
 }
 
 /// The fixed-capacity road map: up to `M` points on each of `B`
@@ -549,6 +555,9 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             b.a = mat3_mul(&rt, &b.a);
             let d = [b.b[0] - t[0], b.b[1] - t[1], b.b[2] - t[2]];
             b.b = mat3_vec(&rt, d);
+            // This frame's rounding (module docs), bounds or not.
+            b.rho += 2.0 * STEP_ROUNDING * (norm1(b.b) + norm1(t));
+            b.phi += STEP_ROUNDING;
             if widen {
                 let nb = sqrt(dot3(b.b, b.b));
                 b.rho = (b.rho + 1.732_051 * bounds.delta + bounds.omega * nb) * ROUND_UP;
@@ -609,11 +618,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             let mut dropped = 0u16;
             if let Some(ring) = self.entries.get_mut(boundary) {
                 let run = (ring, tail + pos, n);
-                dropped = if view.lat_only {
-                    sweep_run::<M, true>(run, &view, &self.scale)
-                } else {
-                    sweep_run::<M, false>(run, &view, &self.scale)
-                };
+                dropped = sweep_run::<M>(run, &view, &self.scale);
             }
             if let Some(lv) = self
                 .batches

@@ -36,6 +36,14 @@
 //! Without configured error bounds every bound stays exactly 0 and the
 //! composed motion is what the per-frame motions compose to in `f32` (see
 //! [`Motion::then`] for its rounding).
+//!
+//! # Rounding
+//! The composition's own `f32` rounding is kept apart, always (configured
+//! bounds or not), for the road map's radius ([`crate::map`], "The
+//! radius", which derives the step): each frame adds [`STEP_ROUNDING`]
+//! (`2⁻¹⁹`) to the orientation's angle error and `2⁻¹⁸ (|T₁|₁ + |T₂|₁)` to
+//! the translation's. The processor pairs with the composed motion as
+//! given (its sticks do not see this rounding).
 
 use crate::config::{Config, ConfigError};
 use crate::math::{mat3_mul, mat3_transpose, mat3_vec, sqrt, Mat3};
@@ -45,6 +53,16 @@ use crate::motion::{Motion, MotionError};
 const SQRT3: f32 = 1.732_051;
 /// Rounding allowance of a bound's arithmetic.
 const ROUND_UP: f32 = 1.0 + 1.0 / 65_536.0;
+
+/// The `f32` rounding of composing one frame's rotation, as an angle
+/// (`2⁻¹⁹ = 32 u`, [`crate::map`], "The radius"); a translation's is
+/// twice this times the 1-norms involved.
+pub(crate) const STEP_ROUNDING: f32 = 1.0 / 524_288.0;
+
+/// `|v|₁`.
+pub(crate) fn norm1(v: [f32; 3]) -> f32 {
+    v[0].abs() + v[1].abs() + v[2].abs()
+}
 
 /// The per-frame error bounds of the configuration.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -89,6 +107,10 @@ pub(crate) struct Chain {
     pub(crate) eps: [f32; 3],
     /// Rotation error angle bound.
     pub(crate) omega: f32,
+    /// The composition's own rounding (module docs): of the translation,
+    /// and of the orientation as an angle.
+    pub(crate) round_t: f32,
+    pub(crate) round_r: f32,
 }
 
 fn norm(v: [f32; 3]) -> f32 {
@@ -103,6 +125,8 @@ impl Chain {
         delta: 0.0,
         eps: [0.0; 3],
         omega: 0.0,
+        round_t: 0.0,
+        round_r: 0.0,
     };
 
     /// The chain continued by one frame's motion `m` with error bounds `b`
@@ -113,8 +137,16 @@ impl Chain {
         let rt2 = mat3_vec(&self.r, t2);
         let t = [self.t[0] + rt2[0], self.t[1] + rt2[1], self.t[2] + rt2[2]];
         let r = mat3_mul(&self.r, &r2);
+        let round_t = self.round_t + 2.0 * STEP_ROUNDING * (norm1(self.t) + norm1(t2));
+        let round_r = self.round_r + STEP_ROUNDING;
         if !(b.any() || self.delta > 0.0 || self.omega > 0.0) {
-            return Chain { t, r, ..*self };
+            return Chain {
+                t,
+                r,
+                round_t,
+                round_r,
+                ..*self
+            };
         }
         let a = self.omega * (norm(t2) + SQRT3 * b.delta) + b.delta;
         let row = self
@@ -138,6 +170,8 @@ impl Chain {
             delta,
             eps,
             omega: (self.omega + b.omega) * ROUND_UP,
+            round_t,
+            round_r,
         }
     }
 
@@ -159,16 +193,19 @@ impl Chain {
     /// The current frame's pose of key-frame points, `P = A P_K + b`
     /// (`A = Rᵀ`, `b = −Rᵀ T`), and the error bound of a carried point,
     /// `ρ + φ |P_K|`: `ρ = √3 δ + ω |T|`, `φ = ω` (the true point is
-    /// `Ωᵀ Rᵀ (P_K − T − d)`, off by at most `ω |P_K − T| + |d|`).
+    /// `Ωᵀ Rᵀ (P_K − T − d)`, off by at most `ω |P_K − T| + |d|`), plus the
+    /// composition's rounding (module docs) and that of `b` itself
+    /// (`2⁻¹⁸ |T|₁`; the rotation's `round_r |T|` is in `round_t`'s steps).
     pub(crate) fn pose(&self) -> (Mat3, [f32; 3], f32, f32) {
         let a = mat3_transpose(&self.r);
         let at = mat3_vec(&a, self.t);
-        let rho = if self.delta > 0.0 || self.omega > 0.0 {
+        let bounds = if self.delta > 0.0 || self.omega > 0.0 {
             (SQRT3 * self.delta + self.omega * norm(self.t)) * ROUND_UP
         } else {
             0.0
         };
-        (a, [-at[0], -at[1], -at[2]], rho, self.omega)
+        let rho = bounds + self.round_t + 2.0 * STEP_ROUNDING * norm1(self.t);
+        (a, [-at[0], -at[1], -at[2]], rho, self.omega + self.round_r)
     }
 }
 
@@ -286,7 +323,10 @@ mod tests {
         let c = Chain::IDENTITY.then(&m, &b).then(&m, &b);
         assert_eq!((c.delta, c.eps, c.omega), (0.0, [0.0; 3], 0.0));
         assert_eq!(c.config(&Config::DEFAULT), Ok(Config::DEFAULT));
-        assert_eq!(c.pose().2, 0.0);
+        // Only the composition's rounding (module docs): two steps' worth.
+        let (_, _, rho, phi) = c.pose();
+        assert_eq!(phi, 2.0 * STEP_ROUNDING);
+        assert!(rho > 0.0 && rho < 4.0 * 2.0 * STEP_ROUNDING * 0.8, "{rho}");
         // The composed motion is the motions' composition.
         let two = m.then(&m).unwrap();
         assert_eq!(c.motion().unwrap().translation(), two.translation());

@@ -63,7 +63,7 @@
 //! # Memory and work
 //! Beside the processor, `Fusion<N, B, M>` holds a [`KeyFrame`] (`16·B·N`
 //! bytes), a [`RoadMap`] (`12·B·M` bytes and [`crate::map::MAP_BATCHES`]
-//! batches) and a few words: 21 340 bytes for `N = 256`, `B = 2`,
+//! batches) and a few words: 21 380 bytes for `N = 256`, `B = 2`,
 //! `M = 512` on the Cortex-M4F, asserted at compile time there (at most
 //! 24 KiB). Per frame the fusion costs one pass over the key frame's points
 //! (`O(1)` each: an intersection, or the consistency check), `O(MAP_BATCHES)`
@@ -81,14 +81,14 @@ mod key;
 
 use core::fmt;
 
-pub(crate) use chain::{Chain, StepBounds};
+pub(crate) use chain::{norm1, Chain, StepBounds, STEP_ROUNDING};
 pub use key::{FusedCounts, FusedPoint, FusedStatus, KeyFrame, PairFused};
 
 use crate::boundary::Frame;
 use crate::config::Config;
 use crate::deadline::{Deadline, NoDeadline};
 use crate::map::{Retired, RoadMap};
-use crate::math::{sin_cos, sqrt};
+use crate::math::{fmax, sin_cos, sqrt};
 use crate::motion::Motion;
 use crate::processor::Processor;
 use crate::structure::{Step, Structure};
@@ -615,9 +615,13 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// fused one flags the point. Returns the point after.
     ///
     /// The distance `r` along the ray through normalised `(x, y)` is the
-    /// depth `Z = r / √(1 + x² + y²)`; the conversion is rounded outwards
-    /// (a `far` whose depth overflows `f32` is an
-    /// [`FusionError::InvalidRange`]).
+    /// depth `Z = r / √(1 + x² + y²)`, on the **true** point's ray, whose
+    /// pixel is within `e₁` of the detected one ([`Config::e1`]): the near
+    /// end is divided by the largest `√(1 + x² + y²)` over those rays and
+    /// the far end by the smallest, both rounded outwards (a `far` whose
+    /// depth overflows `f32` is an [`FusionError::InvalidRange`]). (The
+    /// detected pixel's ray alone missed the truth by about `|x| e₁/f`
+    /// of the depth, found by an adversarial review.)
     ///
     /// The key frame is the processor's kept frame: right after a step
     /// that retired a key frame, the constraint is on the **new** one,
@@ -648,10 +652,22 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             .and_then(|b| b.points().get(index))
             .copied()
             .ok_or(FusionError::NoSuchPoint)?;
-        let [x, y] = kept.camera().normalise(p);
-        let n = sqrt(1.0 + x * x + y * y);
-        // (sqrt is within 2e-7 of the truth; 1e-6 covers it and the division.)
-        let (zn, zf) = (near / n * (1.0 - 1.0e-6), far / n * (1.0 + 1.0e-6));
+        // The true point is on the ray of a pixel within `e₁` of the
+        // detected one: its `√(1 + x² + y²)` between those at the corners
+        // of the box `|Δx| ≤ e₁/f_x`, `|Δy| ≤ e₁/f_y` nearest to and
+        // farthest from the principal point (the disc is inside the box).
+        let cam = kept.camera();
+        let [x, y] = cam.normalise(p);
+        let e1 = self.base.e1();
+        let (dx, dy) = (e1 / cam.fx(), e1 / cam.fy());
+        let (xa, ya) = (x.abs(), y.abs());
+        let (xl, yl) = (fmax(xa - dx, 0.0), fmax(ya - dy, 0.0));
+        let (xh, yh) = (xa + dx, ya + dy);
+        let n_lo = sqrt(1.0 + xl * xl + yl * yl);
+        let n_hi = sqrt(1.0 + xh * xh + yh * yh);
+        // (sqrt is within 2e-7 of the truth; 1e-6 covers it, the squares
+        // and the division.)
+        let (zn, zf) = (near / n_hi * (1.0 - 1.0e-6), far / n_lo * (1.0 + 1.0e-6));
         // (A far end near `f32::MAX` overflows; `n ≥ 1`, so only the far one.)
         if !zf.is_finite() {
             return Err(FusionError::InvalidRange);

@@ -94,6 +94,10 @@ pub const SWEEP_PER_FRAME: usize = 32;
 /// Rounding allowance of a bound's arithmetic.
 const ROUND_UP: f32 = 1.0 + 1.0 / 65_536.0;
 
+/// The largest `|P_K|` bound a map point may have (its coordinates, the
+/// radius and the sweep's bounds then stay finite; [`Retired::unbounded`]).
+const MAX_REACH: f32 = 1.0e30;
+
 /// The `f32` rounding of a map point's evaluation, relative to `|P_K|`
 /// (`2⁻²⁰`, module docs).
 const EVAL_ROUNDING: f32 = 1.0 / 1_048_576.0;
@@ -216,7 +220,9 @@ pub struct Retired {
     /// Points left out: admitted, but with a far end beyond what the map's
     /// depth codes hold (about twice `Config::max_depth`: a range
     /// constraint or a stick reaching that far), which would be an
-    /// unbounded stick in the map.
+    /// unbounded stick in the map, or so far along a steep ray (a distance
+    /// bound past `10³⁰`, with a huge `max_depth`) that the map's `f32`
+    /// arithmetic could overflow.
     pub unbounded: u32,
     /// Older points dropped to make room (also in [`MapDrops::capacity`]).
     pub dropped: u32,
@@ -807,8 +813,8 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             }
             out.entered += n as u32;
         }
-        // The coded ends are up to 2⁻¹² beyond the fused ones, and the
-        // products round: widened by 2⁻¹⁰ of the reach.
+        // The decoded ends are up to 2⁻¹² beyond those of the extent
+        // (`enter`), and the products round: widened by 2⁻¹⁰ of the reach.
         let reach = extent.reach * (1.0 + 1.0 / 1024.0);
         batch.forward = (extent.lo - reach / 1024.0, extent.hi + reach / 1024.0);
         batch.reach = reach;
@@ -849,7 +855,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
     /// slots, their forward coordinates and reach (`|P_K|` on the true
     /// ray, `lat` the batch's `λ`) taken into `extent`. Returns how many
     /// entered, and how many were left out for a far end the codes cannot
-    /// hold.
+    /// hold or a distance bound past [`MAX_REACH`].
     fn enter<const N: usize>(
         &mut self,
         k: usize,
@@ -883,26 +889,35 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             at += 1;
             let [x, y] = cam.normalise(r.pixel1());
             let (z_near, z_far) = c.ends();
-            let far = scale.up(z_far);
-            if far == UNBOUNDED {
+            let (near, far) = (scale.down(z_near), scale.up(z_far).max(1));
+            // The ends as the map decodes them: within `2⁻¹²` of the fused
+            // ones (the caller widens the extent by more), but below `2⁻¹⁵
+            // s` a near end is code 0, depth 0, and a far end code 1, about
+            // `2⁻¹⁵ s` (with a huge `max_depth` far above the fused one).
+            let zn = if near == 0 { 0.0 } else { z_near };
+            let zf = if far == 1 {
+                scale.depth_inner(1)
+            } else {
+                z_far
+            };
+            // `|P_K|`'s bound on the true ray: past `10³⁰` (a far ray of a
+            // wide-angle camera, or such a scale) the map's `f32`
+            // arithmetic could overflow, so such a point is left out too.
+            let (xl, yl) = (x.abs() + lat, y.abs() + lat);
+            let reach = zf * (1.0 + 0.5 * (xl * xl + yl * yl));
+            // (A NaN fails.)
+            if far == UNBOUNDED || !(reach <= MAX_REACH) {
                 unbounded += 1;
                 continue;
             }
-            let e = Entry {
-                x,
-                y,
-                near: scale.down(z_near),
-                far: far.max(1),
-            };
+            let e = Entry { x, y, near, far };
             // Forward coordinate (key frame's vehicle frame) of both
-            // ends; the coded ends are within 2⁻¹² of these (widened by
-            // the caller).
+            // ends.
             let dir = tc - ts * y;
-            let (a, b) = (z_near * dir, z_far * dir);
+            let (a, b) = (zn * dir, zf * dir);
             extent.lo = fmin(extent.lo, fmin(a, b));
             extent.hi = fmax(extent.hi, fmax(a, b));
-            let (xl, yl) = (x.abs() + lat, y.abs() + lat);
-            extent.reach = fmax(extent.reach, z_far * (1.0 + 0.5 * (xl * xl + yl * yl)));
+            extent.reach = fmax(extent.reach, reach);
             if let Some(slot) = ring.get_mut((start + n) % M) {
                 *slot = e;
             }

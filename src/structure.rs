@@ -211,8 +211,12 @@ impl PointResult {
     pub fn pixel1(&self) -> Pixel {
         self.pixel1
     }
-    /// The matched frame-2 pixel (on the frame-2 polyline), if a crossing
-    /// was chosen.
+    /// The matched frame-2 pixel, if a crossing was chosen: the exact
+    /// epipolar line's point there, on the frame-2 polyline up to `f32`
+    /// rounding (within `2⁻¹⁶ S` px, `S` the largest coordinate magnitude
+    /// of the match, the compensated frame-1 point and the FOE, at least 1:
+    /// a tolerance the fuzz pass checks on every match, README "Using the
+    /// library").
     pub fn pixel2(&self) -> Option<Pixel> {
         self.status.has_match().then_some(self.pixel2)
     }

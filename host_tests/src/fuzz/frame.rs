@@ -814,6 +814,54 @@ fn same<const N: usize, const B: usize>(a: &Structure<N, B>, b: &Structure<N, B>
             .all(|(x, y)| x.points().len() == y.points().len())
 }
 
+/// Every reported frame-2 match of `s` lies on its boundary's frame-2
+/// polyline within the documented tolerance, `2⁻¹⁶ S` with `S` the largest
+/// coordinate magnitude of the match, the compensated frame-1 point and the
+/// FOE (README, "Using the library"; the largest ratio seen in a minute of
+/// this pass was `8.3·10⁻⁷`, about a twentieth of it).
+fn check_on_polyline<const N: usize, const B: usize>(
+    s: &Structure<N, B>,
+    kept: &Frame<N, B>,
+    (frame, m): (&Frame<N, B>, &Motion),
+) {
+    let g = roadstereo::PairGeometry::new(&kept.camera(), &frame.camera(), m);
+    let foe = g
+        .focus_of_expansion()
+        .map_or(0.0, |f| f64::from(f.u.abs().max(f.v.abs())));
+    for (k, b) in s.boundaries().iter().enumerate() {
+        let poly = frame.boundaries().get(k).map(|b| b.points());
+        for r in b.points() {
+            let Some(q) = r.pixel2() else { continue };
+            let Some(poly) = poly else {
+                panic!("boundary {k}: a match without a frame-2 boundary: {r:?}");
+            };
+            let (qu, qv) = (f64::from(q.u), f64::from(q.v));
+            let d = poly
+                .windows(2)
+                .map(|w| {
+                    let (au, av) = (f64::from(w[0].u), f64::from(w[0].v));
+                    let (du, dv) = (f64::from(w[1].u) - au, f64::from(w[1].v) - av);
+                    let l2 = du * du + dv * dv;
+                    let t = if l2 > 0.0 {
+                        (((qu - au) * du + (qv - av) * dv) / l2).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    };
+                    (qu - au - t * du).hypot(qv - av - t * dv)
+                })
+                .fold(f64::INFINITY, f64::min);
+            let p1 = g
+                .compensate(r.pixel1())
+                .map_or(0.0, |c| f64::from(c.pixel().u.abs().max(c.pixel().v.abs())));
+            let scale = 1.0f64.max(qu.abs()).max(qv.abs()).max(p1).max(foe);
+            assert!(
+                d <= scale / 65_536.0,
+                "boundary {k}: the match {q:?} is {d:e} px off the frame-2 polyline (S = {scale}): {r:?}"
+            );
+        }
+    }
+}
+
 /// Every result of `s` is well formed, against the kept frame it came from.
 fn check_structure<const N: usize, const B: usize>(
     s: &Structure<N, B>,
@@ -1206,6 +1254,9 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
                             "{what}: the new frame was not kept"
                         );
                         check_structure(&s, k, &config, &mut features);
+                        if let Some(m) = &motion {
+                            check_on_polyline(&s, k, (&frame, m));
+                        }
                         against_reference(&s, r, &config, &mut features);
                         let t = shadow.process(&frame, motion.as_ref());
                         let Ok(Step::Structure(t)) = t else {
@@ -1243,6 +1294,7 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
                         points[0] += c[0];
                         points[1] += c[1];
                         check_structure(&s, k, &config, &mut features);
+                        check_on_polyline(&s, k, (&frame, &motion));
                         against_reference(&s, r, &config, &mut features);
                         within_deadlines(k, (&frame, &motion), &config, r, &mut features);
                         assert!(

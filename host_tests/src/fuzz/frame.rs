@@ -824,7 +824,7 @@ fn check_on_polyline<const N: usize, const B: usize>(
     kept: &Frame<N, B>,
     (frame, m): (&Frame<N, B>, &Motion),
 ) {
-    let g = roadstereo::PairGeometry::new(&kept.camera(), &frame.camera(), m);
+    let g = roadstereo::PairGeometry::new(kept.camera(), frame.camera(), m);
     let foe = g
         .focus_of_expansion()
         .map_or(0.0, |f| f64::from(f.u.abs().max(f.v.abs())));

@@ -283,7 +283,7 @@ fn the_map_radius_covers_rounding_with_e1_zero() {
         fusion.step(id, &see(id as f64), Some(&m)).unwrap();
     }
     assert_eq!(fusion.map().batches(), 1);
-    let mut worst = 0.0f64;
+    let mut worst = f64::NEG_INFINITY;
     let mut n = 0;
     for mp in fusion.map().points(0) {
         let i = key

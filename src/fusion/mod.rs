@@ -20,7 +20,11 @@
 //! composed too (`src/fusion/chain.rs` derives them) and the processor
 //! pairs with them, so the fused interval stays guaranteed: the translation
 //! bound grows with the travel since the key frame, the rotation bound with
-//! the number of frames.
+//! the number of frames. Without configured bounds the composed motion is
+//! taken as exact, and its `f32` rounding (about `5 u` of the rotation a
+//! frame, `10⁻⁴` px at f = 800 over 64 frames) is left to the localisation
+//! errors' slack: the pairs' sticks do not carry it (README, "Limits" of
+//! the fusion); the road map's radius does (`crate::map`, "The radius").
 //!
 //! # Longer baselines, informative pairs
 //! Pairing with the key frame rather than with the previous frame makes the

@@ -342,12 +342,12 @@ mod tests {
         // in `b`, each rounded up by at most `2⁻¹⁶`.
         let (_, _, rho, phi) = c.pose();
         assert!(
-            phi >= 2.0 * STEP_ROUNDING && phi < 2.001 * STEP_ROUNDING,
+            (2.0 * STEP_ROUNDING..2.001 * STEP_ROUNDING).contains(&phi),
             "{phi}"
         );
         let want = STEP_ROUNDING * (2.0 * 1.4 + 4.0 * norm1(c.t));
         assert!(
-            rho >= want * 0.999 && rho <= want * 1.01,
+            (want * 0.999..=want * 1.01).contains(&rho),
             "{rho} against {want}"
         );
         // The composed motion is the motions' composition.

@@ -16,9 +16,12 @@
 //!   hang;
 //! * errors exactly when the API says (the frame chain's rules and the
 //!   range's, decided here from the calls), and then the state untouched:
-//!   a shadow fusion gets only the calls that succeeded, with the same
-//!   clocks, and both agree after every call (their digests, steps and
-//!   constrained points), which also checks determinism;
+//!   its digest as before the call, and on one call in eight its whole
+//!   `Debug` (the processor, the chain, the policy's counters); and a
+//!   shadow fusion gets only the calls
+//!   that succeeded, with the same clocks, and both agree after every call
+//!   (their digests, steps and constrained points), which also checks
+//!   determinism;
 //! * a clock is not asked after it said yes, and the expiry flag is set
 //!   exactly when it did in a step that paired;
 //! * every key-frame point well formed: its status as its counts say
@@ -506,6 +509,11 @@ fn run_case<const N: usize, const B: usize, const M: usize>(case: &Case) -> Outc
                 });
                 let want = expected_step_error(last, *id, motion.as_ref());
                 let before = f.digest();
+                // The whole state, where an error is due (its `Debug`: the
+                // processor, the chain, the policy's counters too), on one
+                // call in eight (formatting it makes a case many times
+                // slower).
+                let whole = (want.is_some() && n % 8 == 0).then(|| format!("{f:?}"));
                 let (got, asked) = step(&mut f, *id, &frame, motion.as_ref(), *clock);
                 if let Some(k) = clock {
                     assert!(
@@ -517,6 +525,13 @@ fn run_case<const N: usize, const B: usize, const M: usize>(case: &Case) -> Outc
                 match got {
                     Err(e) => {
                         assert_eq!(Some(e), want, "{}: error", at("step"));
+                        if let Some(w) = &whole {
+                            assert!(
+                                format!("{f:?}") == *w,
+                                "{}: an error changed the state",
+                                at("step")
+                            );
+                        }
                         assert_eq!(
                             f.digest(),
                             before,
@@ -571,11 +586,13 @@ fn run_case<const N: usize, const B: usize, const M: usize>(case: &Case) -> Outc
                 far,
                 times,
             } => {
-                for _ in 0..*times {
+                for rep in 0..*times {
                     constrain(
                         &mut f,
                         &mut shadow,
                         (*boundary, *index, *near, *far),
+                        // (The whole state as for a step, on the first.)
+                        rep == 0 && n % 8 == 0,
                         &mut features,
                         &at("constrain"),
                     );
@@ -599,6 +616,7 @@ fn constrain<const N: usize, const B: usize, const M: usize>(
     f: &mut Fusion<N, B, M>,
     shadow: &mut Fusion<N, B, M>,
     (boundary, index, near, far): (usize, usize, f32, f32),
+    check_whole: bool,
     features: &mut u128,
     at: &str,
 ) {
@@ -617,6 +635,7 @@ fn constrain<const N: usize, const B: usize, const M: usize>(
         }
     };
     let before = f.digest();
+    let whole = (want.is_some() && check_whole).then(|| format!("{f:?}"));
     match f.constrain(boundary, index, near, far) {
         Err(e) => {
             // A far end whose depth overflows is an invalid range too (its
@@ -628,6 +647,9 @@ fn constrain<const N: usize, const B: usize, const M: usize>(
                 "{at}: constrain({boundary}, {index}, {near}, {far}): {e:?}, expected {want:?}"
             );
             assert_eq!(f.digest(), before, "{at}: an error changed the state");
+            if let Some(w) = &whole {
+                assert!(format!("{f:?}") == *w, "{at}: an error changed the state");
+            }
             set(features, bit::FUSION_ERR + error_bit(&e));
         }
         Ok(p) => {

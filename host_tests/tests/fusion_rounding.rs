@@ -12,48 +12,14 @@
 
 #![allow(clippy::needless_range_loop)]
 
+use host_tests::synth::Rng;
 use roadstereo::fusion::{ChainedMotion, FusedStatus, Fusion, FusionConfig};
 use roadstereo::{Camera, Config, Frame, Motion, Pixel};
 
-// ---------------------------------------------------------------- rng
-#[derive(Clone)]
-pub struct Rng(u64);
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        Rng(seed ^ 0x9E37_79B9_7F4A_7C15)
-    }
-    pub fn u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    pub fn f(&mut self) -> f64 {
-        (self.u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    pub fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.f()
-    }
-    pub fn sym(&mut self, a: f64) -> f64 {
-        self.range(-a, a)
-    }
-    pub fn sign(&mut self) -> f64 {
-        if self.u64() & 1 == 0 {
-            1.0
-        } else {
-            -1.0
-        }
-    }
-    pub fn below(&mut self, n: usize) -> usize {
-        (self.u64() % n as u64) as usize
-    }
-    pub fn pick<T: Copy>(&mut self, xs: &[T]) -> T {
-        xs[self.below(xs.len())]
-    }
-    pub fn chance(&mut self, p: f64) -> bool {
-        self.f() < p
-    }
+// ---------------------------------------------------------------- draws
+// The host tests' SplitMix64 (`synth::Rng`), drawn as the review drew.
+fn pick<T: Copy>(g: &mut Rng, xs: &[T]) -> T {
+    xs[(g.next_u64() % xs.len() as u64) as usize]
 }
 
 // ---------------------------------------------------------------- f64 algebra
@@ -311,14 +277,14 @@ fn the_map_radius_covers_rounding_with_e1_zero() {
 }
 
 fn exact_key_drive(seed: u64, verbose: bool) -> (u64, u64, u64, u64, f64, f64) {
-    let mut g = Rng::new(seed);
-    let f = g.pick(&[400.0f32, 800.0, 1500.0]);
+    let mut g = Rng(seed ^ 0x9E37_79B9_7F4A_7C15);
+    let f = pick(&mut g, &[400.0f32, 800.0, 1500.0]);
     let cam = Camera::new(f, f, 319.5, 239.5, 640, 480).unwrap();
     let (fx, cx, cy) = (f as f64, 319.5f64, 239.5f64);
-    let e1 = g.pick(&[0.0f32, 0.0, 1e-3]);
+    let e1 = pick(&mut g, &[0.0f32, 0.0, 1e-3]);
     let config = Config::new(e1, 0.001, 10.0, 1000.0).unwrap();
-    let tilt = g.range(5.0, 20.0).to_radians() as f32;
-    let partners = g.pick(&[8u16, 20, 40]);
+    let tilt = g.uniform(5.0, 20.0).to_radians() as f32;
+    let partners = pick(&mut g, &[8u16, 20, 40]);
     let fcfg = FusionConfig::new(partners, 0)
         .unwrap()
         .with_tilt(tilt)
@@ -326,25 +292,25 @@ fn exact_key_drive(seed: u64, verbose: bool) -> (u64, u64, u64, u64, f64, f64) {
         .with_map_min_pairs(2)
         .unwrap();
     let tilt = tilt as f64;
-    let h = g.range(1.0, 2.0);
-    let speed = g.pick(&[0.2f32, 0.5, 1.0]);
-    let yaw = g.sym(0.02) as f32;
-    let roll = g.sym(0.01) as f32;
-    let pitch = g.sym(0.01) as f32;
+    let h = g.uniform(1.0, 2.0);
+    let speed = pick(&mut g, &[0.2f32, 0.5, 1.0]);
+    let yaw = g.uniform(-0.02, 0.02) as f32;
+    let roll = g.uniform(-0.01, 0.01) as f32;
+    let pitch = g.uniform(-0.01, 0.01) as f32;
     // key-frame pixels: two edges, rows 300..470, exact f32 pixels
     let mut key_px: Vec<Vec<Pixel>> = vec![vec![], vec![]];
     let mut world: Vec<Vec<V3>> = vec![vec![], vec![]]; // key-frame camera coords
     for b in 0..2 {
         let side = if b == 0 { -1.0 } else { 1.0 };
-        let lat = g.range(1.0, 4.0) * side;
+        let lat = g.uniform(1.0, 4.0) * side;
         for k in 0..40 {
-            let v = (260.0 + 5.0 * k as f64 + g.range(0.0, 0.9)) as f32;
+            let v = (260.0 + 5.0 * k as f64 + g.uniform(0.0, 0.9)) as f32;
             let yv = (v as f64 - cy) / fx;
             // ground plane: camera pitched down by tilt, height h: depth of the ray
             let den = yv * tilt.cos() + tilt.sin();
             let z = h / den;
             let u = (cx
-                + side * (10.0 + 4.0 * k as f64 + g.range(0.0, 0.9)) * (1.0 + lat.abs() * 0.1))
+                + side * (10.0 + 4.0 * k as f64 + g.uniform(0.0, 0.9)) * (1.0 + lat.abs() * 0.1))
                 as f32; // any u: the ray is the pixel's
             if !(u > 2.0 && u < 637.0) {
                 continue;

@@ -336,7 +336,7 @@ pub(super) fn motion(src: &mut Source, tilt: f64) -> MotionIn {
 /// The points of one boundary: a road edge seen from `pose`, a random
 /// polyline, a radial line or a mutated copy, at most `cap + 2` points.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn boundary(
+fn boundary(
     src: &mut Source,
     scene: &Scene,
     edge: usize,
@@ -493,6 +493,23 @@ pub(super) fn boundary(
     pts
 }
 
+/// A frame's `nb` boundaries ([`boundary`], the `b`-th after the last
+/// frame's `b`-th), kept as the last frame's.
+pub(super) fn boundaries(
+    src: &mut Source,
+    (scene, pose): (&Scene, &Pose),
+    nb: usize,
+    (k, size): ([f32; 4], (u16, u16)),
+    cap: usize,
+    last: &mut Vec<Vec<[f32; 2]>>,
+) -> Vec<Vec<[f32; 2]>> {
+    let out: Vec<_> = (0..nb)
+        .map(|b| boundary(src, scene, b, pose, k, size, cap, last.get(b)))
+        .collect();
+    last.clone_from(&out);
+    out
+}
+
 /// Draw a case.
 pub fn generate(src: &mut Source) -> Case {
     let large = src.chance(1, 16);
@@ -537,21 +554,14 @@ pub fn generate(src: &mut Source) -> Case {
             1 => cap_b + 1,
             _ => 1 + src.index(cap_b),
         };
-        let boundaries: Vec<_> = (0..nb)
-            .map(|b| {
-                boundary(
-                    src,
-                    &scene,
-                    b,
-                    &pose,
-                    k,
-                    size,
-                    cap_points,
-                    last_boundaries.get(b),
-                )
-            })
-            .collect();
-        last_boundaries.clone_from(&boundaries);
+        let boundaries = boundaries(
+            src,
+            (&scene, &pose),
+            nb,
+            (k, size),
+            cap_points,
+            &mut last_boundaries,
+        );
         let frame = FrameIn {
             k,
             size,

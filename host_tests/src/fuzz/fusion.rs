@@ -273,21 +273,14 @@ pub fn generate(src: &mut Source) -> Case {
             1 => cap_b + 1,
             _ => 1 + src.index(cap_b.min(scene.edges.len())),
         };
-        let boundaries: Vec<_> = (0..nb)
-            .map(|b| {
-                frame::boundary(
-                    src,
-                    &scene,
-                    b,
-                    &pose,
-                    k,
-                    size,
-                    cap_points,
-                    last_boundaries.get(b),
-                )
-            })
-            .collect();
-        last_boundaries.clone_from(&boundaries);
+        let boundaries = frame::boundaries(
+            src,
+            (&scene, &pose),
+            nb,
+            (k, size),
+            cap_points,
+            &mut last_boundaries,
+        );
         let clock = src.chance(1, 4).then(|| match src.below(4) {
             0 => 0,
             1 => 1 + src.index(8),

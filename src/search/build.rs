@@ -112,6 +112,7 @@ impl<const N: usize> Index<N> {
     /// set aside the unkeyed segments and those of outlying vertices, and
     /// rebuild the envelopes without them; `false` when `tick`'s clock
     /// stopped it (the index then unfit for queries).
+    #[inline(never)]
     fn rebuild(&mut self, orient: f32, wide: f32, tick: &mut Tick<'_>) -> bool {
         let s = self.segments;
         let Some(seg) = self.seg.get_mut(..s) else {
@@ -396,7 +397,15 @@ pub(super) fn outliers(
         if j % CHUNK == CHUNK - 1 && expired(tick) {
             return None;
         }
-        test(j, g, (b.lo, b.hi), (a.lo, a.hi));
+        // `test` sets `g` aside only if it reaches more than `wide` beyond
+        // `b` alone: the hull's ends are beyond `b`'s (or NaN, and then
+        // `test`'s reach fails), and a rounded difference is monotone in
+        // what it subtracts. So only such a segment, or an unkeyed one,
+        // is tested (a NaN passes to the test).
+        let beyond_b = !(g.hi - b.hi <= wide) || !(b.lo - g.lo <= wide);
+        if beyond_b || g.lo == f32::NEG_INFINITY {
+            test(j, g, (b.lo, b.hi), (a.lo, a.hi));
+        }
     }
     for j in tail..s {
         if j % CHUNK == CHUNK - 1 && expired(tick) {

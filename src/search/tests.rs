@@ -515,6 +515,8 @@ fn outliers_are_the_look_ups() {
                     1 => (lo, hi) = (f32::INFINITY, f32::NEG_INFINITY),
                     2 => hi += 2.0 * rng.next(),
                     3 => lo -= 2.0 * rng.next(),
+                    4 if case % 7 == 0 => lo = f32::NAN,
+                    5 if case % 7 == 0 => hi = f32::NAN,
                     _ => {}
                 }
                 Seg {
@@ -525,7 +527,26 @@ fn outliers_are_the_look_ups() {
                 }
             })
             .collect();
-        let wide = 0.2 * rng.next();
+        let mut wide = 0.2 * rng.next();
+        // One case in three: `wide` at (or an ulp either side of) a
+        // segment's reach beyond the one two places before it, where the
+        // pass's first filter and the test must agree to the last bit.
+        if case % 3 == 0 && s > 2 {
+            let j = 2 + (rng.next() * (s - 2) as f32) as usize % (s - 2);
+            let (g, b) = (&seg[j], &seg[j - 2]);
+            let reach = if case % 2 == 0 {
+                g.hi - b.hi
+            } else {
+                b.lo - g.lo
+            };
+            if reach.is_finite() && reach > 0.0 {
+                wide = match case % 5 {
+                    0 => f32::from_bits(reach.to_bits() - 1),
+                    1 => f32::from_bits(reach.to_bits() + 1),
+                    _ => reach,
+                };
+            }
+        }
         let want = reference(&seg, wide);
         found += want.len();
         let got = build::outliers(&seg, wide, &mut None).unwrap();

@@ -389,6 +389,10 @@ pub(super) fn outliers(
             test(j, g, ends(j.checked_sub(2)), ends(Some(j + 2)));
         }
     }
+    // `wide`, finite (the first filter below; with `wide` infinite or NaN
+    // no reach passes `test`, and `f32::MAX` lets every unkeyed segment
+    // through).
+    let reach = if wide < f32::INFINITY { wide } else { f32::MAX };
     for (k, w) in seg.windows(5).enumerate() {
         let [b, _, g, _, a] = w else {
             break;
@@ -398,12 +402,12 @@ pub(super) fn outliers(
             return None;
         }
         // `test` sets `g` aside only if it reaches more than `wide` beyond
-        // `b` alone: the hull's ends are beyond `b`'s (or NaN, and then
-        // `test`'s reach fails), and a rounded difference is monotone in
-        // what it subtracts. So only such a segment, or an unkeyed one,
-        // is tested (a NaN passes to the test).
-        let beyond_b = !(g.hi - b.hi <= wide) || !(b.lo - g.lo <= wide);
-        if beyond_b || g.lo == f32::NEG_INFINITY {
+        // `b` alone (the hull's ends are beyond `b`'s, or NaN, and then
+        // `test`'s reach fails; a rounded difference is monotone in what
+        // it subtracts), or if it is unkeyed: then `b.lo − g.lo` is `+∞`
+        // or NaN, beyond any finite `reach`. So only such segments are
+        // tested (a NaN passes to the test).
+        if !(g.hi - b.hi <= reach) || !(b.lo - g.lo <= reach) {
             test(j, g, (b.lo, b.hi), (a.lo, a.hi));
         }
     }

@@ -541,6 +541,8 @@ fn outliers_are_the_look_ups() {
             };
             if reach.is_finite() && reach > 0.0 {
                 wide = match case % 5 {
+                    _ if case % 11 == 0 => f32::INFINITY,
+                    _ if case % 13 == 0 => f32::NAN,
                     0 => f32::from_bits(reach.to_bits() - 1),
                     1 => f32::from_bits(reach.to_bits() + 1),
                     _ => reach,

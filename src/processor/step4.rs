@@ -123,8 +123,15 @@ fn match_wedge_lean<const N: usize, D: Deadline>(
         cot_twice: pair.config.cot_twice,
         segments: b2.len().saturating_sub(1),
     };
+    // A loose index (the keys fold somewhere): its walks take the block
+    // tree's skips too. Built without a caller's clock its tree is left
+    // to its first use ([`match_deferred`]).
     if blocks.any() {
-        // A loose index (the keys fold somewhere): the tree's skips too.
+        if index.tree_deferred() {
+            // (Laid out of the usual walks' way: [`match_deferred`].)
+            match_deferred(pair, keying, (foe, side), (slots, b2), index, (work, guard));
+            return;
+        }
         hint = walk.points_for::<2, D>(slots, hint, (work, guard));
     } else if aside.is_empty() {
         hint = walk.points_for::<0, D>(slots, hint, (work, guard));
@@ -154,6 +161,8 @@ fn match_wedge_angular<const N: usize, D: Deadline>(
     // A piece's end (at most `N`) is kept in an `f32` for
     // [`refine_deferred`]: exact below 2²⁴. (At compile time, no cost.)
     const { assert!(N < 1 << 24, "a boundary capacity below 2^24 points") };
+    // (A block tree deferred by the build: this path's walks skip by it.)
+    index.ensure_tree();
     let (e2, e2_csc, cot_twice) = (pair.e2(), pair.e2_csc(), pair.config.cot_twice);
     let segments = b2.len().saturating_sub(1);
     let mut deferred = false;
@@ -318,6 +327,7 @@ fn match_wedge_angular_reference<const N: usize>(
     b2: &[Pixel],
     index: &mut Index<N>,
 ) {
+    index.ensure_tree();
     let (e2, e2_csc, cot_twice) = (pair.e2(), pair.e2_csc(), pair.config.cot_twice);
     let segments = b2.len().saturating_sub(1);
     let mut work = Work::new();
@@ -373,6 +383,60 @@ pub(super) fn flag_pending(slots: &mut [PointResult], status: Status) {
     }
 }
 
+/// [`match_wedge_lean`] through a loose index whose block tree the build
+/// deferred (without a caller's clock: `search::Builder::finish`). Its
+/// walks first go as on a tight index ([`LeanWalk::points_deferred`]): a
+/// segment whose keys miss the wedge's is looked at for its unit and
+/// passed, where the tree passes the blocks around it for one. While
+/// they cost no more units than a tight index's walks would, the tree is
+/// not worth its build; past that, the tree is built and the loose walks,
+/// with its skips, take the points left. On the demo drive the first way
+/// is the cheaper: frames 9 and 13 (their walks pass no segment the tree
+/// would skip) cost about 5 800 and 2 500 instructions less than with the
+/// tree built first and the loose walks' dearer loop. Without the fold
+/// test (the certification's `containment_without_the_fold_test`), an
+/// S-bend's walks pass many such segments, and the tree is built.
+#[cold]
+#[inline(never)]
+fn match_deferred<const N: usize, D: Deadline>(
+    pair: &Pair,
+    keying: &Keying,
+    (foe, side): ([f32; 2], f32),
+    (slots, b2): (&mut [PointResult], &[Pixel]),
+    index: &mut Index<N>,
+    (work, guard): (&mut Work, &mut Guard<'_, D>),
+) {
+    let mut hint = index.hint();
+    let mut from = 0;
+    if D::NEVER {
+        let walk = LeanWalk::of(pair, keying, (foe, side), b2, index.lean());
+        let (h, stopped) = if walk.aside.is_empty() {
+            walk.points_deferred::<0, D>(slots, hint, (work, guard))
+        } else {
+            walk.points_deferred::<1, D>(slots, hint, (work, guard))
+        };
+        hint = h;
+        match stopped {
+            Some(i) => from = i,
+            None => {
+                index.set_hint(hint);
+                return;
+            }
+        }
+    }
+    index.ensure_tree();
+    let rest = slots.get_mut(from..).unwrap_or_default();
+    let walk = LeanWalk::of(pair, keying, (foe, side), b2, index.lean());
+    hint = walk.points_for::<2, D>(rest, hint, (work, guard));
+    index.set_hint(hint);
+}
+
+/// The units a point's walk may spend on average through a loose index
+/// before its deferred block tree is built, and the slots taken between
+/// two looks at what they spent ([`LeanWalk::points_deferred`]).
+const DEFERRED_UNITS: u32 = 32;
+const DEFERRED_CHUNK: usize = 32;
+
 /// What every point of a boundary shares on the lean wedge path.
 struct LeanWalk<'a> {
     pair: &'a Pair<'a>,
@@ -390,7 +454,78 @@ struct LeanWalk<'a> {
     segments: usize,
 }
 
-impl LeanWalk<'_> {
+impl<'a> LeanWalk<'a> {
+    /// The lean walk of a boundary through the index view `lean`
+    /// ([`match_deferred`]'s two; [`match_wedge_lean`] writes its own out).
+    #[inline(always)]
+    fn of(
+        pair: &'a Pair<'a>,
+        keying: &Keying,
+        (foe, side): ([f32; 2], f32),
+        b2: &'a [Pixel],
+        lean: Lean<'a>,
+    ) -> Self {
+        let Lean {
+            segs,
+            orient,
+            aside,
+            blocks,
+            ..
+        } = lean;
+        LeanWalk {
+            pair,
+            segs,
+            aside,
+            blocks,
+            b2,
+            foe,
+            side,
+            e2: pair.e2(),
+            e2_csc: pair.e2_csc(),
+            key_scale: keying.key_scale,
+            orient,
+            cot_twice: pair.config.cot_twice,
+            segments: b2.len().saturating_sub(1),
+        }
+    }
+
+    /// [`Self::points`] through a loose index whose block tree is
+    /// deferred ([`match_wedge_lean`]), without a caller's deadline: the
+    /// walks of a tight index (`WALK` 0 or 1), so a segment whose keys
+    /// miss a wedge's is looked at for its unit and passed, where the tree
+    /// would pass the blocks around it for one. Taken [`DEFERRED_CHUNK`]
+    /// slots at a time; while the walks have spent at most
+    /// [`DEFERRED_UNITS`] units a slot and twice the polyline's segments
+    /// beside (a tight index's walks spend about 6 a point, the demo's
+    /// loose frames 15 and 23; the tree costs about 10 instructions a
+    /// segment to build), the tree is not worth building. Past that, the
+    /// walks stop after the part and the slot they reached is returned,
+    /// with the last run's start. A heuristic for speed only: each point's
+    /// result is that of either walk, the reference's unless the budget
+    /// binds (they spend units differently: a block skipped is one unit).
+    #[inline(always)]
+    fn points_deferred<const WALK: u8, D: Deadline>(
+        &self,
+        slots: &mut [PointResult],
+        mut hint: usize,
+        (work, guard): (&mut Work, &mut Guard<'_, D>),
+    ) -> (usize, Option<usize>) {
+        let start = work.credit();
+        let mut allowance = u32::try_from(self.segments.saturating_mul(2)).unwrap_or(u32::MAX);
+        let mut done = 0;
+        for part in slots.chunks_mut(DEFERRED_CHUNK) {
+            hint = self.points::<WALK, D>(part, hint, (work, guard));
+            done += part.len();
+            // (`DEFERRED_CHUNK · DEFERRED_UNITS` fits a `u32`.)
+            let units = u32::try_from(part.len()).unwrap_or(u32::MAX);
+            allowance = allowance.saturating_add(units.saturating_mul(DEFERRED_UNITS));
+            if start.saturating_sub(work.credit()) > allowance {
+                return (hint, Some(done));
+            }
+        }
+        (hint, None)
+    }
+
     /// [`Self::points`], or under a caller's deadline
     /// [`Self::points_within`].
     #[inline(always)]

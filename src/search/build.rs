@@ -22,6 +22,7 @@ impl<const N: usize> Index<N> {
         self.levels = 0;
         self.tree_end = 0;
         self.radial_levels = UNBUILT;
+        self.tree_deferred = false;
         self.aside.clear();
         self.near.clear();
         self.near_overflow = false;
@@ -113,7 +114,7 @@ impl<const N: usize> Index<N> {
     /// rebuild the envelopes without them; `false` when `tick`'s clock
     /// stopped it (the index then unfit for queries).
     #[inline(never)]
-    fn rebuild(&mut self, orient: f32, wide: f32, tick: &mut Tick<'_>) -> bool {
+    fn rebuild(&mut self, orient: f32, wide: f32, defer: bool, tick: &mut Tick<'_>) -> bool {
         let s = self.segments;
         let Some(seg) = self.seg.get_mut(..s) else {
             return true;
@@ -174,8 +175,44 @@ impl<const N: usize> Index<N> {
         let Some(loose) = self.suffix_minima(wide, tick, false) else {
             return false;
         };
-        self.loose = loose;
+        if loose && defer && tick.is_none() {
+            // Until it is built, a tree of one level whose every block
+            // is the widest (it meets every query, so nothing is skipped):
+            // a block tree like any other, the walks by it correct, only
+            // without skips.
+            let blocks = s.div_ceil(FAN);
+            if let Some(level) = self.tree.get_mut(..2 * blocks) {
+                for b in level.chunks_exact_mut(2) {
+                    b.copy_from_slice(&[f32::NEG_INFINITY, f32::INFINITY]);
+                }
+                (self.levels, self.tree_end) = (1, 2 * blocks);
+                self.tree_deferred = true;
+                return true;
+            }
+        }
         !loose || self.build_tree(tick)
+    }
+
+    /// Whether this loose index's block tree is the widest one level the
+    /// build left it until its first use (`Builder::finish`,
+    /// [`Self::ensure_tree`]).
+    #[inline(always)]
+    pub(crate) fn tree_deferred(&self) -> bool {
+        self.tree_deferred
+    }
+
+    /// The block tree built now if it was deferred (`Builder::finish`):
+    /// the same levels the build would have made. Without a clock: the
+    /// deferral is only taken by a build without one, and the tree costs
+    /// what it would have cost there (`O(s)`, once an index). The band and
+    /// angular paths ask for it first; the lean wedge walks when theirs
+    /// cost more units than a tight index's (`step4::match_deferred`).
+    pub(crate) fn ensure_tree(&mut self) {
+        if self.tree_deferred {
+            self.tree_deferred = false;
+            // (Without a clock it always finishes.)
+            let _ = self.build_tree(&mut None);
+        }
     }
 
     /// The block tree over the current intervals (module docs): the key
@@ -212,6 +249,8 @@ impl<const N: usize> Index<N> {
     /// this index's polyline, or when `tick`'s clock stops the build (the
     /// queries then go without them).
     pub(super) fn build_radial(&mut self, b: &[crate::camera::Pixel], tick: &mut Tick<'_>) {
+        // (After the key levels: they end at `tree_end`.)
+        self.ensure_tree();
         self.radial_levels = 0;
         let s = self.segments;
         if s == 0 || b.len() != s + 1 {
@@ -805,6 +844,7 @@ impl<const N: usize> Builder<'_, N> {
             sum,
             order,
             period,
+            unkeyed,
             ..
         } = self;
         let s = n.saturating_sub(1);
@@ -822,8 +862,15 @@ impl<const N: usize> Builder<'_, N> {
         let Some(loose) = index.suffix_minima(wide, tick, true) else {
             return false;
         };
-        index.loose = loose;
-        if (loose || odd || flip) && !index.rebuild(if flip { -o } else { o }, wide, tick) {
+        let orient = if flip { -o } else { o };
+        // Frame 2's index (unkeyed ends meet every key) built without a
+        // clock leaves a loose index's block tree to its first use
+        // ([`Index::ensure_tree`]): the lean wedge walks do without it
+        // (`step4::match_wedge_lean`), and the demo's loose frames 9
+        // and 13 are about 2 000 instructions cheaper for it (their walks
+        // pass no segment the tree would skip).
+        let defer = unkeyed == Unkeyed::MeetAll;
+        if (loose || odd || flip) && !index.rebuild(orient, wide, defer, tick) {
             return false;
         }
         index.kmin = index.seg.first().map_or(f32::INFINITY, |g| g.sm);

@@ -298,6 +298,12 @@ pub(crate) struct Index<const N: usize> {
     /// them (0: none fit; [`UNBUILT`]: not built yet).
     tree_end: usize,
     radial_levels: u8,
+    /// The key levels are wanted (a *loose* index: the envelopes, the
+    /// aside segments left out, are more than [`WIDE`] average widths
+    /// apart somewhere, and runs may be long) but left to the first
+    /// walk that needs them (`build::Builder::finish`,
+    /// [`Self::ensure_tree`]): `levels` is 0 until then.
+    tree_deferred: bool,
     segments: usize,
     orient: f32,
     period: f32,
@@ -316,9 +322,6 @@ pub(crate) struct Index<const N: usize> {
     /// segment but its own two. (`false` too where the build did not test
     /// the order: [`build::Builder::push_all`]'s lean loop.)
     strict: bool,
-    /// The envelopes, the aside segments left out, are more than
-    /// [`WIDE`] average widths apart somewhere: runs may be long.
-    loose: bool,
 }
 
 impl<const N: usize> Default for Index<N> {
@@ -337,6 +340,7 @@ impl<const N: usize> Index<N> {
             levels: 0,
             tree_end: 0,
             radial_levels: UNBUILT,
+            tree_deferred: false,
             segments: 0,
             orient: 1.0,
             period: 0.0,
@@ -347,7 +351,6 @@ impl<const N: usize> Index<N> {
             near_overflow: false,
             hint: 0,
             strict: false,
-            loose: false,
         }
     }
 

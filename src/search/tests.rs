@@ -361,7 +361,7 @@ fn a_segment_half_a_turn_long_meets_every_key() {
 #[test]
 fn a_build_in_parts_or_with_a_clock_is_the_same_build() {
     let mut rng = Rng(0xc4a2_0001);
-    let (mut stopped, mut built) = (0, 0);
+    let (mut stopped, mut built, mut deferred) = (0, 0, 0);
     for case in 0..3000 {
         let (shape, period) = (case % 5, case % 3 == 0);
         let n = 2 + (rng.next() * (CAP - 2) as f32) as usize;
@@ -393,6 +393,16 @@ fn a_build_in_parts_or_with_a_clock_is_the_same_build() {
             false
         };
         assert!(b.finish(near, &mut Some(&mut never)));
+        // Without a clock frame 2's loose index (unkeyed ends meeting
+        // every key) leaves its block tree to its first use: built then,
+        // it is the tree the clocked build made.
+        assert!(!parts.tree_deferred);
+        if whole.tree_deferred {
+            assert_eq!(unkeyed, Unkeyed::MeetAll, "case {case}");
+            assert_eq!(whole.levels, 1, "case {case}: the widest one level");
+            deferred += 1;
+        }
+        whole.ensure_tree();
         assert_eq!(
             std::format!("{whole:?}"),
             std::format!("{parts:?}"),
@@ -418,8 +428,8 @@ fn a_build_in_parts_or_with_a_clock_is_the_same_build() {
         }
     }
     assert!(
-        stopped > 500 && built > 50,
-        "{stopped} stopped, {built} built"
+        stopped > 500 && built > 50 && deferred > 50,
+        "{stopped} stopped, {built} built, {deferred} trees deferred"
     );
 }
 

@@ -207,12 +207,20 @@ impl<const N: usize> Index<N> {
     /// what it would have cost there (`O(s)`, once an index). The band and
     /// angular paths ask for it first; the lean wedge walks when theirs
     /// cost more units than a tight index's (`step4::match_deferred`).
+    #[inline(always)]
     pub(crate) fn ensure_tree(&mut self) {
         if self.tree_deferred {
-            self.tree_deferred = false;
-            // (Without a clock it always finishes.)
-            let _ = self.build_tree(&mut None);
+            self.build_deferred_tree();
         }
+    }
+
+    /// [`Self::ensure_tree`]'s build, out of its callers' loops.
+    #[cold]
+    #[inline(never)]
+    fn build_deferred_tree(&mut self) {
+        self.tree_deferred = false;
+        // (Without a clock it always finishes.)
+        let _ = self.build_tree(&mut None);
     }
 
     /// The block tree over the current intervals (module docs): the key

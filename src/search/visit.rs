@@ -195,8 +195,6 @@ impl<const N: usize> Index<N> {
         work: &mut Work,
         visit: &mut (impl Visitor<'b> + Copy),
     ) -> Result<(), OutOfWork> {
-        // (A block tree deferred by the build: the runs below skip by it.)
-        self.ensure_tree();
         // The usual case: one run, no lists to merge; next, a run and the
         // aside list. Periodic keys take this way when at most one copy of
         // the query meets the keys' range (none: only unkeyed segments

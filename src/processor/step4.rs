@@ -392,10 +392,11 @@ pub(super) fn flag_pending(slots: &mut [PointResult], status: Status) {
 /// not worth its build; past that, the tree is built and the loose walks,
 /// with its skips, take the points left. On the demo drive the first way
 /// is the cheaper: frames 9 and 13 (their walks pass no segment the tree
-/// would skip) cost about 5 800 and 2 500 instructions less than with the
-/// tree built first and the loose walks' dearer loop. Without the fold
-/// test (the certification's `containment_without_the_fold_test`), an
-/// S-bend's walks pass many such segments, and the tree is built.
+/// would skip) cost about 4 900 and 1 700 instructions less in the profile
+/// windows than with the tree built first and the loose walks' dearer
+/// loop. Without the fold test (the certification's
+/// `containment_without_the_fold_test`), an S-bend's walks pass many such
+/// segments, and the tree is built: its yield there is the eager tree's.
 #[cold]
 #[inline(never)]
 fn match_deferred<const N: usize, D: Deadline>(
@@ -496,9 +497,10 @@ impl<'a> LeanWalk<'a> {
     /// would pass the blocks around it for one. Taken [`DEFERRED_CHUNK`]
     /// slots at a time; while the walks have spent at most
     /// [`DEFERRED_UNITS`] units a slot and twice the polyline's segments
-    /// beside (a tight index's walks spend about 6 a point, the demo's
-    /// loose frames 15 and 23; the tree costs about 10 instructions a
-    /// segment to build), the tree is not worth building. Past that, the
+    /// beside (the representative pair's walks spend about 6.5 a point,
+    /// the demo's loose frames 9 and 13 about 15 and 23 a walked point; the
+    /// tree costs about 10 instructions a segment to build, a passed
+    /// segment about 15), the tree is not worth building. Past that, the
     /// walks stop after the part and the slot they reached is returned,
     /// with the last run's start. A heuristic for speed only: each point's
     /// result is that of either walk, the reference's unless the budget

@@ -720,6 +720,10 @@ key-frame fusion over the demo drive (2 × 256 points, 8 partners, map of 2 × 5
     );
     println!("|---:|---:|---:|---:|---:|---:|---|");
     let (mut worst, mut total, mut points) = (0u64, 0u64, 0u64);
+    let deadline = b.deadline();
+    // The costliest paired frame's matching and step, and the steps over
+    // the deadline.
+    let (mut matching, mut step, mut over) = ((0u64, 0u64), (0u64, 0u64), 0usize);
     for r in &rows {
         let paired = field(r, "paired") == Some("true");
         let p = num(r, "points");
@@ -751,7 +755,36 @@ key-frame fusion over the demo drive (2 × 256 points, 8 partners, map of 2 × 5
             worst = worst.max(num(r, "per_point"));
             total += own;
             points += p;
+            let frame = num(r, "frame");
+            matching = matching.max((num(r, "matching_instr"), frame));
+            step = step.max((num(r, "step_instr"), frame));
+            over += usize::from(num(r, "step_instr") > deadline);
         }
+    }
+    println!(
+        "the demo drive's matching (the processor call of each paired step): at most {} instructions (frame {}), {:.1} % of the deadline {deadline} (budget ≤ 100 %, issue 11)",
+        matching.0,
+        matching.1,
+        100.0 * matching.0 as f64 / deadline as f64
+    );
+    if matching.0 > deadline {
+        misses.push(format!(
+            "the demo drive's matching: {} instructions in frame {} > deadline {deadline}",
+            matching.0, matching.1
+        ));
+    }
+    println!(
+        "the demo drive's steps with the fusion: at most {} instructions (frame {}), {:.1} % of the deadline; {over} of {} paired steps over it",
+        step.0,
+        step.1,
+        100.0 * step.0 as f64 / deadline as f64,
+        rows.iter().filter(|r| field(r, "paired") == Some("true")).count()
+    );
+    if over > 0 {
+        misses.push(format!(
+            "{OPEN}the demo drive's steps with the fusion: {over} over the deadline {deadline} (at most {}, frame {})",
+            step.0, step.1
+        ));
     }
     println!(
         "fusion and map: worst paired frame {worst} instructions per key-frame point (budget ≤ {}), {:.1} on average",
@@ -764,7 +797,6 @@ key-frame fusion over the demo drive (2 × 256 points, 8 partners, map of 2 × 5
             b.fusion_per_point
         ));
     }
-    let deadline = b.deadline();
     if let Some((i256, _)) = per.get(&256) {
         let with = i256 + worst * 512;
         println!(

@@ -315,3 +315,78 @@ fn a_cut_frame_still_becomes_the_previous_one() {
     assert!(p.previous() == Some(&f2));
     assert!(p.deadline_expired(), "an error leaves the last flag");
 }
+
+/// A clock that never says yes and caps nothing gives `process`'s results
+/// exactly (`Deadline::carry`), at every work budget: also where the
+/// budget binds (8 and 16 allowances a point) and where frame 2's loose
+/// index defers its block tree (its lean walks go as on a tight index
+/// until they have spent their allowance, with a clock or without one).
+/// The named synthetic scenarios and 20 random ones, exact and rounded,
+/// frame 2 as rendered and with spurious detector points (every 9th
+/// vertex moved 150 px along its row), and the adversarial family at
+/// N = 64 in its own configuration.
+#[test]
+fn an_uncapped_clock_is_process_at_every_budget() {
+    let mut pairs = 0usize;
+    let mut check =
+        |config: Config, (f1, f2, m): (&Frame<N, B>, &Frame<N, B>, &Motion), what: &str| {
+            let mut p = Box::new(Processor::<N, B>::new(config));
+            assert!(matches!(p.process(f1, None), Ok(Step::First)), "{what}");
+            let plain = Box::new(p.process_against_kept(f2, m).expect("kept").clone());
+            let free = Box::new(
+                p.process_against_kept_within(f2, m, &mut Uncapped)
+                    .expect("kept")
+                    .clone(),
+            );
+            assert!(
+                free == plain,
+                "{what}: an uncapped clock that never says yes differs from process"
+            );
+            pairs += 1;
+        };
+    let mut all = scenarios::named();
+    all.extend((0..20).map(scenarios::random));
+    for s in all {
+        let r = s.render();
+        let cam = s.intrinsics.camera();
+        let width = cam.width() as f32;
+        for quantised in [false, true] {
+            let f1 = frame(cam, &synth::Rendered::pixels(&r.frame1, quantised));
+            let clean = synth::Rendered::pixels(&r.frame2, quantised);
+            let mut spiky = clean.clone();
+            for b in &mut spiky {
+                for (i, p) in b.iter_mut().enumerate().skip(4) {
+                    if i % 9 == 0 {
+                        let u = if p.u > width / 2.0 {
+                            p.u - 150.0
+                        } else {
+                            p.u + 150.0
+                        };
+                        *p = roadstereo::Pixel::new(u.clamp(0.0, width - 1.0), p.v);
+                    }
+                }
+            }
+            for (f2, tag) in [(frame(cam, &clean), ""), (frame(cam, &spiky), " spikes")] {
+                for w in [8, 16, 80] {
+                    let config = Config::DEFAULT.with_work_budget(w).expect("budget");
+                    check(
+                        config,
+                        (&f1, &f2, &r.motion()),
+                        &format!("{} q={quantised}{tag} w={w}", s.name),
+                    );
+                }
+            }
+        }
+    }
+    for m in family() {
+        let Ok((k, frames)) = render(&m.params, 64) else {
+            continue;
+        };
+        let (f1, f2, motion) = library_pair(&k, &frames);
+        for w in [8, 16] {
+            let config = m.errors.config().with_work_budget(w).expect("budget");
+            check(config, (&f1, &f2, &motion), &format!("{} w={w}", m.name));
+        }
+    }
+    assert!(pairs > 300, "{pairs} pairs");
+}

@@ -60,13 +60,18 @@ pub(super) fn match_boundary<const N: usize, D: Deadline>(
         }
         _ => {}
     }
-    if !D::NEVER && matcher == Matcher::Indexed && matches!(keying.pencil, Pencil::Half { .. }) {
-        // Under a deadline: the radial levels the band queries use built
-        // before the first point's search, not inside it, the clock asked
-        // before and during the build (between parts of `CHUNK` blocks).
+    if !D::NEVER && matcher == Matcher::Indexed {
+        // Under a deadline: the block tree the build deferred and the
+        // radial levels the band queries use built before the first
+        // point's search, not inside it, the clock asked before and during
+        // the builds (between parts of `CHUNK` blocks).
         let mut ask = || guard.check();
         if !ask() {
-            index.build_radial_once(b2, &mut Some(&mut ask));
+            if matches!(keying.pencil, Pencil::Half { .. }) {
+                index.build_radial_once(b2, &mut Some(&mut ask));
+            } else {
+                let _ = index.ensure_tree_within(&mut Some(&mut ask));
+            }
         }
         if guard.has_expired() {
             flag_pending(slots, Status::OverBudget);
@@ -124,8 +129,8 @@ fn match_wedge_lean<const N: usize, D: Deadline>(
         segments: b2.len().saturating_sub(1),
     };
     // A loose index (the keys fold somewhere): its walks take the block
-    // tree's skips too. Built without a caller's clock its tree is left
-    // to its first use ([`match_deferred`]).
+    // tree's skips too. Frame 2's index leaves its tree to its first use
+    // ([`match_deferred`]).
     if blocks.any() {
         if index.tree_deferred() {
             // (Laid out of the usual walks' way: [`match_deferred`].)
@@ -161,8 +166,17 @@ fn match_wedge_angular<const N: usize, D: Deadline>(
     // A piece's end (at most `N`) is kept in an `f32` for
     // [`refine_deferred`]: exact below 2²⁴. (At compile time, no cost.)
     const { assert!(N < 1 << 24, "a boundary capacity below 2^24 points") };
-    // (A block tree deferred by the build: this path's walks skip by it.)
-    index.ensure_tree();
+    // (A block tree deferred by the build: this path's walks skip by it.
+    // Under a caller's deadline, with its clock asked during the build.)
+    if D::NEVER {
+        index.ensure_tree();
+    } else {
+        let mut ask = || guard.check();
+        if !index.ensure_tree_within(&mut Some(&mut ask)) {
+            flag_pending(slots, Status::OverBudget);
+            return;
+        }
+    }
     let (e2, e2_csc, cot_twice) = (pair.e2(), pair.e2_csc(), pair.config.cot_twice);
     let segments = b2.len().saturating_sub(1);
     let mut deferred = false;
@@ -384,7 +398,7 @@ pub(super) fn flag_pending(slots: &mut [PointResult], status: Status) {
 }
 
 /// [`match_wedge_lean`] through a loose index whose block tree the build
-/// deferred (without a caller's clock: `search::Builder::finish`). Its
+/// deferred (`search::Builder::finish`). Its
 /// walks first go as on a tight index ([`LeanWalk::points_deferred`]): a
 /// segment whose keys miss the wedge's is looked at for its unit and
 /// passed, where the tree passes the blocks around it for one. While
@@ -392,11 +406,13 @@ pub(super) fn flag_pending(slots: &mut [PointResult], status: Status) {
 /// not worth its build; past that, the tree is built and the loose walks,
 /// with its skips, take the points left. On the demo drive the first way
 /// is the cheaper: frames 9 and 13 (their walks pass no segment the tree
-/// would skip) cost about 4 900 and 1 700 instructions less in the profile
+/// would skip) cost about 3 800 and 700 instructions less in the profile
 /// windows than with the tree built first and the loose walks' dearer
 /// loop. Without the fold test (the certification's
 /// `containment_without_the_fold_test`), an S-bend's walks pass many such
 /// segments, and the tree is built: its yield there is the eager tree's.
+/// Under a small work budget or a clock that caps a point's search the
+/// tree is built first (below).
 #[cold]
 #[inline(never)]
 fn match_deferred<const N: usize, D: Deadline>(
@@ -407,36 +423,54 @@ fn match_deferred<const N: usize, D: Deadline>(
     index: &mut Index<N>,
     (work, guard): (&mut Work, &mut Guard<'_, D>),
 ) {
-    let mut hint = index.hint();
-    let mut from = 0;
-    if D::NEVER {
+    // The allowance: twice the polyline's segments and `DEFERRED_UNITS` a
+    // point to walk. Under a work budget below twice that a point
+    // (`Config::with_work_budget`), where the budget binds sooner, or a
+    // deadline that caps a point's search (`Deadline::carry`), the tree's
+    // skips are worth their build: it is built first, and the results are
+    // those of the tree built with the index. (A clock that caps nothing
+    // defers as `process` does: the same results while it says no.)
+    let w = pair.config.work_per_point;
+    let (hint, stopped) = if w < 2 * DEFERRED_UNITS || guard.caps() {
+        (index.hint(), Some(0))
+    } else {
         let walk = LeanWalk::of(pair, keying, (foe, side), b2, index.lean());
-        let (h, stopped) = if walk.aside.is_empty() {
-            walk.points_deferred::<0, D>(slots, hint, (work, guard))
+        let base = u32::try_from(walk.segments.saturating_mul(2)).unwrap_or(u32::MAX);
+        let allowance = (base, DEFERRED_UNITS);
+        if walk.aside.is_empty() {
+            walk.points_deferred::<0, D>(slots, index.hint(), (work, guard), allowance)
         } else {
-            walk.points_deferred::<1, D>(slots, hint, (work, guard))
-        };
-        hint = h;
-        match stopped {
-            Some(i) => from = i,
-            None => {
-                index.set_hint(hint);
-                return;
-            }
+            walk.points_deferred::<1, D>(slots, index.hint(), (work, guard), allowance)
         }
-    }
-    index.ensure_tree();
+    };
+    index.set_hint(hint);
+    let Some(from) = stopped else {
+        return;
+    };
     let rest = slots.get_mut(from..).unwrap_or_default();
+    // The tree, under a caller's deadline with its clock asked during the
+    // build (a clock that stops it stops the frame).
+    let built = if D::NEVER {
+        index.ensure_tree();
+        true
+    } else {
+        let mut ask = || guard.check();
+        index.ensure_tree_within(&mut Some(&mut ask))
+    };
+    if !built {
+        flag_pending(rest, Status::OverBudget);
+        return;
+    }
     let walk = LeanWalk::of(pair, keying, (foe, side), b2, index.lean());
-    hint = walk.points_for::<2, D>(rest, hint, (work, guard));
+    let hint = walk.points_for::<2, D>(rest, index.hint(), (work, guard));
     index.set_hint(hint);
 }
 
 /// The units a point's walk may spend on average through a loose index
-/// before its deferred block tree is built, and the slots taken between
-/// two looks at what they spent ([`LeanWalk::points_deferred`]).
+/// before its deferred block tree is built, and the slots walked between
+/// two looks at what they spent ([`match_deferred`]).
 const DEFERRED_UNITS: u32 = 32;
-const DEFERRED_CHUNK: usize = 32;
+const DEFERRED_PART: usize = 32;
 
 /// What every point of a boundary shares on the lean wedge path.
 struct LeanWalk<'a> {
@@ -491,37 +525,47 @@ impl<'a> LeanWalk<'a> {
     }
 
     /// [`Self::points`] through a loose index whose block tree is
-    /// deferred ([`match_wedge_lean`]), without a caller's deadline: the
-    /// walks of a tight index (`WALK` 0 or 1), so a segment whose keys
-    /// miss a wedge's is looked at for its unit and passed, where the tree
-    /// would pass the blocks around it for one. Taken [`DEFERRED_CHUNK`]
-    /// slots at a time; while the walks have spent at most
-    /// [`DEFERRED_UNITS`] units a slot and twice the polyline's segments
-    /// beside (the representative pair's walks spend about 6.5 a point,
-    /// the demo's loose frames 9 and 13 about 15 and 23 a walked point; the
-    /// tree costs about 10 instructions a segment to build, a passed
-    /// segment about 15), the tree is not worth building. Past that, the
-    /// walks stop after the part and the slot they reached is returned,
-    /// with the last run's start. A heuristic for speed only: each point's
-    /// result is that of either walk, the reference's unless the budget
-    /// binds (they spend units differently: a block skipped is one unit).
+    /// deferred ([`match_deferred`]): each point's walk as on a tight index
+    /// (`WALK` 0, the plain walk, or 1, the aside walk), so a segment whose
+    /// keys miss a wedge's is looked at for its unit and passed, where the
+    /// tree would pass the blocks around it for one. [`DEFERRED_PART`]
+    /// slots at a time, through [`Self::points_for`] (the usual loop, the
+    /// clock asked before each point as there), while the walks have spent
+    /// at most `allowance` units (`(base, a)`: `base` and `a` more for each
+    /// point there was to walk); past that, the walks stop after the part
+    /// and the slot they reached is returned, with the last run's start,
+    /// for the walks with the tree. So the tree is built where the tight
+    /// walks cost more than a tight index's would, and before it the walks
+    /// spent at most the allowance and one part's walks. A heuristic for
+    /// speed only: each point's result is that of either walk, the
+    /// reference's unless the budget binds (they spend units differently:
+    /// a block skipped is one unit). The same with and without a clock, so
+    /// a clock that never says yes changes no result.
     #[inline(always)]
     fn points_deferred<const WALK: u8, D: Deadline>(
         &self,
         slots: &mut [PointResult],
         mut hint: usize,
         (work, guard): (&mut Work, &mut Guard<'_, D>),
+        (base, a): (u32, u32),
     ) -> (usize, Option<usize>) {
-        let start = work.credit();
-        let mut allowance = u32::try_from(self.segments.saturating_mul(2)).unwrap_or(u32::MAX);
-        let mut done = 0;
-        for part in slots.chunks_mut(DEFERRED_CHUNK) {
-            hint = self.points::<WALK, D>(part, hint, (work, guard));
+        let (mut spent, mut allowance, mut done) = (0u32, base, 0usize);
+        for part in slots.chunks_mut(DEFERRED_PART) {
+            let pending = part
+                .iter()
+                .filter(|r| r.status == Status::NoIntersection)
+                .count();
+            // (At most `DEFERRED_PART`.)
+            let pending = u32::try_from(pending).unwrap_or(u32::MAX);
+            // The units the part spends, credit and held back together (no
+            // grant comes while it is walked).
+            let before = work.credit().saturating_add(guard.reserve());
+            hint = self.points_for::<WALK, D>(part, hint, (work, guard));
+            let after = work.credit().saturating_add(guard.reserve());
+            spent = spent.saturating_add(before.saturating_sub(after));
+            allowance = allowance.saturating_add(a.saturating_mul(pending));
             done += part.len();
-            // (`DEFERRED_CHUNK · DEFERRED_UNITS` fits a `u32`.)
-            let units = u32::try_from(part.len()).unwrap_or(u32::MAX);
-            allowance = allowance.saturating_add(units.saturating_mul(DEFERRED_UNITS));
-            if start.saturating_sub(work.credit()) > allowance {
+            if spent > allowance {
                 return (hint, Some(done));
             }
         }

@@ -52,12 +52,12 @@
 //! meet the keys, `Lean::copy`): it merges the aside entries in by index
 //! and, on a loose index, skips from a segment that misses the query over
 //! the largest aligned block that misses it too ([`Blocks::skip_at`]).
-//! Frame 2's index built without a caller's clock leaves its tree until a
-//! walk needs it ([`Index::ensure_tree`]; until then one level of the
-//! widest blocks, which skips nothing): the wedge path's walks first go
-//! as on a tight index and ask for the tree only once they have spent
-//! more units than a tight index's would (`processor::step4`,
-//! `match_deferred`).
+//! Frame 2's index leaves its tree until a walk needs it
+//! ([`Index::ensure_tree`]; until then one level of the widest blocks,
+//! which skips nothing): the wedge path's walks first go as on a tight
+//! index and ask for the tree only once they have spent more units than
+//! a tight index's would (`processor::step4`, `match_deferred`; at once
+//! under a small work budget or a clock that caps a point's search).
 //!
 //! Moving backwards, the band path's key interval is wide (the band's part
 //! near the FOE is wide in angle), and its visitor rejects most segments
@@ -308,7 +308,9 @@ pub(crate) struct Index<const N: usize> {
     /// aside segments left out, are more than [`WIDE`] average widths
     /// apart somewhere, and runs may be long) but left to the first
     /// walk that needs them (`build::Builder::finish`,
-    /// [`Self::ensure_tree`]): `levels` is 0 until then.
+    /// [`Self::ensure_tree`]): until then the tree is one level of the
+    /// widest blocks (`levels` 1), which skips nothing, and the lean wedge
+    /// path tells a deferred tree by this flag.
     tree_deferred: bool,
     segments: usize,
     orient: f32,

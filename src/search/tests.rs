@@ -393,21 +393,49 @@ fn a_build_in_parts_or_with_a_clock_is_the_same_build() {
             false
         };
         assert!(b.finish(near, &mut Some(&mut never)));
-        // Without a clock frame 2's loose index (unkeyed ends meeting
-        // every key) leaves its block tree to its first use: built then,
-        // it is the tree the clocked build made.
-        assert!(!parts.tree_deferred);
-        if whole.tree_deferred {
-            assert_eq!(unkeyed, Unkeyed::MeetAll, "case {case}");
-            assert_eq!(whole.levels, 1, "case {case}: the widest one level");
-            deferred += 1;
-        }
-        whole.ensure_tree();
         assert_eq!(
             std::format!("{whole:?}"),
             std::format!("{parts:?}"),
             "case {case} (shape {shape}, period {period})"
         );
+        // Frame 2's loose index (unkeyed ends meeting every key) leaves its
+        // block tree to its first use, with a clock or without: one level
+        // of the widest blocks until then, and built then the tree the
+        // build would have made: the fold test's index's (the same keys
+        // with unkeyed ends meeting none, eager), whenever both are loose.
+        if whole.tree_deferred {
+            assert_eq!(unkeyed, Unkeyed::MeetAll, "case {case}");
+            assert_eq!(whole.levels, 1, "case {case}: the widest one level");
+            let blocks = whole.segments.div_ceil(FAN);
+            assert!(
+                whole.tree[..2 * blocks]
+                    .chunks_exact(2)
+                    .all(|b| b == [f32::NEG_INFINITY, f32::INFINITY]),
+                "case {case}"
+            );
+            deferred += 1;
+            let mut clock_never = || false;
+            assert!(parts.ensure_tree_within(&mut Some(&mut clock_never)));
+            whole.ensure_tree();
+            assert!(!whole.tree_deferred && !parts.tree_deferred, "case {case}");
+            assert_eq!(
+                std::format!("{whole:?}"),
+                std::format!("{parts:?}"),
+                "case {case}: the tree built"
+            );
+            // Its first level, the hull of each block's intervals (the
+            // placeholder's widest blocks all overwritten).
+            assert!(whole.levels >= 1, "case {case}");
+            for (k, c) in whole.seg[..whole.segments].chunks(FAN).enumerate() {
+                let lo = c.iter().map(|g| g.lo).fold(f32::INFINITY, fmin);
+                let hi = c.iter().map(|g| g.hi).fold(f32::NEG_INFINITY, fmax);
+                assert_eq!(
+                    whole.tree[2 * k..2 * k + 2],
+                    [lo, hi],
+                    "case {case}: block {k}"
+                );
+            }
+        }
         // Stopped at a question of the build.
         let q = (rng.next() * (asked + 1) as f32) as usize;
         let mut cut = Index::<CAP>::new();

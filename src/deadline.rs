@@ -150,20 +150,6 @@ impl<'d, D: Deadline> Guard<'d, D> {
         true
     }
 
-    /// The carried units held back from the current point (beside the
-    /// credit, the units left to spend).
-    #[inline(always)]
-    pub(crate) fn reserve(&self) -> u32 {
-        self.reserve
-    }
-
-    /// Whether a point's search is capped ([`Deadline::carry`] below what
-    /// makes the cap every unit there is).
-    #[inline(always)]
-    pub(crate) fn caps(&self) -> bool {
-        !D::NEVER && self.cap != u32::MAX
-    }
-
     /// Whether the deadline has expired (asking the clock once more if it
     /// had not yet).
     #[inline(always)]

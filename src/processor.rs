@@ -1082,8 +1082,6 @@ mod tests {
         let mut builder = index.builder((0.0, 1.0), Unkeyed::MeetAll);
         builder.push_all(b2.iter().map(key));
         builder.finish(None, &mut None);
-        // (Without a clock frame 2's loose index defers its tree.)
-        index.ensure_tree();
         let lean = index.lean();
         assert_eq!(
             lean.aside.len(),

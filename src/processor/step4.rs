@@ -60,18 +60,13 @@ pub(super) fn match_boundary<const N: usize, D: Deadline>(
         }
         _ => {}
     }
-    if !D::NEVER && matcher == Matcher::Indexed {
-        // Under a deadline: the block tree the build deferred and the
-        // radial levels the band queries use built before the first
-        // point's search, not inside it, the clock asked before and during
-        // the builds (between parts of `CHUNK` blocks).
+    if !D::NEVER && matcher == Matcher::Indexed && matches!(keying.pencil, Pencil::Half { .. }) {
+        // Under a deadline: the radial levels the band queries use built
+        // before the first point's search, not inside it, the clock asked
+        // before and during the build (between parts of `CHUNK` blocks).
         let mut ask = || guard.check();
         if !ask() {
-            if matches!(keying.pencil, Pencil::Half { .. }) {
-                index.build_radial_once(b2, &mut Some(&mut ask));
-            } else {
-                let _ = index.ensure_tree_within(&mut Some(&mut ask));
-            }
+            index.build_radial_once(b2, &mut Some(&mut ask));
         }
         if guard.has_expired() {
             flag_pending(slots, Status::OverBudget);
@@ -128,15 +123,8 @@ fn match_wedge_lean<const N: usize, D: Deadline>(
         cot_twice: pair.config.cot_twice,
         segments: b2.len().saturating_sub(1),
     };
-    // A loose index (the keys fold somewhere): its walks take the block
-    // tree's skips too. Frame 2's index leaves its tree to its first use
-    // ([`match_deferred`]).
     if blocks.any() {
-        if index.tree_deferred() {
-            // (Laid out of the usual walks' way: [`match_deferred`].)
-            match_deferred(pair, keying, (foe, side), (slots, b2), index, (work, guard));
-            return;
-        }
+        // A loose index (the keys fold somewhere): the tree's skips too.
         hint = walk.points_for::<2, D>(slots, hint, (work, guard));
     } else if aside.is_empty() {
         hint = walk.points_for::<0, D>(slots, hint, (work, guard));
@@ -166,17 +154,6 @@ fn match_wedge_angular<const N: usize, D: Deadline>(
     // A piece's end (at most `N`) is kept in an `f32` for
     // [`refine_deferred`]: exact below 2²⁴. (At compile time, no cost.)
     const { assert!(N < 1 << 24, "a boundary capacity below 2^24 points") };
-    // (A block tree deferred by the build: this path's walks skip by it.
-    // Under a caller's deadline, with its clock asked during the build.)
-    if D::NEVER {
-        index.ensure_tree();
-    } else {
-        let mut ask = || guard.check();
-        if !index.ensure_tree_within(&mut Some(&mut ask)) {
-            flag_pending(slots, Status::OverBudget);
-            return;
-        }
-    }
     let (e2, e2_csc, cot_twice) = (pair.e2(), pair.e2_csc(), pair.config.cot_twice);
     let segments = b2.len().saturating_sub(1);
     let mut deferred = false;
@@ -341,7 +318,6 @@ fn match_wedge_angular_reference<const N: usize>(
     b2: &[Pixel],
     index: &mut Index<N>,
 ) {
-    index.ensure_tree();
     let (e2, e2_csc, cot_twice) = (pair.e2(), pair.e2_csc(), pair.config.cot_twice);
     let segments = b2.len().saturating_sub(1);
     let mut work = Work::new();
@@ -397,81 +373,6 @@ pub(super) fn flag_pending(slots: &mut [PointResult], status: Status) {
     }
 }
 
-/// [`match_wedge_lean`] through a loose index whose block tree the build
-/// deferred (`search::Builder::finish`). Its
-/// walks first go as on a tight index ([`LeanWalk::points_deferred`]): a
-/// segment whose keys miss the wedge's is looked at for its unit and
-/// passed, where the tree passes the blocks around it for one. While
-/// they cost no more units than a tight index's walks would, the tree is
-/// not worth its build; past that, the tree is built and the loose walks,
-/// with its skips, take the points left. On the demo drive the first way
-/// is the cheaper: frames 9 and 13 (their walks pass no segment the tree
-/// would skip) cost about 3 800 and 700 instructions less in the profile
-/// windows than with the tree built first and the loose walks' dearer
-/// loop. Without the fold test (the certification's
-/// `containment_without_the_fold_test`), an S-bend's walks pass many such
-/// segments, and the tree is built: its yield there is the eager tree's.
-/// Under a small work budget or a clock that caps a point's search the
-/// tree is built first (below).
-#[cold]
-#[inline(never)]
-fn match_deferred<const N: usize, D: Deadline>(
-    pair: &Pair,
-    keying: &Keying,
-    (foe, side): ([f32; 2], f32),
-    (slots, b2): (&mut [PointResult], &[Pixel]),
-    index: &mut Index<N>,
-    (work, guard): (&mut Work, &mut Guard<'_, D>),
-) {
-    // The allowance: twice the polyline's segments and `DEFERRED_UNITS` a
-    // point to walk. Under a work budget below twice that a point
-    // (`Config::with_work_budget`), where the budget binds sooner, or a
-    // deadline that caps a point's search (`Deadline::carry`), the tree's
-    // skips are worth their build: it is built first, and the results are
-    // those of the tree built with the index. (A clock that caps nothing
-    // defers as `process` does: the same results while it says no.)
-    let w = pair.config.work_per_point;
-    let (hint, stopped) = if w < 2 * DEFERRED_UNITS || guard.caps() {
-        (index.hint(), Some(0))
-    } else {
-        let walk = LeanWalk::of(pair, keying, (foe, side), b2, index.lean());
-        let base = u32::try_from(walk.segments.saturating_mul(2)).unwrap_or(u32::MAX);
-        let allowance = (base, DEFERRED_UNITS);
-        if walk.aside.is_empty() {
-            walk.points_deferred::<0, D>(slots, index.hint(), (work, guard), allowance)
-        } else {
-            walk.points_deferred::<1, D>(slots, index.hint(), (work, guard), allowance)
-        }
-    };
-    index.set_hint(hint);
-    let Some(from) = stopped else {
-        return;
-    };
-    let rest = slots.get_mut(from..).unwrap_or_default();
-    // The tree, under a caller's deadline with its clock asked during the
-    // build (a clock that stops it stops the frame).
-    let built = if D::NEVER {
-        index.ensure_tree();
-        true
-    } else {
-        let mut ask = || guard.check();
-        index.ensure_tree_within(&mut Some(&mut ask))
-    };
-    if !built {
-        flag_pending(rest, Status::OverBudget);
-        return;
-    }
-    let walk = LeanWalk::of(pair, keying, (foe, side), b2, index.lean());
-    let hint = walk.points_for::<2, D>(rest, index.hint(), (work, guard));
-    index.set_hint(hint);
-}
-
-/// The units a point's walk may spend on average through a loose index
-/// before its deferred block tree is built, and the slots walked between
-/// two looks at what they spent ([`match_deferred`]).
-const DEFERRED_UNITS: u32 = 32;
-const DEFERRED_PART: usize = 32;
-
 /// What every point of a boundary shares on the lean wedge path.
 struct LeanWalk<'a> {
     pair: &'a Pair<'a>,
@@ -489,89 +390,7 @@ struct LeanWalk<'a> {
     segments: usize,
 }
 
-impl<'a> LeanWalk<'a> {
-    /// The lean walk of a boundary through the index view `lean`
-    /// ([`match_deferred`]'s two; [`match_wedge_lean`] writes its own out).
-    #[inline(always)]
-    fn of(
-        pair: &'a Pair<'a>,
-        keying: &Keying,
-        (foe, side): ([f32; 2], f32),
-        b2: &'a [Pixel],
-        lean: Lean<'a>,
-    ) -> Self {
-        let Lean {
-            segs,
-            orient,
-            aside,
-            blocks,
-            ..
-        } = lean;
-        LeanWalk {
-            pair,
-            segs,
-            aside,
-            blocks,
-            b2,
-            foe,
-            side,
-            e2: pair.e2(),
-            e2_csc: pair.e2_csc(),
-            key_scale: keying.key_scale,
-            orient,
-            cot_twice: pair.config.cot_twice,
-            segments: b2.len().saturating_sub(1),
-        }
-    }
-
-    /// [`Self::points`] through a loose index whose block tree is
-    /// deferred ([`match_deferred`]): each point's walk as on a tight index
-    /// (`WALK` 0, the plain walk, or 1, the aside walk), so a segment whose
-    /// keys miss a wedge's is looked at for its unit and passed, where the
-    /// tree would pass the blocks around it for one. [`DEFERRED_PART`]
-    /// slots at a time, through [`Self::points_for`] (the usual loop, the
-    /// clock asked before each point as there), while the walks have spent
-    /// at most `allowance` units (`(base, a)`: `base` and `a` more for each
-    /// point there was to walk); past that, the walks stop after the part
-    /// and the slot they reached is returned, with the last run's start,
-    /// for the walks with the tree. So the tree is built where the tight
-    /// walks cost more than a tight index's would, and before it the walks
-    /// spent at most the allowance and one part's walks. A heuristic for
-    /// speed only: each point's result is that of either walk, the
-    /// reference's unless the budget binds (they spend units differently:
-    /// a block skipped is one unit). The same with and without a clock, so
-    /// a clock that never says yes changes no result.
-    #[inline(always)]
-    fn points_deferred<const WALK: u8, D: Deadline>(
-        &self,
-        slots: &mut [PointResult],
-        mut hint: usize,
-        (work, guard): (&mut Work, &mut Guard<'_, D>),
-        (base, a): (u32, u32),
-    ) -> (usize, Option<usize>) {
-        let (mut spent, mut allowance, mut done) = (0u32, base, 0usize);
-        for part in slots.chunks_mut(DEFERRED_PART) {
-            let pending = part
-                .iter()
-                .filter(|r| r.status == Status::NoIntersection)
-                .count();
-            // (At most `DEFERRED_PART`.)
-            let pending = u32::try_from(pending).unwrap_or(u32::MAX);
-            // The units the part spends, credit and held back together (no
-            // grant comes while it is walked).
-            let before = work.credit().saturating_add(guard.reserve());
-            hint = self.points_for::<WALK, D>(part, hint, (work, guard));
-            let after = work.credit().saturating_add(guard.reserve());
-            spent = spent.saturating_add(before.saturating_sub(after));
-            allowance = allowance.saturating_add(a.saturating_mul(pending));
-            done += part.len();
-            if spent > allowance {
-                return (hint, Some(done));
-            }
-        }
-        (hint, None)
-    }
-
+impl LeanWalk<'_> {
     /// [`Self::points`], or under a caller's deadline
     /// [`Self::points_within`].
     #[inline(always)]
@@ -1316,10 +1135,6 @@ fn match_point<const N: usize>(
             walk.outcome()
         }
         Matcher::Indexed => {
-            // (A block tree deferred by the build: the band's runs skip by
-            // it. Asked here, not in `Index::visit`: there the band path's
-            // visits measured up to 2 % dearer.)
-            index.ensure_tree();
             let query = band_query(pair, keying, &band, key, near_foe);
             let with_near = geom.w() < 0.0;
             match index.visit(query, with_near, None, work, &mut walk) {

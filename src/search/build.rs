@@ -22,7 +22,6 @@ impl<const N: usize> Index<N> {
         self.levels = 0;
         self.tree_end = 0;
         self.radial_levels = UNBUILT;
-        self.tree_deferred = false;
         self.aside.clear();
         self.near.clear();
         self.near_overflow = false;
@@ -114,7 +113,7 @@ impl<const N: usize> Index<N> {
     /// rebuild the envelopes without them; `false` when `tick`'s clock
     /// stopped it (the index then unfit for queries).
     #[inline(never)]
-    fn rebuild(&mut self, orient: f32, wide: f32, defer: bool, tick: &mut Tick<'_>) -> bool {
+    fn rebuild(&mut self, orient: f32, wide: f32, tick: &mut Tick<'_>) -> bool {
         let s = self.segments;
         let Some(seg) = self.seg.get_mut(..s) else {
             return true;
@@ -175,66 +174,8 @@ impl<const N: usize> Index<N> {
         let Some(loose) = self.suffix_minima(wide, tick, false) else {
             return false;
         };
-        if loose && defer {
-            // Until it is built, a tree of one level whose every block
-            // is the widest (it meets every query, so nothing is skipped):
-            // a block tree like any other, the walks by it correct, only
-            // without skips. (With or without a clock: the same index
-            // either way, so that a clock that never says yes changes no
-            // result, `crate::deadline`. At most `N / 4` values, written
-            // without asking it.)
-            let blocks = s.div_ceil(FAN);
-            if let Some(level) = self.tree.get_mut(..2 * blocks) {
-                for b in level.chunks_exact_mut(2) {
-                    b.copy_from_slice(&[f32::NEG_INFINITY, f32::INFINITY]);
-                }
-                (self.levels, self.tree_end) = (1, 2 * blocks);
-                self.tree_deferred = true;
-                return true;
-            }
-        }
+        self.loose = loose;
         !loose || self.build_tree(tick)
-    }
-
-    /// Whether this loose index's block tree is the widest one level the
-    /// build left it until its first use (`Builder::finish`,
-    /// [`Self::ensure_tree`]).
-    #[inline(always)]
-    pub(crate) fn tree_deferred(&self) -> bool {
-        self.tree_deferred
-    }
-
-    /// The block tree built now if it was deferred (`Builder::finish`):
-    /// the same levels the build would have made, in `O(s)` once an
-    /// index. The band and angular paths ask for it first; the lean wedge
-    /// walks when theirs cost more units than a tight index's
-    /// (`step4::match_deferred`). Without a clock; under a caller's
-    /// deadline [`Self::ensure_tree_within`].
-    #[inline(always)]
-    pub(crate) fn ensure_tree(&mut self) {
-        if self.tree_deferred {
-            self.build_deferred_tree(&mut None);
-        }
-    }
-
-    /// [`Self::ensure_tree`] with `tick`'s clock asked during the build
-    /// (between parts of [`CHUNK`] blocks); `false` when it stopped the
-    /// build. The tree is then still the deferred one, whose level-1
-    /// blocks are each the widest or already their own hull: every block
-    /// holds its segments' keys, so the walks by it stay correct.
-    #[inline(always)]
-    pub(crate) fn ensure_tree_within(&mut self, tick: &mut Tick<'_>) -> bool {
-        !self.tree_deferred || self.build_deferred_tree(tick)
-    }
-
-    /// [`Self::ensure_tree`]'s build, out of its callers' loops.
-    #[cold]
-    #[inline(never)]
-    fn build_deferred_tree(&mut self, tick: &mut Tick<'_>) -> bool {
-        // (A stopped build leaves `levels` and `tree_end` as they were.)
-        let built = self.build_tree(tick);
-        self.tree_deferred = !built;
-        built
     }
 
     /// The block tree over the current intervals (module docs): the key
@@ -272,11 +213,6 @@ impl<const N: usize> Index<N> {
     /// queries then go without them).
     pub(super) fn build_radial(&mut self, b: &[crate::camera::Pixel], tick: &mut Tick<'_>) {
         self.radial_levels = 0;
-        // (After the key levels: they end at `tree_end`. A clock that
-        // stops their build leaves the queries without radial levels.)
-        if !self.ensure_tree_within(tick) {
-            return;
-        }
         let s = self.segments;
         if s == 0 || b.len() != s + 1 {
             return;
@@ -869,7 +805,6 @@ impl<const N: usize> Builder<'_, N> {
             sum,
             order,
             period,
-            unkeyed,
             ..
         } = self;
         let s = n.saturating_sub(1);
@@ -887,14 +822,8 @@ impl<const N: usize> Builder<'_, N> {
         let Some(loose) = index.suffix_minima(wide, tick, true) else {
             return false;
         };
-        let orient = if flip { -o } else { o };
-        // Frame 2's index (unkeyed ends meet every key) leaves a loose
-        // index's block tree to its first use ([`Index::ensure_tree`]):
-        // the lean wedge walks may do without it (`step4::match_deferred`;
-        // the demo's loose frames 9 and 13 pass no segment the tree would
-        // skip, and it costs about 2 000 instructions to build there).
-        let defer = unkeyed == Unkeyed::MeetAll;
-        if (loose || odd || flip) && !index.rebuild(orient, wide, defer, tick) {
+        index.loose = loose;
+        if (loose || odd || flip) && !index.rebuild(if flip { -o } else { o }, wide, tick) {
             return false;
         }
         index.kmin = index.seg.first().map_or(f32::INFINITY, |g| g.sm);

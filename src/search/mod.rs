@@ -52,12 +52,6 @@
 //! meet the keys, `Lean::copy`): it merges the aside entries in by index
 //! and, on a loose index, skips from a segment that misses the query over
 //! the largest aligned block that misses it too ([`Blocks::skip_at`]).
-//! Frame 2's index leaves its tree until a walk needs it
-//! ([`Index::ensure_tree`]; until then one level of the widest blocks,
-//! which skips nothing): the wedge path's walks first go as on a tight
-//! index and ask for the tree only once they have spent more units than
-//! a tight index's would (`processor::step4`, `match_deferred`; at once
-//! under a small work budget or a clock that caps a point's search).
 //!
 //! Moving backwards, the band path's key interval is wide (the band's part
 //! near the FOE is wide in angle), and its visitor rejects most segments
@@ -304,14 +298,6 @@ pub(crate) struct Index<const N: usize> {
     /// them (0: none fit; [`UNBUILT`]: not built yet).
     tree_end: usize,
     radial_levels: u8,
-    /// The key levels are wanted (a *loose* index: the envelopes, the
-    /// aside segments left out, are more than [`WIDE`] average widths
-    /// apart somewhere, and runs may be long) but left to the first
-    /// walk that needs them (`build::Builder::finish`,
-    /// [`Self::ensure_tree`]): until then the tree is one level of the
-    /// widest blocks (`levels` 1), which skips nothing, and the lean wedge
-    /// path tells a deferred tree by this flag.
-    tree_deferred: bool,
     segments: usize,
     orient: f32,
     period: f32,
@@ -330,6 +316,9 @@ pub(crate) struct Index<const N: usize> {
     /// segment but its own two. (`false` too where the build did not test
     /// the order: [`build::Builder::push_all`]'s lean loop.)
     strict: bool,
+    /// The envelopes, the aside segments left out, are more than
+    /// [`WIDE`] average widths apart somewhere: runs may be long.
+    loose: bool,
 }
 
 impl<const N: usize> Default for Index<N> {
@@ -348,7 +337,6 @@ impl<const N: usize> Index<N> {
             levels: 0,
             tree_end: 0,
             radial_levels: UNBUILT,
-            tree_deferred: false,
             segments: 0,
             orient: 1.0,
             period: 0.0,
@@ -359,6 +347,7 @@ impl<const N: usize> Index<N> {
             near_overflow: false,
             hint: 0,
             strict: false,
+            loose: false,
         }
     }
 

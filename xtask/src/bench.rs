@@ -769,7 +769,7 @@ key-frame fusion over the demo drive (2 × 256 points, 8 partners, map of 2 × 5
     );
     if matching.0 > deadline {
         misses.push(format!(
-            "the demo drive's matching: {} instructions in frame {} > deadline {deadline}",
+            "{OPEN}the demo drive's matching: {} instructions in frame {} > deadline {deadline}",
             matching.0, matching.1
         ));
     }

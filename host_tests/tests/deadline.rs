@@ -318,13 +318,13 @@ fn a_cut_frame_still_becomes_the_previous_one() {
 
 /// A clock that never says yes and caps nothing gives `process`'s results
 /// exactly (`Deadline::carry`), at every work budget: also where the
-/// budget binds (8 and 16 allowances a point) and where frame 2's loose
-/// index defers its block tree (its lean walks go as on a tight index
-/// until they have spent their allowance, with a clock or without one).
-/// The named synthetic scenarios and 20 random ones, exact and rounded,
-/// frame 2 as rendered and with spurious detector points (every 9th
-/// vertex moved 150 px along its row), and the adversarial family at
-/// N = 64 in its own configuration.
+/// budget binds (8 and 16 allowances a point), where a search structure
+/// built differently with a clock than without one would show (a
+/// deferred block tree did, `docs/PERFORMANCE.md`, "The demo's matching
+/// within the deadline"). The named synthetic scenarios and 20 random
+/// ones, exact and rounded, frame 2 as rendered and with spurious
+/// detector points (every 9th vertex moved 150 px along its row), and
+/// the adversarial family at N = 64 in its own configuration.
 #[test]
 fn an_uncapped_clock_is_process_at_every_budget() {
     let mut pairs = 0usize;

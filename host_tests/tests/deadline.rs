@@ -69,6 +69,26 @@ impl Counts {
     }
 }
 
+/// `f2` against `p`'s kept frame within a clock that never says yes and
+/// caps nothing ([`Uncapped`]) gives `plain`, `process`'s result
+/// (`Deadline::carry`).
+fn assert_uncapped_is(
+    p: &mut Processor<N, B>,
+    (f2, m): (&Frame<N, B>, &Motion),
+    plain: &Structure<N, B>,
+    what: &str,
+) {
+    let free = Box::new(
+        p.process_against_kept_within(f2, m, &mut Uncapped)
+            .expect("kept")
+            .clone(),
+    );
+    assert!(
+        *free == *plain,
+        "{what}: an uncapped clock that never says yes differs from process"
+    );
+}
+
 /// Every point of `got` (within a deadline) against `full` (the largest
 /// budget, no deadline).
 fn compare(got: &Structure<N, B>, full: &Structure<N, B>, what: &str, c: &mut Counts) {
@@ -133,15 +153,7 @@ fn sweep(config: Config, (f1, f2, m): (&Frame<N, B>, &Frame<N, B>, &Motion), wha
         "{what}: {asked} questions for {points} points"
     );
     // With no cap and a clock that never says yes: `process` exactly.
-    let free = Box::new(
-        p.process_against_kept_within(f2, m, &mut Uncapped)
-            .expect("kept")
-            .clone(),
-    );
-    assert!(
-        free == default,
-        "{what}: an uncapped clock that never says yes differs from process"
-    );
+    assert_uncapped_is(&mut p, (f2, m), &default, what);
     let mut c = Counts::default();
     compare(&uncut, &full, what, &mut c);
     c.capped = uncut
@@ -333,15 +345,7 @@ fn an_uncapped_clock_is_process_at_every_budget() {
             let mut p = Box::new(Processor::<N, B>::new(config));
             assert!(matches!(p.process(f1, None), Ok(Step::First)), "{what}");
             let plain = Box::new(p.process_against_kept(f2, m).expect("kept").clone());
-            let free = Box::new(
-                p.process_against_kept_within(f2, m, &mut Uncapped)
-                    .expect("kept")
-                    .clone(),
-            );
-            assert!(
-                free == plain,
-                "{what}: an uncapped clock that never says yes differs from process"
-            );
+            assert_uncapped_is(&mut p, (f2, m), &plain, what);
             pairs += 1;
         };
     let mut all = scenarios::named();

@@ -52,8 +52,8 @@ use crate::matching::{Outcome, Radial, Walker};
 use crate::motion::Motion;
 use crate::pencil::{half_key, Keying, Pencil, NO_KEY};
 use crate::search::{
-    expired, run_start_in, Blocks, Builder, Flow, Index, KeyOrder, Lean, OutOfWork, Query, Tick,
-    Unkeyed, Visitor, Work, CHUNK, CLIP_UNITS,
+    expired, run_start_in, BlockSkip, Blocks, Builder, Flow, Index, KeyOrder, LazyBlocks, Lean,
+    OutOfWork, Query, Tick, Unkeyed, Visitor, Work, CHUNK, CLIP_UNITS,
 };
 use crate::structure::{PointResult, ProcessError, Status, Step, Structure};
 use crate::wedge::{WVertex, Wedge, WedgeWalk, WedgeWalker};
@@ -858,6 +858,16 @@ fn frame2_index<const N: usize>(
                 _ => false,
             };
             builder.finish(Some(&is_near), tick)
+        }
+        // Searched only by the lean wedge walks (the predicate
+        // `match_boundary` takes them by), without a clock: a loose
+        // index's block tree left until a walk reads it (the same tree,
+        // units and results; [`Builder::finish_deferring_tree`]).
+        None if tick.is_none()
+            && step4::wedge_path(pair)
+            && matches!(keying.pencil, Pencil::Half { .. }) =>
+        {
+            builder.finish_deferring_tree(None)
         }
         None => builder.finish(None, tick),
     }

@@ -3,6 +3,7 @@
 //! outlier pass and the rebuild, the block tree.
 
 use super::*;
+use core::cell::Cell;
 
 impl<const N: usize> Index<N> {
     /// Start indexing a polyline: push its vertex keys and their margins
@@ -113,7 +114,7 @@ impl<const N: usize> Index<N> {
     /// rebuild the envelopes without them; `false` when `tick`'s clock
     /// stopped it (the index then unfit for queries).
     #[inline(never)]
-    fn rebuild(&mut self, orient: f32, wide: f32, tick: &mut Tick<'_>) -> bool {
+    fn rebuild(&mut self, orient: f32, wide: f32, tick: &mut Tick<'_>, defer: bool) -> bool {
         let s = self.segments;
         let Some(seg) = self.seg.get_mut(..s) else {
             return true;
@@ -175,6 +176,11 @@ impl<const N: usize> Index<N> {
             return false;
         };
         self.loose = loose;
+        if loose && defer {
+            // Left for the lean wedge walks ([`LazyBlocks`]).
+            (self.levels, self.tree_end) = (0, PENDING);
+            return true;
+        }
         !loose || self.build_tree(tick)
     }
 
@@ -182,20 +188,9 @@ impl<const N: usize> Index<N> {
     /// levels, `(min lo, max hi)` of each block ([`build_levels`]); `false`
     /// when `tick`'s clock stopped it.
     fn build_tree(&mut self, tick: &mut Tick<'_>) -> bool {
-        let s = self.segments;
-        let hull = |c: &[Seg]| {
-            let mut q = [f32::INFINITY, f32::NEG_INFINITY];
-            for g in c {
-                q = [fmin(q[0], g.lo), fmax(q[1], g.hi)];
-            }
-            q
-        };
-        // (Whole blocks, then the short last one: the same blocks as
-        // `chunks(FAN)`, the whole ones each in one straight run.)
-        let blocks = self.seg.get(..s).unwrap_or(&[]).chunks_exact(FAN);
-        let last = Some(blocks.remainder()).filter(|r| !r.is_empty());
-        let leaves = blocks.map(hull).chain(last.map(hull));
-        match build_levels(&mut self.tree, s, 0, leaves, tick) {
+        let seg = self.seg.get(..self.segments).unwrap_or(&[]);
+        let tree = Cell::from_mut(self.tree.as_mut_slice()).as_slice_of_cells();
+        match key_levels(seg, tree, tick) {
             Some(built) => {
                 (self.levels, self.tree_end) = built;
                 true
@@ -241,12 +236,36 @@ impl<const N: usize> Index<N> {
             q
         };
         let leaves = (0..s.div_ceil(FAN)).map(|k| leaf(k * FAN, ((k + 1) * FAN).min(s)));
-        let Some((levels, _)) = build_levels(&mut self.tree, s, self.tree_end, leaves, tick) else {
+        let tree = Cell::from_mut(self.tree.as_mut_slice()).as_slice_of_cells();
+        let Some((levels, _)) = build_levels(tree, s, self.tree_end, leaves, tick) else {
             return;
         };
         // (`levels` ≤ LEVELS = 4.)
         self.radial_levels = u8::try_from(levels).unwrap_or(0);
     }
+}
+
+/// The block tree's key levels over the segments `seg` in `tree`
+/// ([`build_levels`] with each block's `(min lo, max hi)`): how many were
+/// built and where they end; `None` when `tick`'s clock stopped it.
+pub(super) fn key_levels(
+    seg: &[Seg],
+    tree: &[Cell<f32>],
+    tick: &mut Tick<'_>,
+) -> Option<(usize, usize)> {
+    let hull = |c: &[Seg]| {
+        let mut q = [f32::INFINITY, f32::NEG_INFINITY];
+        for g in c {
+            q = [fmin(q[0], g.lo), fmax(q[1], g.hi)];
+        }
+        q
+    };
+    // (Whole blocks, then the short last one: the same blocks as
+    // `chunks(FAN)`, the whole ones each in one straight run.)
+    let blocks = seg.chunks_exact(FAN);
+    let last = Some(blocks.remainder()).filter(|r| !r.is_empty());
+    let leaves = blocks.map(hull).chain(last.map(hull));
+    build_levels(tree, seg.len(), 0, leaves, tick)
 }
 
 /// Levels of a block tree over `s` segments in `tree` from `base` on,
@@ -262,7 +281,7 @@ impl<const N: usize> Index<N> {
 /// `∞` at odd ones). `None` when `tick`'s clock stopped it (asked before
 /// every `CHUNK / FAN` blocks: about `CHUNK` segments' or blocks' work).
 fn build_levels<const W: usize>(
-    tree: &mut [f32],
+    tree: &[Cell<f32>],
     s: usize,
     mut base: usize,
     leaves: impl Iterator<Item = [f32; W]>,
@@ -287,13 +306,13 @@ fn build_levels<const W: usize>(
         };
         if level == 1 {
             // (The same blocks, written in order.)
-            let blocks = tree.get_mut(base..end).unwrap_or_default();
-            for (k, t) in blocks.chunks_exact_mut(W).enumerate() {
+            let blocks = tree.get(base..end).unwrap_or_default();
+            for (k, t) in blocks.chunks_exact(W).enumerate() {
                 if k % (CHUNK / FAN) == CHUNK / FAN - 1 && expired(tick) {
                     return None;
                 }
-                for (t, v) in t.iter_mut().zip(leaves.next().unwrap_or(widest)) {
-                    *t = v;
+                for (t, v) in t.iter().zip(leaves.next().unwrap_or(widest)) {
+                    t.set(v);
                 }
             }
         } else {
@@ -311,7 +330,7 @@ fn build_levels<const W: usize>(
                 }
                 for c in k * FAN..((k + 1) * FAN).min(below_n) {
                     for (i, v) in q.iter_mut().enumerate() {
-                        let at = tree.get(below_base + W * c + i).copied();
+                        let at = tree.get(below_base + W * c + i).map(Cell::get);
                         *v = if i % 2 == 0 {
                             fmin(*v, at.unwrap_or(f32::NEG_INFINITY))
                         } else {
@@ -319,9 +338,9 @@ fn build_levels<const W: usize>(
                         };
                     }
                 }
-                if let Some(t) = tree.get_mut(base + W * k..base + W * (k + 1)) {
-                    for (t, v) in t.iter_mut().zip(q) {
-                        *t = v;
+                if let Some(t) = tree.get(base + W * k..base + W * (k + 1)) {
+                    for (t, v) in t.iter().zip(q) {
+                        t.set(v);
                     }
                 }
             }
@@ -796,6 +815,35 @@ impl<const N: usize> Builder<'_, N> {
     /// with `W' < 0`; `None` otherwise). `false` when `tick`'s clock
     /// stopped a pass ([`Tick`]): the index is then unfit for queries.
     pub(crate) fn finish(self, near: Option<&dyn Fn(usize) -> bool>, tick: &mut Tick<'_>) -> bool {
+        self.finish_with(near, tick, false)
+    }
+
+    /// [`Self::finish`] without a clock, a loose index's block tree left
+    /// until a walk reads it ([`LazyBlocks`], [`Index::lean_lazy`]): for an
+    /// index searched only by the lean wedge walks, which build it at their
+    /// first aligned segment that misses their keys, the build's tree
+    /// exactly. Along most road boundaries whose keys fold somewhere no
+    /// walk gets there, and the tree (about 8 instructions a segment) is
+    /// never built. Any other reader of the index sees no tree (`levels`
+    /// 0), which skips nothing and so is never wrong, only slower, and its
+    /// radial levels find no room; the caller takes this build only where
+    /// the lean walks are the one search
+    /// ([`crate::processor`]'s `frame2_index`).
+    pub(crate) fn finish_deferring_tree(self, near: Option<&dyn Fn(usize) -> bool>) -> bool {
+        self.finish_with(near, &mut None, true)
+    }
+
+    /// [`Self::finish`], the block tree left to build with `defer`.
+    /// (Inlined into both: the per-frame call's build measured the
+    /// representative window 488 127 estimated cycles so, 488 809 with one
+    /// copy out of line, 488 823 with one call taking `defer`.)
+    #[inline(always)]
+    fn finish_with(
+        self,
+        near: Option<&dyn Fn(usize) -> bool>,
+        tick: &mut Tick<'_>,
+        defer: bool,
+    ) -> bool {
         let Builder {
             index,
             o,
@@ -823,7 +871,7 @@ impl<const N: usize> Builder<'_, N> {
             return false;
         };
         index.loose = loose;
-        if (loose || odd || flip) && !index.rebuild(if flip { -o } else { o }, wide, tick) {
+        if (loose || odd || flip) && !index.rebuild(if flip { -o } else { o }, wide, tick, defer) {
             return false;
         }
         index.kmin = index.seg.first().map_or(f32::INFINITY, |g| g.sm);

@@ -5,20 +5,22 @@
 use super::*;
 use crate::camera::Pixel;
 use crate::matching::Radial;
+use build::key_levels;
 
-/// An index's view for a caller that walks runs itself ([`Index::lean`]).
+/// An index's view for a caller that walks runs itself ([`Index::lean`];
+/// its block tree as `B`, [`Blocks`] or [`LazyBlocks`]).
 #[derive(Clone, Copy)]
-pub(crate) struct Lean<'a> {
+pub(crate) struct Lean<'a, B = Blocks<'a>> {
     pub(crate) segs: &'a [Seg],
     pub(crate) orient: f32,
     pub(crate) aside: &'a [Aside],
-    pub(crate) blocks: Blocks<'a>,
+    pub(crate) blocks: B,
     /// The keys' period (0: none) and range `[kmin, kmax]` ([`copies_in`]).
     pub(super) period: f32,
     pub(super) range: (f32, f32),
 }
 
-impl Lean<'_> {
+impl<B> Lean<'_, B> {
     /// The one copy of the oriented query `[ql, qh]` to walk
     /// ([`copies_in`]): for keys without a period the query itself; for
     /// periodic keys the copy `[ql + 4m, qh + 4m]` that can meet the keys'
@@ -51,6 +53,16 @@ pub(crate) struct Blocks<'a> {
     pub(super) segments: usize,
 }
 
+/// The skips of a block tree, as a walk takes them ([`Blocks`], or
+/// [`LazyBlocks`], which builds a tree left to build on its first read).
+pub(crate) trait BlockSkip: Copy {
+    /// At segment `j` of a loose index's run: how many segments from `j`
+    /// on a block skip passes over: the largest block aligned at `j` whose
+    /// key range `meets` does not accept (0: look at segment `j` itself).
+    /// At most [`LEVELS`] steps.
+    fn skip_at(&self, j: usize, meets: impl Fn(f32, f32) -> bool) -> usize;
+}
+
 impl Blocks<'_> {
     /// No tree (a walk without skips).
     pub(crate) const NONE: Blocks<'static> = Blocks {
@@ -60,21 +72,25 @@ impl Blocks<'_> {
     };
 
     /// Whether there is a tree (a loose index).
-    #[inline(always)]
+    #[cfg(test)]
     pub(crate) fn any(&self) -> bool {
         self.levels > 0
     }
+}
 
-    /// At segment `j` of a loose index's run: how many segments from `j`
-    /// on a block skip passes over: the largest block aligned at `j` whose
-    /// key range `meets` does not accept (0: look at segment `j` itself).
-    /// At most [`LEVELS`] steps.
+impl BlockSkip for Blocks<'_> {
+    /// (A tree left to build has no levels here, and skips nothing: only
+    /// the lean walks search such an index,
+    /// [`Builder::finish_deferring_tree`].)
     #[inline(always)]
-    pub(crate) fn skip_at(&self, j: usize, meets: impl Fn(f32, f32) -> bool) -> usize {
+    fn skip_at(&self, j: usize, meets: impl Fn(f32, f32) -> bool) -> usize {
         // Only a position aligned to a block starts one.
         if j & (FAN - 1) != 0 {
             return 0;
         }
+        // (Written out here, not through [`skip_in`]: through it the
+        // bench firmware's pseudo-angle walks measured dearer, `fwd_spiral`
+        // +0.8 % at N = 512.)
         let (mut base, mut n, mut skip) = (0usize, self.segments, 0usize);
         let mut shift = 0u32;
         for _ in 0..self.levels.min(LEVELS) {
@@ -108,6 +124,96 @@ impl Blocks<'_> {
     }
 }
 
+/// The block tree of a loose index as the lean wedge walks read it
+/// ([`Index::lean_lazy`]): its values as cells, so that a tree the build
+/// left ([`Builder::finish_deferring_tree`]) is built on the first read,
+/// at a walk's first aligned segment that misses its keys. The same tree
+/// as the build's (the same intervals), so the same skips, units and
+/// results; along most boundaries whose keys fold somewhere no walk reads
+/// it, and it is never built.
+#[derive(Clone, Copy)]
+pub(crate) struct LazyBlocks<'a> {
+    tree: &'a [core::cell::Cell<f32>],
+    levels: &'a core::cell::Cell<usize>,
+    pub(super) tree_end: &'a core::cell::Cell<usize>,
+    segs: &'a [Seg],
+}
+
+impl LazyBlocks<'_> {
+    /// Whether there is a tree, built or left to build (a loose index).
+    #[inline(always)]
+    pub(crate) fn any(&self) -> bool {
+        self.levels.get() > 0 || self.tree_end.get() == PENDING
+    }
+
+    /// The tree built now (it was left to build): its levels.
+    #[cold]
+    #[inline(never)]
+    fn build(&self) -> usize {
+        // (Without a clock: the build defers only without one.)
+        let (levels, end) = key_levels(self.segs, self.tree, &mut None).unwrap_or((0, 0));
+        self.levels.set(levels);
+        self.tree_end.set(end);
+        levels
+    }
+}
+
+impl BlockSkip for LazyBlocks<'_> {
+    #[inline(always)]
+    fn skip_at(&self, j: usize, meets: impl Fn(f32, f32) -> bool) -> usize {
+        if j & (FAN - 1) != 0 {
+            return 0;
+        }
+        let mut levels = self.levels.get();
+        if self.tree_end.get() == PENDING {
+            levels = self.build();
+        }
+        let tree = self.tree;
+        let segments = self.segs.len();
+        skip_in(
+            |i| tree.get(i).map(core::cell::Cell::get),
+            (levels, segments),
+            j,
+            meets,
+        )
+    }
+}
+
+/// [`BlockSkip::skip_at`] at an aligned `j`, in a tree of `levels` levels
+/// over `segments` segments whose values `read` gives.
+#[inline(always)]
+fn skip_in(
+    read: impl Fn(usize) -> Option<f32>,
+    (levels, segments): (usize, usize),
+    j: usize,
+    meets: impl Fn(f32, f32) -> bool,
+) -> usize {
+    let (mut base, mut n, mut skip) = (0usize, segments, 0usize);
+    let mut shift = 0u32;
+    for _ in 0..levels.min(LEVELS) {
+        shift += FAN_BITS;
+        n = n.div_ceil(FAN);
+        // (`shift` ≤ 3 · LEVELS = 12.)
+        let size = 1usize << shift;
+        if j & (size - 1) != 0 {
+            break;
+        }
+        let b = j >> shift;
+        let (lo, hi) = (
+            read(base + 2 * b).unwrap_or(f32::NEG_INFINITY),
+            read(base + 2 * b + 1).unwrap_or(f32::INFINITY),
+        );
+        // A block that meets the query holds every larger block's
+        // range too: stop there.
+        if lo <= hi && meets(lo, hi) {
+            break;
+        }
+        skip = size;
+        base += 2 * n;
+    }
+    skip
+}
+
 impl<const N: usize> Index<N> {
     /// The block tree as [`Blocks`] (no levels when none is built).
     #[inline(always)]
@@ -116,6 +222,27 @@ impl<const N: usize> Index<N> {
             tree: &self.tree,
             levels: self.levels,
             segments: self.segments,
+        }
+    }
+
+    /// [`Self::lean`] with the block tree as [`LazyBlocks`]: built on a
+    /// walk's first read if the build left it.
+    #[inline(always)]
+    pub(crate) fn lean_lazy(&mut self) -> Lean<'_, LazyBlocks<'_>> {
+        let segs = self.seg.get(..self.segments.min(N)).unwrap_or(&[]);
+        let tree = core::cell::Cell::from_mut(self.tree.as_mut_slice()).as_slice_of_cells();
+        Lean {
+            segs,
+            orient: self.orient,
+            aside: self.aside.as_slice(),
+            blocks: LazyBlocks {
+                tree,
+                levels: core::cell::Cell::from_mut(&mut self.levels),
+                tree_end: core::cell::Cell::from_mut(&mut self.tree_end),
+                segs,
+            },
+            period: self.period,
+            range: (self.kmin, self.kmax),
         }
     }
 

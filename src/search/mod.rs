@@ -47,7 +47,12 @@
 //! range misses the query (at an aligned position, the largest such block),
 //! so a long run costs about one step per block it crosses and per segment
 //! it visits, not one per segment. A tight index never builds or reads the
-//! tree. The wedge path walks the runs of every index itself
+//! tree. Built without a clock for the lean wedge walks alone, a loose
+//! index leaves the tree ([`Builder::finish_deferring_tree`]) until a walk
+//! first reads it, at its first aligned segment that misses its keys
+//! ([`LazyBlocks`]: built there, the build's tree exactly, so the same
+//! skips, units and results; along most road boundaries no walk gets
+//! there). The wedge path walks the runs of every index itself
 //! (`Index::lean`; for periodic keys the one copy of its query that can
 //! meet the keys, `Lean::copy`): it merges the aside entries in by index
 //! and, on a loose index, skips from a segment that misses the query over
@@ -86,7 +91,7 @@ mod lean;
 mod visit;
 
 pub(crate) use build::{Builder, KeyOrder};
-pub(crate) use lean::{run_start_in, Blocks, Lean};
+pub(crate) use lean::{run_start_in, BlockSkip, Blocks, LazyBlocks, Lean};
 
 /// Segments kept aside (see the module docs).
 pub(crate) const MAX_ASIDE: usize = 8;
@@ -122,6 +127,12 @@ const LEVELS: usize = 4;
 
 /// `Index::radial_levels` before the radial levels are built.
 const UNBUILT: u8 = u8::MAX;
+
+/// `Index::tree_end` of a loose index whose block tree is left to build
+/// ([`Builder::finish_deferring_tree`]), its `levels` 0 meanwhile: every
+/// reader but the lean wedge walks ([`LazyBlocks`]) sees no tree, which
+/// skips nothing (so is never wrong), and the radial levels find no room.
+const PENDING: usize = usize::MAX;
 
 /// The caller's clock inside a pass over a polyline ([`crate::deadline`]):
 /// asked before every [`CHUNK`] items of each pass of a build, so that no
@@ -289,7 +300,8 @@ pub(crate) struct Index<const N: usize> {
     margin: [f32; N],
     /// The block tree (loose indexes only): the `(min lo, max hi)` of each
     /// aligned block of `FAN^l` segments, level `l = 1 …` after level
-    /// `l − 1`, flattened; `levels` levels are built (0: no tree).
+    /// `l − 1`, flattened; `levels` levels are built (0: no tree, or one
+    /// left to build: `tree_end` [`PENDING`]).
     tree: [f32; N],
     levels: usize,
     /// Where the key levels end in `tree`, and the block tree's *radial*

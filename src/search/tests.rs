@@ -423,6 +423,87 @@ fn a_build_in_parts_or_with_a_clock_is_the_same_build() {
     );
 }
 
+/// A build that leaves the block tree ([`Builder::finish_deferring_tree`])
+/// gives the eager build's index but for the tree; a walk's view of it
+/// ([`Index::lean_lazy`]) builds the tree on its first aligned read, the
+/// eager build's tree exactly, and from then on (and on that read) skips
+/// as the eager tree does. Checked on every shape of [`keys`] with every
+/// aligned segment and random queries, and the tree left alone by reads
+/// at unaligned segments. (It fails with the lazy view skipping nothing
+/// before its build, or with a tree built from other intervals.)
+#[test]
+fn a_deferred_tree_is_the_eager_tree() {
+    let mut rng = Rng(0xc4a2_0002);
+    let (mut deferred, mut read) = (0, 0);
+    for case in 0..3000 {
+        let (shape, period) = (case % 5, case % 3 == 0);
+        let n = 2 + (rng.next() * (CAP - 2) as f32) as usize;
+        let ks = keys(&mut rng, shape, n, period);
+        let orient = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+        let p = if period { 4.0 } else { 0.0 };
+        let mut eager = Index::<CAP>::new();
+        let mut b = eager.builder((p, orient), Unkeyed::MeetAll);
+        b.push_all(ks.iter().copied());
+        assert!(b.finish(None, &mut None));
+        let mut lazy = Index::<CAP>::new();
+        let mut b = lazy.builder((p, orient), Unkeyed::MeetAll);
+        b.push_all(ks.iter().copied());
+        assert!(b.finish_deferring_tree(None));
+        if eager.levels == 0 {
+            // A tight index: no tree either way, the same index.
+            assert_eq!(
+                std::format!("{eager:?}"),
+                std::format!("{lazy:?}"),
+                "case {case}"
+            );
+            continue;
+        }
+        deferred += 1;
+        assert_eq!((lazy.levels, lazy.tree_end), (0, PENDING), "case {case}");
+        // Every reader but the lazy view sees no tree, and skips nothing.
+        assert_eq!(lazy.skip_at(0, |_, _| false), 0, "case {case}");
+        let (kmin, kmax) = (eager.kmin, eager.kmax);
+        let s = eager.segments;
+        let query = |rng: &mut Rng| {
+            let a = kmin + (kmax - kmin) * (rng.next() * 1.2 - 0.1);
+            let w = (kmax - kmin) * 0.1 * rng.next();
+            (a, a + w)
+        };
+        {
+            let view = lazy.lean_lazy();
+            assert!(view.blocks.any(), "case {case}: a tree left to build");
+            // Unaligned reads build nothing.
+            for j in (1..s).filter(|j| j % FAN != 0) {
+                assert_eq!(view.blocks.skip_at(j, |_, _| false), 0);
+            }
+            assert_eq!(view.blocks.tree_end.get(), PENDING, "case {case}");
+            // The first aligned read builds it, and skips as the eager
+            // tree does; so does every later one.
+            for j in (0..s).step_by(FAN) {
+                for _ in 0..4 {
+                    let (ql, qh) = query(&mut rng);
+                    let meets = |l: f32, h: f32| l <= qh && h >= ql;
+                    assert_eq!(
+                        view.blocks.skip_at(j, meets),
+                        eager.blocks().skip_at(j, meets),
+                        "case {case}: j = {j}, query ({ql}, {qh})"
+                    );
+                }
+            }
+            read += 1;
+        }
+        assert_eq!(
+            std::format!("{eager:?}"),
+            std::format!("{lazy:?}"),
+            "case {case}: the tree built on the first read"
+        );
+    }
+    assert!(
+        deferred > 500 && read == deferred,
+        "{deferred} deferred, {read} read"
+    );
+}
+
 /// [`KeyOrder::push_until_settled`] leaves [`KeyOrder::strict`] and
 /// [`KeyOrder::settled`] as pushing every key one at a time does, whole or
 /// in parts (a caller's deadline between them), and, while not settled,

@@ -835,7 +835,7 @@ impl<const N: usize> Builder<'_, N> {
 
     /// [`Self::finish`], the block tree left to build with `defer`.
     /// (Inlined into both: the per-frame call's build measured the
-    /// representative window 488 127 estimated cycles so, 488 809 with one
+    /// representative window 488 067 estimated cycles so, 488 809 with one
     /// copy out of line, 488 823 with one call taking `defer`.)
     #[inline(always)]
     fn finish_with(

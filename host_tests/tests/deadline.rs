@@ -71,7 +71,8 @@ impl Counts {
 
 /// `f2` against `p`'s kept frame within a clock that never says yes and
 /// caps nothing ([`Uncapped`]) gives `plain`, `process`'s result
-/// (`Deadline::carry`).
+/// (`Deadline::carry`): every point, and the work units spent and granted
+/// (which `Structure`'s equality leaves out).
 fn assert_uncapped_is(
     p: &mut Processor<N, B>,
     (f2, m): (&Frame<N, B>, &Motion),
@@ -86,6 +87,11 @@ fn assert_uncapped_is(
     assert!(
         *free == *plain,
         "{what}: an uncapped clock that never says yes differs from process"
+    );
+    assert_eq!(
+        free.work_units(),
+        plain.work_units(),
+        "{what}: an uncapped clock spent other work units than process"
     );
 }
 

@@ -36,7 +36,7 @@ pub(crate) enum Outcome {
     /// A crossing: its `λ'` and the piece's range `[lo, hi]`; on the
     /// wedge path also where the piece ends, one past its last segment
     /// (its segments' lines tighten the stick,
-    /// [`crate::wedge::Wedge::stick`]; the band path gives 0).
+    /// [`crate::wedge::Wedge::refined`]; the band path gives 0).
     Match {
         lam: f32,
         lo: f32,

@@ -299,8 +299,10 @@ pub(crate) fn half_key(
     }
 }
 
-/// The pseudo-angle of a non-zero `d` ([`crate::math::pseudo_angle_nonzero`]
-/// by a reciprocal) and that reciprocal, `1/(|d_u| + |d_v|)`.
+/// The pseudo-angle of a non-zero `d` (by a reciprocal: with `d` turned so
+/// that "up" is the `+x` axis, `p = y/(|x| + |y|)`, placed by half-plane
+/// as `p`, `4 + p` or `2 − p`, in `[0, 4)` up to rounding) and that
+/// reciprocal, `1/(|d_u| + |d_v|)`.
 #[inline(always)]
 fn pseudo_angle_with_inverse(d: [f32; 2]) -> (f32, f32) {
     // Rotate so that "up" (0,-1) becomes the +x axis: (x, y) -> (-y, x).

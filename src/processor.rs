@@ -804,7 +804,7 @@ fn compensate_all_certified<const BOUNDED: bool>(
 /// [`CHUNK`] vertices; the builder takes each part where the last one
 /// ended). Half-plane keys go through the lean loop's bounded form
 /// ([`Builder::push_all_bounded`]) but with `checking`, the tests' switch
-/// ([`Processor::set_checking_forms`]).
+/// (`Processor::set_checking_forms`, tests and the fuzz target only).
 fn frame2_keys<'a, const N: usize>(
     index: &'a mut Index<N>,
     keying: &Keying,

@@ -7,7 +7,8 @@ use core::cell::Cell;
 
 impl<const N: usize> Index<N> {
     /// Start indexing a polyline: push its vertex keys and their margins
-    /// in order ([`Builder::push`]), then [`Builder::finish`]. `period` 4
+    /// in order ([`Builder::push_all`] and its kin), then
+    /// [`Builder::finish`]. `period` 4
     /// for pseudo-angles; `orient` the likely orientation of the keys (+1
     /// rising, −1 falling: any value gives the same index, a wrong one
     /// costs a rebuild). A segment's interval is that of its end keys,
@@ -109,7 +110,7 @@ impl<const N: usize> Index<N> {
         Some(!(gap <= wide))
     }
 
-    /// The slow path of [`Self::build`]: orient the intervals as `orient`,
+    /// The slow path of [`Builder::finish`]: orient the intervals as `orient`,
     /// set aside the unkeyed segments and those of outlying vertices, and
     /// rebuild the envelopes without them; `false` when `tick`'s clock
     /// stopped it (the index then unfit for queries).

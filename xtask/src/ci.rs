@@ -59,8 +59,10 @@ const CARGO_CHECKS: &[(&str, &[&str])] = &[
     ("", &["build", "--release", "--target", THUMB, "--features", "defmt"]),
     ("", &["clippy", "--target", THUMB, "--", "-D", "warnings"]),
     ("", &["clippy", "--target", THUMB, "--features", "defmt", "--", "-D", "warnings"]),
-    // The API docs, without a broken or private link.
+    // The API docs, without a broken or private link; and the crate's
+    // internal docs (the maintainers' reading), without a broken link.
     ("", &["rustdoc", "--lib", "--target", "host-tuple", "--", "-D", "warnings"]),
+    ("", &["rustdoc", "--lib", "--target", "host-tuple", "--", "-D", "warnings", "--document-private-items"]),
     // The library's tests and the host tests.
     ("", &["clippy", "--target", "host-tuple", "--all-targets", "--", "-D", "warnings"]),
     ("host_tests", &["clippy", "--all-targets", "--", "-D", "warnings"]),

@@ -357,7 +357,7 @@ fn main() -> ! {
             let bytes = stack::high_water(|| {
                 let _ = black_box(processor.process(black_box(&f2), Some(&m)));
             });
-            defmt::info!("stack per_frame_call={=u32}", bytes);
+            defmt::info!("stack per_frame_call={=u32} pair=representative", bytes);
         }
     }
     for (n, data) in STRESS.iter() {
@@ -387,6 +387,17 @@ fn main() -> ! {
         };
         processor.set_config(c);
         let r = measure_pair(processor, &f1, &f2, &m);
+        if *n == 256 {
+            // The stack on every path the family takes (the band path, the
+            // pseudo-angle path, a block tree built inside a walk), not
+            // only the representative pair's.
+            processor.reset();
+            let _ = processor.process(&f1, None);
+            let bytes = stack::high_water(|| {
+                let _ = black_box(processor.process(black_box(&f2), Some(&m)));
+            });
+            defmt::info!("stack per_frame_call={=u32} pair={=str}", bytes, name);
+        }
         processor.set_config(Config::DEFAULT);
         defmt::info!(
             "adversarial name={=str} n={=u32} points={=u32} instr={=u32} per_point={=u32} digest={=u32:08x} processed={=bool} work_spent={=u32} work_granted={=u32} {=str}",

@@ -189,7 +189,8 @@ impl<const N: usize> Index<N> {
     /// levels, `(min lo, max hi)` of each block ([`build_levels`]); `false`
     /// when `tick`'s clock stopped it.
     fn build_tree(&mut self, tick: &mut Tick<'_>) -> bool {
-        let seg = self.seg.get(..self.segments).unwrap_or(&[]);
+        // (The segments as [`Self::lean_lazy`] takes them: one tree.)
+        let seg = self.seg.get(..self.segments.min(N)).unwrap_or(&[]);
         let tree = Cell::from_mut(self.tree.as_mut_slice()).as_slice_of_cells();
         match key_levels(seg, tree, tick) {
             Some(built) => {
@@ -210,7 +211,9 @@ impl<const N: usize> Index<N> {
     pub(super) fn build_radial(&mut self, b: &[crate::camera::Pixel], tick: &mut Tick<'_>) {
         self.radial_levels = 0;
         let s = self.segments;
-        if s == 0 || b.len() != s + 1 {
+        // (A key tree left to build, `tree_end` [`PENDING`]: no radial
+        // levels either; only the lean walks search such an index.)
+        if s == 0 || b.len() != s + 1 || self.tree_end == PENDING {
             return;
         }
         let seg = &self.seg;

@@ -116,8 +116,9 @@ pub(crate) const MAX_COPIES: usize = 3;
 /// within 12 of 0. Not always: across the unkeyed disc round the FOE the
 /// unwrapping guesses the turn, and a boundary that zig-zags through the
 /// disc many times can pile the guesses up; hence the check in
-/// `copies_in` ([`Lean::copy`], [`Index::copies`]), for every query (the band path visits every segment, the
-/// fold test assumes a fold, the wedge path gives the point to the band).
+/// `copies_in` ([`Lean::copy`], [`Index::copies`]), for every query (the
+/// band path visits every segment, the fold test assumes a fold, the
+/// wedge path gives the point to the band).
 const COPY_REACH: f32 = 32.0;
 /// The fan-out of the block tree, `2^FAN_BITS`.
 const FAN_BITS: u32 = 3;

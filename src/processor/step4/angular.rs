@@ -93,7 +93,7 @@ pub(super) fn match_wedge_angular<const N: usize, D: Deadline>(
 /// the points left are [`Status::OverBudget`].
 #[cold]
 #[inline(never)]
-pub(super) fn refine_deferred<D: Deadline>(
+fn refine_deferred<D: Deadline>(
     (pair, foe): (&Pair, [f32; 2]),
     slots: &mut [PointResult],
     b2: &[Pixel],
@@ -162,7 +162,7 @@ pub(super) fn angular_wedge(
 /// no single copy (rare: out of line, not a second inlined band path).
 #[cold]
 #[inline(never)]
-pub(super) fn band_point<const N: usize>(
+fn band_point<const N: usize>(
     (pair, keying, near_foe): (&Pair, &Keying, f32),
     r: &PointResult,
     b2: &[Pixel],

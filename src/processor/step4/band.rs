@@ -87,13 +87,7 @@ pub(super) fn match_point<const N: usize>(
 
 /// The key interval to search for a band (see [`Band::key_half_width`]
 /// and [`Keying::around`]).
-pub(super) fn band_query(
-    pair: &Pair,
-    keying: &Keying,
-    band: &Band,
-    key: f32,
-    near_foe: f32,
-) -> Query {
+fn band_query(pair: &Pair, keying: &Keying, band: &Band, key: f32, near_foe: f32) -> Query {
     const NOTHING: Query = Query::Keys(f32::INFINITY, f32::NEG_INFINITY);
     if keying.angular() {
         match band.key_half_width(near_foe, pair.exhaustive(), keying.key_scale) {
@@ -122,7 +116,7 @@ pub(super) fn band_query(
 }
 
 /// The point's result from the walk's outcome: depth (eq. 2.3) and stick.
-pub(super) fn conclude(
+fn conclude(
     pair: &Pair,
     p1: Pixel,
     iz: f32,

@@ -55,7 +55,7 @@ pub(super) fn match_wedge_lean<const N: usize, D: Deadline>(
 }
 
 /// What every point of a boundary shares on the lean wedge path.
-pub(super) struct LeanWalk<'a> {
+struct LeanWalk<'a> {
     pair: &'a Pair<'a>,
     segs: &'a [crate::search::Seg],
     aside: &'a [crate::search::Aside],
@@ -333,7 +333,7 @@ impl LeanWalk<'_> {
 /// entries and no block tree. Returns the outcome and where the run
 /// started.
 #[inline(always)]
-pub(super) fn wedge_run(
+fn wedge_run(
     wedge: &Wedge,
     (segs, b2): (&[crate::search::Seg], &[Pixel]),
     hint: usize,
@@ -551,7 +551,7 @@ pub(in crate::processor) fn wedge_run_aside<const SKIP: bool>(
 /// walk stops ([`Status::OverBudget`] included).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-pub(super) fn offer(
+fn offer(
     wedge: &Wedge,
     b2: &[Pixel],
     k: usize,
@@ -603,11 +603,7 @@ pub(super) fn offer(
 /// units offering them all would cost (one each, [`CLIP_UNITS`] more for
 /// each whose interval meets the keys).
 #[inline(always)]
-pub(super) fn aside_idle(
-    wedge: &Wedge,
-    b2: &[Pixel],
-    aside: &[crate::search::Aside],
-) -> Option<u32> {
+fn aside_idle(wedge: &Wedge, b2: &[Pixel], aside: &[crate::search::Aside]) -> Option<u32> {
     let mut units = 0u32;
     // The vertex that starts segment `cached`, when it is `va`.
     let mut cached = usize::MAX;

@@ -829,8 +829,8 @@ impl<const N: usize> Builder<'_, N> {
     /// exactly. Along most road boundaries whose keys fold somewhere no
     /// walk gets there, and the tree (about 8 instructions a segment) is
     /// never built. Any other reader of the index sees no tree (`levels`
-    /// 0), which skips nothing and so is never wrong, only slower, and its
-    /// radial levels find no room; the caller takes this build only where
+    /// 0), which skips nothing and so is never wrong, only slower, and no
+    /// radial levels are built; the caller takes this build only where
     /// the lean walks are the one search
     /// ([`crate::processor`]'s `frame2_index`).
     pub(crate) fn finish_deferring_tree(self, near: Option<&dyn Fn(usize) -> bool>) -> bool {

@@ -132,7 +132,7 @@ const UNBUILT: u8 = u8::MAX;
 /// `Index::tree_end` of a loose index whose block tree is left to build
 /// ([`Builder::finish_deferring_tree`]), its `levels` 0 meanwhile: every
 /// reader but the lean wedge walks ([`LazyBlocks`]) sees no tree, which
-/// skips nothing (so is never wrong), and the radial levels find no room.
+/// skips nothing (so is never wrong), and no radial levels are built.
 const PENDING: usize = usize::MAX;
 
 /// The caller's clock inside a pass over a polyline ([`crate::deadline`]):

@@ -125,6 +125,150 @@ fn containment(noise: Noise, motion: Option<MotionNoise>, per_family: usize) -> 
     all
 }
 
+/// What the work budget and the cap of a deadline cost on the fusion's
+/// drives, whose pairs reach across up to eight frames (README, "Within a
+/// deadline" and "Worst case"):
+///
+/// * **The default budget, no clock.** A point the budget flags
+///   `over_budget` would never be `ok` with the largest budget (the pair
+///   run again with it): the budget costs no depth here. (Mostly fold
+///   queries, each paid from the allowances of the points before it,
+///   `fold::step`: on a crest the first points' queries are the dear
+///   ones.)
+/// * **The cap** (`Deadline::carry`, 2 by default), a clock that never
+///   says yes against no clock: a point whose search needs more than
+///   `CARRY` allowances at once comes out `over_budget` (or `ok` with a
+///   looser stick), and one the frame's credit ran out on without a clock
+///   may be done, never anything else. Compared step by step up to a
+///   drive's first changed point (after it the key frames may differ). An
+///   adversarial review found such a drive of its own.
+///
+/// The figures printed are README's.
+#[test]
+fn the_deadline_cap_on_the_drives() {
+    let policy = FusionConfig::DEFAULT;
+    let (mut compared, mut changed_drives, mut pairs, mut points) =
+        (0usize, 0usize, 0usize, 0usize);
+    let mut over_budget = std::collections::BTreeMap::new();
+    let (mut looser, mut done_within) = (0usize, 0usize);
+    // Points `over_budget` without a clock, in every paired step.
+    let mut budget_flagged = std::collections::BTreeMap::new();
+    let mut all_points = 0usize;
+    for family in DriveFamily::ALL {
+        let (ds, _) = drives(family, PER_FAMILY, FRAMES);
+        for (seed, d) in &ds {
+            let input = d.input(Noise::Rounded, None, *seed);
+            fn record(
+                steps: &mut Vec<Option<roadstereo::Structure<N, B>>>,
+            ) -> impl FnMut(usize, &roadstereo::fusion::FusionStep, &HostFusion) + '_ {
+                move |_, step, f| steps.push(step.paired.map(|_| f.structure().clone()))
+            }
+            let mut full = Vec::new();
+            let mut keys = Vec::new();
+            run(d, &input, policy, |j, step, f| {
+                record(&mut full)(j, step, f);
+                keys.push(f.key().map_or(0, |k| k.id() as usize));
+            });
+            let mut capped = Vec::new();
+            // (A clock asked at most `usize::MAX` times never says yes.)
+            host_tests::drives::run_within(
+                d,
+                &input,
+                policy,
+                Some(usize::MAX),
+                record(&mut capped),
+            );
+            compared += 1;
+            // Every `over_budget` point without a clock, and what the pair
+            // gives it with the largest budget (the key frame and partner
+            // again, the motion composed as the fusion composes it).
+            let cfg = input.config();
+            let largest = cfg
+                .with_work_budget(Config::MAX_WORK_PER_POINT)
+                .expect("the largest budget");
+            for (j, (b, key)) in full.iter().zip(&keys).enumerate() {
+                let Some(b) = b else { continue };
+                all_points += b
+                    .boundaries()
+                    .iter()
+                    .map(|x| x.points().len())
+                    .sum::<usize>();
+                if b.status_counts().get(Status::OverBudget) == 0 {
+                    continue;
+                }
+                let mut p = Box::new(roadstereo::Processor::<N, B>::new(largest));
+                let k = d.spec.intrinsics;
+                p.process(&input.frame(&k, *key), None).expect("key frame");
+                let mut m = input.given[*key];
+                for g in &input.given[*key + 1..j] {
+                    m = m.then(g).expect("composed");
+                }
+                let big = p
+                    .process_against_kept(&input.frame(&k, j), &m)
+                    .expect("pair");
+                for (x, y) in b.boundaries().iter().zip(big.boundaries()) {
+                    for (q, r) in x.points().iter().zip(y.points()) {
+                        if q.status() == Status::OverBudget {
+                            *budget_flagged.entry(r.status().name()).or_insert(0usize) += 1;
+                        }
+                    }
+                }
+            }
+            'steps: for (j, (a, b)) in capped.iter().zip(&full).enumerate() {
+                let (a, b) = match (a, b) {
+                    (Some(a), Some(b)) => (a, b),
+                    (None, None) => continue,
+                    _ => panic!("{}: step {j} paired in one run only", d.spec.name),
+                };
+                pairs += 1;
+                let mut changed = false;
+                for (x, y) in a.boundaries().iter().zip(b.boundaries()) {
+                    assert_eq!(x.points().len(), y.points().len());
+                    for (p, q) in x.points().iter().zip(y.points()) {
+                        points += 1;
+                        if p == q {
+                            continue;
+                        }
+                        changed = true;
+                        if q.status() == Status::OverBudget {
+                            // (The frame's credit ran out without a clock;
+                            // under the cap it went round otherwise.)
+                            done_within += 1;
+                        } else if p.status() == Status::OverBudget {
+                            assert!(p.interval().is_none(), "{}: step {j}: {p:?}", d.spec.name);
+                            *over_budget.entry(q.status().name()).or_insert(0usize) += 1;
+                        } else if host_tests::fuzz::frame::looser_stick(p, q) {
+                            looser += 1;
+                        } else {
+                            panic!(
+                                "{}: step {j}: within the clock {p:?}, without {q:?}",
+                                d.spec.name
+                            );
+                        }
+                    }
+                }
+                if changed {
+                    changed_drives += 1;
+                    break 'steps;
+                }
+            }
+        }
+    }
+    println!(
+        "the default cap on {compared} drives (rounded, {FRAMES} frames): {changed_drives} drives with a changed point; up to the first, {pairs} pairs, {points} points, over_budget where no clock gives {over_budget:?}, {looser} looser sticks, {done_within} done where no clock ran out of the budget; without a clock, of {all_points} points, over_budget: {budget_flagged:?} (as the largest budget gives them)"
+    );
+    assert!(pairs > compared * (FRAMES / 2), "{pairs} pairs compared");
+    assert!(
+        all_points > 2_000_000 && !budget_flagged.is_empty(),
+        "the budget binds nowhere: {budget_flagged:?} (README's figure to update)"
+    );
+    assert_eq!(
+        budget_flagged.get("ok"),
+        None,
+        "the default budget cost depths on the drives"
+    );
+}
+
 /// The fusion with every frame's matching cut short by a deadline
 /// (`Fusion::step_within`, a clock that says the time is up from its
 /// 300th question on: about the first boundary of a 2 × 256 frame): the

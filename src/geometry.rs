@@ -8,13 +8,33 @@
 //! coordinates `(x, y)` meets it at depth `Z = h / (y cos θ + sin θ)`. A
 //! pair `(θ, h)` is consistent with a point when that depth lies in the
 //! point's stick `[Z_near, Z_far]`, i.e. when
-//! `h ∈ [Z_near (y cos θ + sin θ), Z_far (y cos θ + sin θ)]`. For each tilt
-//! on a grid the heights consistent with all but a few points (wrong
-//! matches) are found by a sweep over the interval ends; the tilts with any
-//! such height, and the heights, give the ranges. The road width for a
-//! `(θ, h)` is the median distance, on the plane, from the points of one
-//! boundary to the polyline of the other; it scales with `h`, so its range
-//! follows from the extreme heights at each consistent tilt.
+//! `h ∈ [Z_near g(θ), Z_far g(θ)]` with `g(θ) = y cos θ + sin θ`.
+//!
+//! **Exact up to a superset.** The tilts from 0° to 60° are cut into
+//! cells of 0.05°, and a cell with any consistent height into 16 parts;
+//! in each cell (and part) every point's interval is widened to what any
+//! tilt of it allows: `[Z_near g₋, Z_far g₊]` with `g₋` and `g₊`
+//! the least and the largest `g` over the cell (`g = √(1 + y²) sin(θ + φ)`,
+//! `tan φ = y`, rises to one maximum and falls, so `g₋` is at an end of the
+//! cell and `g₊` at an end or, where `g′ = cos θ − y sin θ` changes sign in
+//! the cell, `√(1 + y²)`), each widened by the rounding of `g` (the sine
+//! and cosine within `3·10⁻⁷`, the sum within two units: `10⁻⁶ (|y| +
+//! 1)` taken) and of the products (`2⁻²²` relative). The heights covered by
+//! all but a few (`outliers`, wrong matches) of those intervals are found
+//! by a sweep over their ends. A `(θ, h)` that agrees with the sticks has
+//! `h` in every widened interval of `θ`'s cell and part, so the parts with
+//! any such height give a tilt range, and their heights a height range,
+//! that hold every `(θ, h)` consistent with the sticks (with all but
+//! `outliers` of them). Until an adversarial review, the heights were
+//! those of the grid tilts alone: with sticks of ±0.1 % a true tilt
+//! between two grid tilts was reported with a height range that missed
+//! the truth, or as inconsistent.
+//!
+//! The road width for a `(θ, h)` is the median distance, on the plane,
+//! from the points of one boundary to the polyline of the other; it scales
+//! with `h`. It is an estimate (the median of the distances, not a bound):
+//! its range is the hull, over the cells with a height, of the widths at
+//! the cell's two ends times the cell's heights.
 
 use core::fmt;
 
@@ -137,29 +157,71 @@ pub const MAX_NORMALISED: f32 = 1.0e5;
 /// of the estimate below `1e22`, far from `f32` overflow.
 pub const MAX_SAMPLE_DEPTH: f32 = 1.0e6;
 
-/// Tilt grid step, radians (0.05°).
+/// Tilt cell width, radians (0.05°).
 const TILT_STEP: f32 = 0.000_872_664_6;
-/// Tilts on the grid after 0: `TILT_STEPS · TILT_STEP` is 60°, the
-/// largest tilt tried.
+/// Tilt cells: `TILT_STEPS · TILT_STEP` is 60°, the largest tilt tried.
 const TILT_STEPS: u16 = 1200;
+/// Parts of a tilt cell with any consistent height, each tested again:
+/// the widening of a point's interval over a cell is then a sixteenth.
+const SUB_CELLS: u16 = 16;
 
-/// Heights consistent with all but `m` of the points at tilt `(s, c)`:
-/// the hull of the heights covered by at least `n − m` intervals.
+/// The rounding allowance of `g = y cos θ + sin θ` per unit of `|y| + 1`
+/// (module docs).
+const G_ROUNDING: f32 = 1.0e-6;
+/// The relative rounding allowance of a product `Z g` (module docs).
+const PRODUCT_ROUNDING: f32 = 2.384_185_8e-7;
+
+/// The tilt cell `[θ_a, θ_b]` with the sines and cosines of its ends.
+#[derive(Clone, Copy)]
+struct Cell {
+    a: (f32, f32),
+    b: (f32, f32),
+}
+
+impl Cell {
+    /// The heights a point allows at some tilt of the cell, widened by the
+    /// rounding (module docs); `None` where no tilt of the cell has its ray
+    /// meet the plane ahead (the point disagrees).
+    fn interval(&self, p: &Sample) -> Option<(f32, f32)> {
+        let ((sa, ca), (sb, cb)) = (self.a, self.b);
+        let (ga, gb) = (p.y * ca + sa, p.y * cb + sb);
+        let tol = G_ROUNDING * (p.y.abs() + 1.0);
+        let mut g_hi = fmax(ga, gb);
+        // `g′` from positive (or nearly) at `θ_a` to negative (or nearly)
+        // at `θ_b`: the maximum `√(1 + y²)` may lie inside.
+        if ca - p.y * sa >= -tol && cb - p.y * sb <= tol {
+            g_hi = fmax(g_hi, sqrt(1.0 + p.y * p.y) * (1.0 + PRODUCT_ROUNDING));
+        }
+        let g_hi = g_hi + tol;
+        if g_hi <= 0.0 {
+            return None;
+        }
+        let g_lo = fmax(fmin(ga, gb) - tol, 0.0);
+        Some((
+            p.z_near * g_lo * (1.0 - PRODUCT_ROUNDING),
+            p.z_far * g_hi * (1.0 + PRODUCT_ROUNDING),
+        ))
+    }
+}
+
+/// Heights consistent with all but `m` of the points in tilt cell `cell`
+/// ([`Cell::interval`]): the hull of the heights covered by at least `n −
+/// m` intervals.
 ///
 /// Work: one pass over `points` (at most `N` are used), two sorts, and a
 /// sweep of exactly one step per interval end (`2n` steps).
-fn heights<const N: usize>(points: &[Sample], s: f32, c: f32, m: usize) -> Option<Range> {
+fn heights<const N: usize>(points: &[Sample], cell: &Cell, m: usize) -> Option<Range> {
     let mut lo = [0.0f32; N];
     let mut hi = [0.0f32; N];
     let mut n = 0;
     for ((l, h), p) in lo.iter_mut().zip(hi.iter_mut()).zip(points) {
-        let k = p.y * c + s;
-        if k <= 0.0 {
-            // The ray does not meet the plane ahead: this point disagrees.
+        let Some((a, b)) = cell.interval(p) else {
+            // No ray of the cell meets the plane ahead: this point
+            // disagrees.
             continue;
-        }
-        *l = p.z_near * k;
-        *h = p.z_far * k;
+        };
+        *l = a;
+        *h = b;
         n += 1;
     }
     let need = points.len().saturating_sub(m);
@@ -341,7 +403,7 @@ fn plane_points<'a, const N: usize>(
     all.get(..n).unwrap_or_default()
 }
 
-/// The ranges [`road_geometry`] accumulates over the tilt grid.
+/// The ranges [`road_geometry`] accumulates over the tilt cells.
 struct Hull {
     tilt: Range,
     height: Range,
@@ -354,33 +416,31 @@ impl Hull {
         hi: f32::NEG_INFINITY,
     };
 
-    /// Step 3 of [`road_geometry`], at one tilt: the heights consistent
-    /// there, and the width they give (the width scales with the height).
-    fn add(&mut self, tilt: f32, height: Range, width_at_unit_height: Option<f32>) {
-        self.tilt.lo = fmin(self.tilt.lo, tilt);
-        self.tilt.hi = fmax(self.tilt.hi, tilt);
+    /// Step 3 of [`road_geometry`], in one tilt cell `[θ_a, θ_b]`: the
+    /// heights consistent there, and the widths at unit height at its
+    /// ends (the width scales with the height).
+    fn add(&mut self, (ta, tb): (f32, f32), height: Range, widths: [Option<f32>; 2]) {
+        self.tilt.lo = fmin(self.tilt.lo, ta);
+        self.tilt.hi = fmax(self.tilt.hi, tb);
         self.height.lo = fmin(self.height.lo, height.lo);
         self.height.hi = fmax(self.height.hi, height.hi);
-        if let Some(w) = width_at_unit_height {
+        for w in widths.into_iter().flatten() {
             self.width.lo = fmin(self.width.lo, w * height.lo);
             self.width.hi = fmax(self.width.hi, w * height.hi);
         }
     }
 
-    /// Step 4 of [`road_geometry`]: a result if any tilt fitted and gave
-    /// a width, the tilt range widened by the grid step (a tilt within
-    /// half a step beyond the ends may also fit).
+    /// Step 4 of [`road_geometry`]: a result if any tilt cell fitted and
+    /// gave a width.
     fn finish(self, outliers: usize) -> Result<RoadGeometry, GeometryError> {
         let Hull {
-            mut tilt,
+            tilt,
             height,
             width,
         } = self;
         if !(tilt.lo.is_finite() && width.lo.is_finite()) {
             return Err(GeometryError::Inconsistent);
         }
-        tilt.lo = fmax(tilt.lo - TILT_STEP, 0.0);
-        tilt.hi += TILT_STEP;
         Ok(RoadGeometry {
             height,
             tilt,
@@ -404,10 +464,16 @@ impl Hull {
 /// `0 ≤ z_near ≤ z_far ≤` [`MAX_SAMPLE_DEPTH`]; anything else is a typed
 /// error naming the first bad sample.
 ///
-/// Work: `G = 1201` tilts (a constant), each with `O(M log M)` for the
-/// heights of the `M ≤ N` plane-fit points and `O(V · m²)` for the widths
-/// of `V ≤ 16` views of `m ≤ N` points per boundary — a check of the
-/// reconstruction, not a per-frame task.
+/// The height and tilt ranges hold every `(θ, h)` with `θ` in `[0°, 60°]`
+/// that agrees with the sticks of all but `outliers` of the plane-fit
+/// points (module docs: a superset, by the widening over a 0.003°
+/// part of a cell); the width range is an estimate.
+///
+/// Work: `G = 1200` tilt cells (a constant), each with `O(M log M)` for
+/// the heights of the `M ≤ N` plane-fit points (16 times more in a cell
+/// with any), and at most `G + 1` grid tilts with `O(V · m²)` for the
+/// widths of `V ≤ 16` views of `m ≤ N` points per boundary — a check of
+/// the reconstruction, not a per-frame task.
 pub fn road_geometry<const N: usize>(
     views: &[(&[Sample], &[Sample])],
     outliers: usize,
@@ -417,19 +483,43 @@ pub fn road_geometry<const N: usize>(
     // 2. Gather the points of the plane fit.
     let mut all = [Sample::default(); N];
     let points = plane_points(views, &mut all);
-    // 3. Sweep the tilt grid: heights consistent at each tilt, and widths.
+    // 3. Sweep the tilt cells: heights consistent in each, and widths at
+    // its ends (each grid tilt's width made once, when a cell needs it).
     let mut hull = Hull {
         tilt: Hull::EMPTY,
         height: Hull::EMPTY,
         width: Hull::EMPTY,
     };
-    for step in 0..=TILT_STEPS {
-        let tilt = f32::from(step) * TILT_STEP;
-        // `sin_cos` is valid here: the tilt is in [0, 60°].
-        let (s, c) = sin_cos(tilt);
-        if let Some(h) = heights::<N>(points, s, c, outliers) {
-            hull.add(tilt, h, median_width::<N>(views, s, c));
+    // `sin_cos` is valid here: the tilts are in [0, 60°].
+    let mut a = (0.0f32, sin_cos(0.0));
+    let mut width_a: Option<Option<f32>> = None;
+    for step in 1..=TILT_STEPS {
+        let tb = f32::from(step) * TILT_STEP;
+        let b = (tb, sin_cos(tb));
+        let cell = Cell { a: a.1, b: b.1 };
+        let mut width_b = None;
+        if heights::<N>(points, &cell, outliers).is_some() {
+            let wa = *width_a.get_or_insert_with(|| median_width::<N>(views, a.1 .0, a.1 .1));
+            let wb = median_width::<N>(views, b.1 .0, b.1 .1);
+            width_b = Some(wb);
+            // The cell's heights from its `SUB_CELLS` parts (each a
+            // superset of its own, and the parts cover the cell).
+            let mut sa = a;
+            for part in 1..=SUB_CELLS {
+                let t = if part == SUB_CELLS {
+                    tb
+                } else {
+                    a.0 + TILT_STEP * (f32::from(part) / f32::from(SUB_CELLS))
+                };
+                let sb = (t, sin_cos(t));
+                let sub = Cell { a: sa.1, b: sb.1 };
+                if let Some(h) = heights::<N>(points, &sub, outliers) {
+                    hull.add((sa.0, sb.0), h, [wa, wb]);
+                }
+                sa = sb;
+            }
         }
+        (a, width_a) = (b, width_b);
     }
     // 4. The ranges.
     hull.finish(outliers)

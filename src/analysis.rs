@@ -25,7 +25,7 @@
 //! range against `f64`).
 
 use crate::geometry::Range;
-use crate::math::{atan, fmax, reduce_angle, sin_cos, sin_cos_reduced, AngleError};
+use crate::math::{atan, fmax, fmin, reduce_angle, sin_cos, sin_cos_reduced, AngleError};
 
 /// Vehicle-frame translation `(U, V, W)` → camera frame, camera pitched
 /// down by `tilt` radians (Appendix I).
@@ -82,23 +82,60 @@ pub fn disparity_tilted(f: f32, h: f32, w: f32, z: f32, tilt: f32) -> Result<f32
 /// The stretch of flat ground in the vertical field of view: the nearest
 /// and farthest horizontal distances (`lo`, `hi`) seen by a camera at
 /// height `h`, tilted down by `tilt`, with half vertical field of view
-/// `half_fov` (radians; `atan(rows / 2 / f_y)`). The far end is infinite
-/// when the upper edge of the view is at or above the horizon. `Ok(None)`
-/// if the ground is not seen. `half_fov` must be in `(0, π/2)`
+/// `half_fov` (radians; `atan(rows / 2 / f_y)`), positive ahead of the
+/// camera and negative behind it. The far end is `+∞` when the upper
+/// edge of the view is at or above the horizon ahead, the near end `−∞`
+/// when the lower edge is at or past the horizon behind. `Ok(None)` if the
+/// ground is not seen. `half_fov` must be in `(0, π/2)`
 /// ([`AngleError::OutOfDomain`] otherwise); `tilt` is reduced to `[−π, π]`.
+///
+/// A ray at the angle `α` below the horizontal ahead meets the ground
+/// exactly when `α` lies in `(0, π)` (modulo a turn), at the horizontal
+/// distance `h cot α`, which falls as `α` rises; the view's rays are at
+/// `[tilt − half_fov, tilt + half_fov]`, shorter than half a turn, so the
+/// ground seen is `h cot α` over that interval's one part in `(0, π)`.
+/// (Until an adversarial review the view's lower edge had to be short of
+/// the vertical: a camera tilted 80° with a half field of view of 20° saw
+/// "no ground".)
 pub fn ground_interval(h: f32, tilt: f32, half_fov: f32) -> Result<Option<Range>, AngleError> {
+    use core::f32::consts::{FRAC_PI_2, PI, TAU};
     if !half_fov.is_finite() {
         return Err(AngleError::NotFinite);
     }
-    if !(half_fov > 0.0 && half_fov < core::f32::consts::FRAC_PI_2) {
+    if !(half_fov > 0.0 && half_fov < FRAC_PI_2) {
         return Err(AngleError::OutOfDomain);
     }
-    Ok(ground_in_view(h, reduce_angle(tilt)?, half_fov).map(|(lo, hi)| Range { lo, hi }))
+    let tilt = reduce_angle(tilt)?;
+    // `h cot α` for `α` in `(0, π)` (the tangent of the forward rays as
+    // [`ground_in_view`] takes it, the same bits there).
+    let at = |a: f32| {
+        let t = if a <= FRAC_PI_2 { tan_small(a) } else { tan(a) };
+        h / t
+    };
+    // The copy of the view (unshifted, or a turn on for a tilt near −π)
+    // that meets `(0, π)`; at most one does.
+    for shift in [0.0, TAU] {
+        let (upper, lower) = (tilt - half_fov + shift, tilt + half_fov + shift);
+        let (a, b) = (fmax(upper, 0.0), fmin(lower, PI));
+        if a < b {
+            let near = if lower >= PI {
+                f32::NEG_INFINITY
+            } else {
+                at(b)
+            };
+            let far = if upper <= 0.0 { f32::INFINITY } else { at(a) };
+            return Ok(Some(Range { lo: near, hi: far }));
+        }
+    }
+    Ok(None)
 }
 
-/// [`ground_interval`] for a tilt in `[−π, π]` and a half field of view in
-/// `(0, π/2)`: the rays it takes the tangent of are then within
-/// [`sin_cos`]'s range.
+/// The ground ahead in the view of a camera tilted `tilt` (in `[−π, π]`)
+/// with a half field of view in `(0, π/2)`, for [`common_rows_motion`]:
+/// [`ground_interval`]'s values where the view's lower edge is below the
+/// horizon and short of the vertical, `None` otherwise (that model of
+/// rows assumes the ground seen ahead). The rays it takes the tangent of
+/// are then within [`sin_cos`]'s range.
 fn ground_in_view(h: f32, tilt: f32, half_fov: f32) -> Option<(f32, f32)> {
     let lower = tilt + half_fov; // steepest ray below the horizon
     let upper = tilt - half_fov;
@@ -153,8 +190,10 @@ pub fn motion_factor(n: f32, w: f32, z_prime: f32, tilt: f32) -> Result<f32, Ang
 /// forward by `w` (flat ground, camera at height `h`, tilted by `tilt`,
 /// `rows` image rows, focal length `f_y`, principal point at the centre).
 /// The rows lost are those of the strip the vehicle drives past.
-/// `Ok(None)` if the ground is not seen (or `rows`, `f_y` do not give a
-/// field of view); `tilt` is reduced to `[−π, π]`.
+/// `Ok(None)` if the ground is not seen ahead with the view's lower edge
+/// short of the vertical (`tilt + half_fov < π/2`, the model of rows
+/// here), or `rows`, `f_y` do not give a field of view; `tilt` is reduced
+/// to `[−π, π]`.
 pub fn common_rows_motion(
     h: f32,
     tilt: f32,

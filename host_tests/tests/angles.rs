@@ -213,6 +213,100 @@ fn reduced_f64(x: f32) -> f64 {
     x - turn * (x / turn).round()
 }
 
+/// The ground seen, in `f64`: `h cot α` over the part of the view's rays
+/// `[t − half, t + half]` (below the horizontal ahead; shifted by a turn
+/// for a tilt near −π) in `(0, π)`, with the part's ends `(a, b)`; near
+/// end `−∞` when the view reaches the horizon behind, far end `+∞` when it
+/// reaches the horizon ahead.
+fn ground_f64(h: f64, t: f64, half: f64) -> Option<(f64, f64, f64, f64)> {
+    use std::f64::consts::{PI, TAU};
+    [0.0, TAU].into_iter().find_map(|shift| {
+        let (upper, lower) = (t - half + shift, t + half + shift);
+        let (a, b) = (upper.max(0.0), lower.min(PI));
+        (a < b).then(|| {
+            let near = if lower >= PI {
+                f64::NEG_INFINITY
+            } else {
+                h / b.tan()
+            };
+            let far = if upper <= 0.0 {
+                f64::INFINITY
+            } else {
+                h / a.tan()
+            };
+            (near, far, a, b)
+        })
+    })
+}
+
+/// A camera looking steeply down or back sees the ground behind it too
+/// (an adversarial review: 80° down with a half field of view of 20°, and
+/// 23° down with 70°, were "no ground"), and one upside down sees the
+/// ground behind it; every tilt from −π to π with half fields of view
+/// from 0.01 to 1.5 rad against `f64`, away from the view's edges at the
+/// horizons (where `f32` and `f64` may fall on either side).
+#[test]
+fn ground_seen_at_every_tilt() {
+    let r = ground_interval(1.0, 80f32.to_radians(), 20f32.to_radians())
+        .unwrap()
+        .expect("ground seen");
+    assert!(
+        (r.lo - (-0.176_327)).abs() < 1e-4 && (r.hi - 0.577_350).abs() < 1e-4,
+        "{r:?}"
+    );
+    let r = ground_interval(1.0, 23f32.to_radians(), 70f32.to_radians())
+        .unwrap()
+        .expect("ground seen");
+    assert!(
+        r.hi.is_infinite() && (r.lo - (-0.052_408)).abs() < 1e-4,
+        "{r:?}"
+    );
+    let (mut seen, mut compared) = (0, 0);
+    for i in 0..=4000 {
+        let t = -std::f64::consts::PI + std::f64::consts::TAU * f64::from(i) / 4000.0;
+        for half in [0.01f64, 0.2, 0.7, 1.2, 1.5] {
+            let (tf, hf) = (t as f32, half as f32);
+            let (t64, h64) = (f64::from(tf), f64::from(hf));
+            // Away from the horizons' edges by 1e-5 rad.
+            let edge = [
+                0.0,
+                std::f64::consts::PI,
+                -std::f64::consts::PI,
+                std::f64::consts::TAU,
+            ]
+            .iter()
+            .any(|e| (t64 - h64 - e).abs() < 1e-5 || (t64 + h64 - e).abs() < 1e-5);
+            if edge {
+                continue;
+            }
+            compared += 1;
+            let got = ground_interval(2.0, tf, hf).unwrap().map(|r| (r.lo, r.hi));
+            let want = ground_f64(2.0, t64, h64);
+            match (got, want) {
+                (None, None) => {}
+                (Some((gn, gf)), Some((wn, wf, a, b))) => {
+                    seen += 1;
+                    let slope = |x: f64| 2.0 / (x.sin() * x.sin());
+                    assert!(
+                        close(gn, wn, 3e-7 * slope(b), 1e-5),
+                        "{t} {half}: {gn} vs {wn}"
+                    );
+                    assert!(
+                        close(gf, wf, 3e-7 * slope(a), 1e-5),
+                        "{t} {half}: {gf} vs {wf}"
+                    );
+                }
+                _ => panic!("tilt {t}, half {half}: {got:?} vs {want:?}"),
+            }
+        }
+    }
+    println!("{compared} views, {seen} see the ground");
+    assert!(
+        seen > compared / 3 && seen < compared,
+        "{seen} of {compared}"
+    );
+}
+
 /// The ground in view and the common rows, at every tilt of the table and
 /// with the half field of view of 480 rows at f = 800: the tilt is reduced
 /// (6 rad sees the ground that `6 − 2π` does not: it looks up), a half
@@ -232,30 +326,36 @@ fn ground_in_view_reduces_the_tilt() {
     {
         let t = reduced_f64(x);
         let (lower, upper) = (t + half_fov, t - half_fov);
-        let want = (lower > 0.0 && lower < std::f64::consts::FRAC_PI_2).then(|| {
-            let far = if upper > 0.0 {
-                h / upper.tan()
-            } else {
-                f64::INFINITY
-            };
-            (h / lower.tan(), far)
-        });
+        let want = ground_f64(h, t, half_fov);
         let got = ground_interval(h as f32, x, half_fov as f32)
             .unwrap()
             .map(|r| (r.lo, r.hi));
+        // `common_rows_motion`'s model: the ground ahead, the view's lower
+        // edge short of the vertical.
+        let ahead = lower > 0.0 && lower < std::f64::consts::FRAC_PI_2;
+        if !ahead {
+            assert_eq!(
+                common_rows_motion(h as f32, x, f as f32, rows as f32, w as f32),
+                Ok(None),
+                "θ = {x}"
+            );
+        }
         match (got, want) {
             (None, None) => {}
-            (Some((gn, gf)), Some((wn, wf))) => {
+            (Some((gn, gf)), Some((wn, wf, a, b))) => {
                 seen += 1;
                 let slope = |a: f64| h / (a.sin() * a.sin());
                 assert!(
-                    close(gn, wn, 3e-7 * slope(lower), 1e-5),
+                    close(gn, wn, 3e-7 * slope(b), 1e-5),
                     "θ = {x}: {gn} vs {wn}"
                 );
                 assert!(
-                    close(gf, wf, 3e-7 * slope(upper), 1e-5),
+                    close(gf, wf, 3e-7 * slope(a), 1e-5),
                     "θ = {x}: {gf} vs {wf}"
                 );
+                if !ahead {
+                    continue;
+                }
                 // Common rows (the docs' formula, in f64).
                 let row = |d: f64| f * ((h / d).atan() - t).tan();
                 let top = if wf.is_finite() {

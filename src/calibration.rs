@@ -573,7 +573,10 @@ impl Intrinsics {
 /// translations `(+t, +t, t)`, `(−t, +t, t)`, `(−t, −t, t)`, `(+t, −t, t)`
 /// (in that order: round the image, so neighbours are adjacent). Each
 /// within ±[`MAX_COORD_PX`]; [`CalibrationError::Overflow`] if a result
-/// would not be finite.
+/// would not be finite; [`CalibrationError::Degenerate`] if no `r² > 0`
+/// fits, or if the rolls the four FOEs give disagree (their mean turn
+/// shorter than half a unit: e.g. the four in mirrored order, which no
+/// roll of the model gives).
 pub fn calibrate_stepwise(
     straight: Pixel,
     diagonal: [Pixel; 4],
@@ -618,6 +621,15 @@ pub fn calibrate_stepwise(
         sin_sum += cross(*s, e) / (le * ls);
         // |D⁻¹ d| = √2 with D = f_y diag(r, 1): f_y = |(d_x / r, d_y)| / √2.
         fy_sum += sqrt(dk[0] * dk[0] / r2 + dk[1] * dk[1]) / ls;
+    }
+    // The four turns agree for FOEs the model can give (exactly, without
+    // noise: their sum is 4 long). Four that cancel (the diagonal FOEs in
+    // mirrored order, a reflection no roll gives) left the roll to
+    // `atan2(0, 0)` until an adversarial review: their mean is required
+    // to be at least half a unit long (each turn within 60° of it would
+    // do).
+    if !(sqrt(sin_sum * sin_sum + cos_sum * cos_sum) >= 2.0) {
+        return Err(CalibrationError::Degenerate);
     }
     let roll = -crate::math::atan2(sin_sum, cos_sum);
     let fy = fy_sum / 4.0;

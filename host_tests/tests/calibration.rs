@@ -673,3 +673,67 @@ fn intrinsics_methods_are_finite_or_typed_errors() {
         ))
     );
 }
+
+/// Diagonal FOEs no camera of the model gives are `Degenerate`, not a
+/// roll from `atan2(0, 0)` (an adversarial review: the four of a square
+/// in mirrored order gave `Ok` with roll 0, `f_x = f_y = 100`). The same
+/// four in the documented order still calibrate, at every roll.
+#[test]
+fn mirrored_diagonal_foes_are_degenerate() {
+    let p = Pixel::new;
+    let c = p(300.0, 200.0);
+    // Round the image in the documented order: (+,+), (−,+), (−,−), (+,−).
+    let ok = calibrate_stepwise(
+        c,
+        [
+            p(400.0, 300.0),
+            p(200.0, 300.0),
+            p(200.0, 100.0),
+            p(400.0, 100.0),
+        ],
+    )
+    .expect("the documented order");
+    assert!(
+        (ok.fx - 100.0).abs() < 1e-3 && (ok.fy - 100.0).abs() < 1e-3 && ok.roll.abs() < 1e-6,
+        "{ok:?}"
+    );
+    let mirrored = [
+        p(400.0, 300.0),
+        p(400.0, 100.0),
+        p(200.0, 100.0),
+        p(200.0, 300.0),
+    ];
+    assert_eq!(
+        calibrate_stepwise(c, mirrored),
+        Err(CalibrationError::Degenerate)
+    );
+    // Every roll of the documented order, and its mirror image. (At rolls
+    // of exactly ±45° and ±135° the fit of `r²` is degenerate, a known
+    // limit: those may be `Degenerate` too.)
+    let mut calibrated = 0;
+    for k in 0..360 {
+        let g = (k as f32).to_radians();
+        let (s, co) = (g.sin(), g.cos());
+        let turn = |x: f32, y: f32| p(300.0 + co * x - s * y, 200.0 + s * x + co * y);
+        let square = [
+            turn(100.0, 100.0),
+            turn(-100.0, 100.0),
+            turn(-100.0, -100.0),
+            turn(100.0, -100.0),
+        ];
+        if let Ok(k) = calibrate_stepwise(c, square) {
+            assert!(
+                (k.fx - 100.0).abs() < 0.1 && (k.fy - 100.0).abs() < 0.1,
+                "{g}: {k:?}"
+            );
+            calibrated += 1;
+        }
+        let [a, b, cc, d] = square;
+        assert_eq!(
+            calibrate_stepwise(c, [a, d, cc, b]),
+            Err(CalibrationError::Degenerate),
+            "roll {k}° mirrored"
+        );
+    }
+    assert!(calibrated >= 356, "{calibrated} of 360 rolls calibrated");
+}

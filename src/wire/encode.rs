@@ -18,8 +18,8 @@ use super::WireError;
 pub enum EncodeError {
     /// The output buffer is too small.
     BufferTooSmall,
-    /// A point is outside what the format holds (`[−1, 4094.9375]` px) or
-    /// not finite.
+    /// A point is outside what the format holds (`[−1, 4078.875]` px,
+    /// after rounding to the sixteenth) or not finite.
     PointRange,
     /// A radius is negative, NaN or above [`super::MAX_RADIUS_PX`].
     Radius,
@@ -33,7 +33,7 @@ impl fmt::Display for EncodeError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
             Self::BufferTooSmall => "output buffer too small",
-            Self::PointRange => "point outside [-1, 4094.9375] px or not finite",
+            Self::PointRange => "point outside [-1, 4078.875] px or not finite",
             Self::Radius => "error radius outside [0, 100] px",
             Self::TooLarge => "too many boundaries, points or bytes for the format",
         })

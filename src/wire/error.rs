@@ -7,9 +7,14 @@ use crate::{BoundaryError, CameraError, ConfigError, MotionError};
 /// Why a packet was not taken, or what the receiver noticed about one.
 ///
 /// Every error but [`WireError::CounterJump`] discards the packet, and
-/// none of them changes the decoder's counters, its camera or the
-/// processor's kept state: the next good packet gives exactly what it
-/// would have given had the bad one never come.
+/// none of them changes the decoder's camera or the processor's kept
+/// state. Nor its counters, with one exception (`docs/wire.md`): a packet
+/// intact up to its content (CRC, header and counter checked out, the
+/// content then rejected) records its counter as received, so the next
+/// good packet of its data id counts it neither missed nor repeated.
+/// Otherwise the next good packet gives exactly what it would have given
+/// had the bad one never come. (An adversarial review found this
+/// paragraph claiming no exception.)
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]

@@ -402,3 +402,41 @@ fn result_packet_carries_the_deadline_flag() {
     let (structure, expired, ok, over) = parse(&raw[..n]);
     assert!(structure && !expired && over == 0 && ok > 0, "{ok} ok");
 }
+
+/// `px_to_raw` rounds to the nearest sixteenth exactly (a tie upwards),
+/// and says `None` exactly where the rounded value is below −1 px or above
+/// 4078.875 px: against `f64` at the 64 `f32` on either side of every
+/// sixteenth's midpoint (where a double rounding would show; the review's
+/// 0.031248987 and −1.0312504 among them) and at ends of the range.
+#[test]
+fn px_to_raw_rounds_exactly() {
+    let want = |px: f32| -> Option<u16> {
+        let y = f64::from(px) * 16.0;
+        let n = (y + 0.5).floor();
+        let raw = n + 273.0;
+        (px.is_finite() && (257.0..=65535.0).contains(&raw)).then_some(raw as u16)
+    };
+    assert_eq!(px_to_raw(0.031_248_987), Some(273));
+    assert_eq!(px_to_raw(-1.031_250_4), None);
+    assert_eq!(px_to_raw(-1.0), Some(RAW_MINUS_ONE_PX));
+    assert_eq!(px_to_raw(4078.875), Some(u16::MAX));
+    assert_eq!(px_to_raw(4078.91), None);
+    for v in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1.0e9, -1.0e9] {
+        assert_eq!(px_to_raw(v), None, "{v}");
+    }
+    let mut checked = 0u32;
+    // Every midpoint `(k + 1/2)/16` px from −2 px to 4100 px, every 7th.
+    let mut k = -33i32;
+    while k < 65_600 {
+        let mid = (k as f32 + 0.5) / 16.0;
+        let bits = mid.to_bits();
+        for d in 0..=128u32 {
+            let b = (bits + d).wrapping_sub(64);
+            let px = f32::from_bits(b);
+            assert_eq!(px_to_raw(px), want(px), "{px:e} ({b:#x})");
+            checked += 1;
+        }
+        k += 7;
+    }
+    assert!(checked > 1_000_000, "{checked}");
+}

@@ -1,6 +1,7 @@
 //! Road geometry from the reconstruction (paper, Sec. 4.2.1): camera height
-//! above the road, camera tilt and road width, each as the range consistent
-//! with the sticks, without prior knowledge of any of them.
+//! above the road and camera tilt, each as a range that holds every value
+//! consistent with the sticks, and the road width estimated from them,
+//! without prior knowledge of any of them.
 //!
 //! The near road is taken as a plane. With zero roll, a plane at height `h`
 //! below a camera tilted down by `θ` is `Y cos θ + Z sin θ = h` in camera
@@ -75,7 +76,8 @@ impl Range {
     }
 }
 
-/// Camera height, tilt (radians) and road width consistent with the sticks.
+/// Camera height and tilt (radians) consistent with the sticks, and the
+/// road width estimated from them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct RoadGeometry {
@@ -83,8 +85,11 @@ pub struct RoadGeometry {
     pub height: Range,
     /// Camera tilt below the horizontal, radians.
     pub tilt: Range,
-    /// Road width, length units.
-    pub width: Range,
+    /// Road width, length units: an estimate (module docs); `None` when
+    /// no view gives one (every point of a boundary at or beyond the
+    /// horizon of every consistent tilt, where its ground position is not
+    /// finite). The height and tilt ranges do not depend on it.
+    pub width: Option<Range>,
     /// Points that may disagree (wrong matches) at each tilt.
     pub outliers_allowed: usize,
 }
@@ -110,8 +115,12 @@ pub enum GeometryError {
     TooFewPoints,
     /// More points on a boundary than the capacity `N`.
     TooManyPoints,
-    /// More than [`MAX_VIEWS`] views.
+    /// More than [`MAX_VIEWS`] views, or more boundaries (two a view)
+    /// than the capacity `N` can take a point of each.
     TooManyViews,
+    /// `outliers` is not below the number of points of the plane fit:
+    /// every `(θ, h)` would agree with all but `outliers` of them.
+    TooManyOutliers,
     /// A coordinate or stick end of this sample is NaN or infinite.
     NotFinite(SampleIndex),
     /// This sample is finite but outside the accepted ranges: `|x|` or
@@ -136,7 +145,12 @@ impl fmt::Display for GeometryError {
         match self {
             Self::TooFewPoints => f.write_str("too few reconstructed points on a boundary"),
             Self::TooManyPoints => f.write_str("more points on a boundary than the capacity"),
-            Self::TooManyViews => f.write_str("more views than MAX_VIEWS"),
+            Self::TooManyViews => {
+                f.write_str("more views than MAX_VIEWS, or than the capacity takes")
+            }
+            Self::TooManyOutliers => {
+                f.write_str("outliers allowed not below the points of the plane fit")
+            }
             Self::NotFinite(i) => at(f, i, "is NaN or infinite"),
             Self::OutOfRange(i) => at(f, i, "is out of range"),
             Self::Inconsistent => f.write_str("no ground plane is consistent with the sticks"),
@@ -382,25 +396,68 @@ fn check_views<const N: usize>(views: &[(&[Sample], &[Sample])]) -> Result<(), G
 
 /// Step 2 of [`road_geometry`]: the points of the plane fit, copied into
 /// `all` — every boundary of every view (the road is taken as planar over
-/// the points given; pass the near part of a hilly road), up to
-/// `max(N / (2 · views), 5)` of each, nearest first, and no more than `N`.
+/// the points given; pass the near part of a hilly road). When they do not
+/// all fit in `N`, each boundary keeps its `q` nearest (by the stick's
+/// middle, whatever their order), `q` the largest share with which the
+/// boundaries' points fit: every view keeps points, the farther ones of
+/// the longest boundaries are left out first. (Until an adversarial review
+/// each boundary gave its first `max(N / (2 · views), 5)` points in the
+/// order given, and views past the capacity none: 16 views of which the
+/// last 9 disagreed with the first 7 came out consistent at `N = 64`.)
+/// [`GeometryError::TooManyViews`] when `N` cannot take one point of every
+/// boundary.
+///
+/// Work: `O(N)` per share tried (at most `N`), and a sort of each
+/// boundary's depths that does not fit.
 fn plane_points<'a, const N: usize>(
     views: &[(&[Sample], &[Sample])],
     all: &'a mut [Sample; N],
-) -> &'a [Sample] {
-    let share = (N / (2 * views.len().max(1))).max(5);
+) -> Result<&'a [Sample], GeometryError> {
+    let sides = || views.iter().flat_map(|(l, r)| [*l, *r]);
+    let taken = |q: usize| {
+        sides()
+            .map(|side| side.len().min(q))
+            .fold(0usize, usize::saturating_add)
+    };
+    // The largest share that fits (the sides are at most `N` long, so a
+    // share of `N` takes every point).
+    let mut q = 0;
+    while q < N && taken(q + 1) <= N {
+        q += 1;
+    }
+    if q == 0 {
+        return Err(GeometryError::TooManyViews);
+    }
     let mut n = 0;
-    for (l, r) in views {
-        for side in [*l, *r] {
-            for p in side.iter().take(share) {
-                if let Some(slot) = all.get_mut(n) {
-                    *slot = *p;
-                    n += 1;
-                }
+    let mut keys = [0.0f32; N];
+    for side in sides() {
+        // The `q`-th least middle of the side's sticks (all of them when
+        // the side fits): the points below it, then those at it, up to `q`.
+        let cut = if side.len() > q {
+            let k = keys.get_mut(..side.len()).unwrap_or_default();
+            for (key, p) in k.iter_mut().zip(side) {
+                *key = middle(p);
+            }
+            k.sort_unstable_by(f32::total_cmp);
+            k.get(q - 1).copied().unwrap_or(f32::INFINITY)
+        } else {
+            f32::INFINITY
+        };
+        let below = side.iter().filter(|p| middle(p) < cut);
+        let at = side.iter().filter(|p| middle(p) == cut);
+        for p in below.chain(at).take(q) {
+            if let Some(slot) = all.get_mut(n) {
+                *slot = *p;
+                n += 1;
             }
         }
     }
-    all.get(..n).unwrap_or_default()
+    Ok(all.get(..n).unwrap_or_default())
+}
+
+/// The middle of a sample's stick (finite: the sticks are validated).
+fn middle(p: &Sample) -> f32 {
+    0.5 * p.z_near + 0.5 * p.z_far
 }
 
 /// The ranges [`road_geometry`] accumulates over the tilt cells.
@@ -430,21 +487,24 @@ impl Hull {
         }
     }
 
-    /// Step 4 of [`road_geometry`]: a result if any tilt cell fitted and
-    /// gave a width.
+    /// Step 4 of [`road_geometry`]: a result if any tilt cell fitted (the
+    /// width if any of them gave one). (Until an adversarial review a
+    /// result needed a width too: sticks consistent with a tilt and a
+    /// height, but whose points of one boundary were all near the horizon,
+    /// came out [`GeometryError::Inconsistent`].)
     fn finish(self, outliers: usize) -> Result<RoadGeometry, GeometryError> {
         let Hull {
             tilt,
             height,
             width,
         } = self;
-        if !(tilt.lo.is_finite() && width.lo.is_finite()) {
+        if !tilt.lo.is_finite() {
             return Err(GeometryError::Inconsistent);
         }
         Ok(RoadGeometry {
             height,
             tilt,
-            width,
+            width: width.lo.is_finite().then_some(width),
             outliers_allowed: outliers,
         })
     }
@@ -456,18 +516,23 @@ impl Hull {
 /// e.g. successive frame pairs. A `(θ, h)` must agree with the points of
 /// all views (all but `outliers` of them, for wrong matches); the width is
 /// the median over the views of each view's median boundary distance. `N`
-/// is the capacity for all points together; more are left out (the
-/// farther points of each view first).
+/// is the capacity for the plane fit's points together; when there are
+/// more, every boundary of every view keeps the same number of its
+/// nearest points (by the stick's middle, in any order given), as many as
+/// fit, and the farther ones are left out.
 ///
-/// Input: 1 to [`MAX_VIEWS`] views, [`MIN_POINTS`] to `N` samples on each
-/// boundary, every sample finite with `|x|, |y| ≤` [`MAX_NORMALISED`] and
-/// `0 ≤ z_near ≤ z_far ≤` [`MAX_SAMPLE_DEPTH`]; anything else is a typed
-/// error naming the first bad sample.
+/// Input: 1 to [`MAX_VIEWS`] views, no more boundaries (`2 · views`) than
+/// `N`, [`MIN_POINTS`] to `N` samples on each boundary, every sample
+/// finite with `|x|, |y| ≤` [`MAX_NORMALISED`] and `0 ≤ z_near ≤ z_far ≤`
+/// [`MAX_SAMPLE_DEPTH`], `outliers` below the plane fit's points; anything
+/// else is a typed error (naming the first bad sample).
 ///
 /// The height and tilt ranges hold every `(θ, h)` with `θ` in `[0°, 60°]`
 /// that agrees with the sticks of all but `outliers` of the plane-fit
 /// points (module docs: a superset, by the widening over a 0.003°
-/// part of a cell); the width range is an estimate.
+/// part of a cell), and [`GeometryError::Inconsistent`] means no such
+/// `(θ, h)` exists; the width range is an estimate, `None` when no view
+/// gives one.
 ///
 /// Work: `G = 1200` tilt cells (a constant), each with `O(M log M)` for
 /// the heights of the `M ≤ N` plane-fit points (16 times more in a cell
@@ -482,7 +547,10 @@ pub fn road_geometry<const N: usize>(
     check_views::<N>(views)?;
     // 2. Gather the points of the plane fit.
     let mut all = [Sample::default(); N];
-    let points = plane_points(views, &mut all);
+    let points = plane_points(views, &mut all)?;
+    if outliers >= points.len() {
+        return Err(GeometryError::TooManyOutliers);
+    }
     // 3. Sweep the tilt cells: heights consistent in each, and widths at
     // its ends (each grid tilt's width made once, when a cell needs it).
     let mut hull = Hull {

@@ -1335,6 +1335,7 @@ fn road_geometry_from_the_fused_map() {
             let points: usize = sets.iter().map(|(l, r)| l.len() + r.len()).sum();
             assert!(!views.is_empty(), "{what}");
             let g = road_geometry::<CAP>(&views, 0).expect("geometry");
+            let width = g.width.expect("a width");
             let (tl, th) = (g.tilt.lo.to_degrees(), g.tilt.hi.to_degrees());
             lines.push(format!(
                 "| {what}: {} key frames of {partners} partners ({points} points) | {:.2}–{:.2} ({:.2}) | {tl:.1}–{th:.1}° ({:.1}°) | {:.2}–{:.2} ({:.2}) |",
@@ -1343,19 +1344,19 @@ fn road_geometry_from_the_fused_map() {
                 g.height.hi,
                 g.height.width(),
                 th - tl,
-                g.width.lo,
-                g.width.hi,
-                g.width.width()
+                width.lo,
+                width.hi,
+                width.width()
             ));
             assert!(
                 g.height.contains(2.0)
                     && g.tilt.contains(23f32.to_radians())
-                    && g.width.contains(2.6),
+                    && width.contains(2.6),
                 "{what}: {g:?}"
             );
             // Under half the paper's ranges.
             assert!(
-                g.height.width() <= 0.20 && th - tl <= 2.0 && g.width.width() <= 0.30,
+                g.height.width() <= 0.20 && th - tl <= 2.0 && width.width() <= 0.30,
                 "{what}: {g:?}"
             );
         }

@@ -3,7 +3,7 @@
 //! frames, 512 × 480, f = 800, quantised boundaries.
 
 use host_tests::{frame, reconstruct, synth};
-use roadstereo::geometry::{road_geometry, samples, Range, RoadGeometry, Sample};
+use roadstereo::geometry::{road_geometry, samples, GeometryError, Range, RoadGeometry, Sample};
 use roadstereo::{Config, Processor, Step};
 
 const N: usize = host_tests::N;
@@ -30,6 +30,12 @@ fn alv(curvature: f64, heading_deg: f64) -> synth::Scenario {
     s
 }
 
+/// The width range, which these roads (both boundaries seen below the
+/// horizon) always give.
+fn width(g: &RoadGeometry) -> Range {
+    g.width.expect("a width")
+}
+
 /// The three ranges as "lo–hi (width)", tilt in degrees.
 fn cells(g: &RoadGeometry) -> [String; 3] {
     let cell = |r: &Range, scale: f32, digits: usize| {
@@ -39,7 +45,7 @@ fn cells(g: &RoadGeometry) -> [String; 3] {
     [
         cell(&g.height, 1.0, 2),
         cell(&g.tilt, 1f32.to_degrees(), 1),
-        cell(&g.width, 1.0, 2),
+        cell(&width(g), 1.0, 2),
     ]
 }
 
@@ -68,7 +74,7 @@ fn alv_geometry_ranges_contain_the_truth() {
         let s = alv(k, h);
         let (left, right) = boundary_samples(&s);
         let g0 = road_geometry::<N>(&[(&left, &right)], 0).expect("geometry");
-        println!("  (no outlier allowance: height {:.2}–{:.2}, tilt {:.1}–{:.1}, width {:.2}–{:.2}; {} + {} points)", g0.height.lo, g0.height.hi, g0.tilt.lo.to_degrees(), g0.tilt.hi.to_degrees(), g0.width.lo, g0.width.hi, left.len(), right.len());
+        println!("  (no outlier allowance: height {:.2}–{:.2}, tilt {:.1}–{:.1}, width {:.2}–{:.2}; {} + {} points)", g0.height.lo, g0.height.hi, g0.tilt.lo.to_degrees(), g0.tilt.hi.to_degrees(), width(&g0).lo, width(&g0).hi, left.len(), right.len());
         let g = road_geometry::<N>(&[(&left, &right)], 3).expect("geometry");
         let tilt_deg = (g.tilt.lo.to_degrees(), g.tilt.hi.to_degrees());
         let [h, t, w] = cells(&g);
@@ -78,11 +84,11 @@ fn alv_geometry_ranges_contain_the_truth() {
             g.tilt.contains(23f32.to_radians()),
             "{name}: tilt {tilt_deg:?}"
         );
-        assert!(g.width.contains(2.6), "{name}: width {:?}", g.width);
+        assert!(width(&g).contains(2.6), "{name}: width {:?}", g.width);
         // Not vacuous: a tenth of the value or tighter (the widths are
         // printed next to the paper's above).
         assert!(
-            g.height.width() <= 1.0 && g.width.width() <= 0.8,
+            g.height.width() <= 1.0 && width(&g).width() <= 0.8,
             "{name}: {g:?}"
         );
         assert!(tilt_deg.1 - tilt_deg.0 <= 8.0, "{name}: tilt range");
@@ -101,7 +107,7 @@ fn wrong_matches_are_tolerated() {
     }
     let g = road_geometry::<N>(&[(&left, &right)], 3).expect("geometry");
     assert!(
-        g.height.contains(2.0) && g.tilt.contains(23f32.to_radians()) && g.width.contains(2.6),
+        g.height.contains(2.0) && g.tilt.contains(23f32.to_radians()) && width(&g).contains(2.6),
         "{g:?}"
     );
     // Without the allowance the same data has no consistent plane near the truth.
@@ -169,7 +175,9 @@ fn key_frames_narrow_the_ranges() {
             views.len()
         );
         assert!(
-            g.height.contains(2.0) && g.tilt.contains(23f32.to_radians()) && g.width.contains(2.6),
+            g.height.contains(2.0)
+                && g.tilt.contains(23f32.to_radians())
+                && width(&g).contains(2.6),
             "{g:?}"
         );
         if outliers == 0 {
@@ -179,7 +187,11 @@ fn key_frames_narrow_the_ranges() {
                 g.height.width()
             );
             assert!(tilt.1 - tilt.0 <= 2.0, "tilt range {}", tilt.1 - tilt.0);
-            assert!(g.width.width() <= 0.30, "width range {}", g.width.width());
+            assert!(
+                width(&g).width() <= 0.30,
+                "width range {}",
+                width(&g).width()
+            );
         }
     }
 }
@@ -228,7 +240,7 @@ fn planar_road_gives_the_truth_also_with_extreme_accepted_samples() {
     use roadstereo::geometry::{MAX_NORMALISED, MAX_SAMPLE_DEPTH};
     let (left, mut right) = planar_road(12);
     let check = |g: &RoadGeometry| {
-        for r in [g.height, g.tilt, g.width] {
+        for r in [g.height, g.tilt, width(g)] {
             assert!(
                 r.lo.is_finite() && r.hi.is_finite() && r.lo <= r.hi,
                 "{g:?}"
@@ -236,10 +248,10 @@ fn planar_road_gives_the_truth_also_with_extreme_accepted_samples() {
         }
         assert!(g.height.contains(1.5), "{g:?}");
         assert!(g.tilt.contains(20f32.to_radians()), "{g:?}");
-        assert!(g.width.contains(2.6), "{g:?}");
+        assert!(width(g).contains(2.6), "{g:?}");
         // Not vacuous: well inside what any camera could have.
         assert!(g.height.lo >= 1.0 && g.height.hi <= 2.0, "{g:?}");
-        assert!(g.width.lo >= 2.0 && g.width.hi <= 3.2, "{g:?}");
+        assert!(width(g).lo >= 2.0 && width(g).hi <= 3.2, "{g:?}");
     };
     let g = within_seconds(30, {
         let (l, r) = (left.clone(), right.clone());
@@ -446,6 +458,129 @@ fn the_reviewers_tilts_between_grid_tilts() {
             g.tilt.contains(tilt_deg.to_radians() as f32),
             "{tilt_deg}°: {:?}",
             g.tilt
+        );
+    }
+}
+
+/// A ground point `(x, z)` (lateral, forward) of a plane `h` below a camera
+/// tilted `tilt` down, as a sample with a stick of `±eps` of its camera
+/// depth, computed in `f64`.
+fn ground_sample(h: f64, tilt: f64, x: f64, z: f64, eps: f64) -> Sample {
+    let (s, c) = tilt.sin_cos();
+    let (yc, zc) = (h * c - z * s, z * c + h * s);
+    Sample {
+        x: (x / zc) as f32,
+        y: (yc / zc) as f32,
+        z_near: (zc * (1.0 - eps)) as f32,
+        z_far: (zc * (1.0 + eps)) as f32,
+    }
+}
+
+/// An adversarial review: views past what the capacity holds were left
+/// out whole (16 views, the last 9 at another height, came out consistent
+/// at `N = 64`), and a boundary given far to near gave its far points to
+/// the plane fit. Every boundary now keeps its nearest points, as many as
+/// fit, whatever its order.
+#[test]
+fn every_view_and_the_nearest_points_enter_the_plane_fit() {
+    let tilt = 20f64.to_radians();
+    let side = |h: f64, x: f64| -> Vec<Sample> {
+        (0..12)
+            .map(|i| ground_sample(h, tilt, x, 4.0 + i as f64, 0.002))
+            .collect()
+    };
+    let sets: Vec<(Vec<Sample>, Vec<Sample>)> = (0..16)
+        .map(|v| {
+            let h = if v < 7 { 1.5 } else { 3.0 };
+            (side(h, -1.3), side(h, 1.3))
+        })
+        .collect();
+    let views: Vec<(&[Sample], &[Sample])> = sets
+        .iter()
+        .map(|(l, r)| (l.as_slice(), r.as_slice()))
+        .collect();
+    // No `(θ, h)` fits both heights, whatever the capacity.
+    for g in [
+        road_geometry::<64>(&views, 0),
+        road_geometry::<1024>(&views, 0),
+    ] {
+        assert_eq!(g, Err(GeometryError::Inconsistent), "{g:?}");
+    }
+    // The first 7 views alone are consistent with their height.
+    let g = road_geometry::<64>(&views[..7], 0).expect("geometry");
+    assert!(
+        g.height.contains(1.5) && g.tilt.contains(tilt as f32),
+        "{g:?}"
+    );
+    // Fewer than one point a boundary: an error, not a silent drop.
+    assert_eq!(
+        road_geometry::<31>(&views, 0),
+        Err(GeometryError::TooManyViews)
+    );
+
+    // Ten points on the plane (2 to 12 ahead), five on a hill beyond it:
+    // with room for ten a boundary, the plane's points are the ones kept,
+    // given near to far or far to near.
+    let hill = |x: f64| -> Vec<Sample> {
+        let mut v: Vec<Sample> = (0..10)
+            .map(|i| ground_sample(1.5, tilt, x, 2.0 + 10.0 * i as f64 / 9.0, 0.002))
+            .collect();
+        // Rising ground: 0.3 higher every 3 ahead past 12.
+        v.extend((0..5).map(|i| {
+            let z = 14.0 + 3.0 * i as f64;
+            ground_sample(1.5 - 0.3 * (i as f64 + 1.0), tilt, x, z, 0.002)
+        }));
+        v
+    };
+    let (l, r) = (hill(-1.3), hill(1.3));
+    let (mut lr, mut rr) = (l.clone(), r.clone());
+    lr.reverse();
+    rr.reverse();
+    let near_first = road_geometry::<20>(&[(&l, &r)], 0).expect("near first");
+    let far_first = road_geometry::<20>(&[(&lr, &rr)], 0).expect("far first");
+    for g in [near_first, far_first] {
+        assert!(
+            g.height.contains(1.5) && g.tilt.contains(tilt as f32),
+            "{g:?}"
+        );
+        assert!(g.height.width() < 0.1, "{g:?}");
+    }
+    assert_eq!(near_first, far_first);
+    // With room for all of them the hill's points disagree with the plane.
+    assert_eq!(
+        road_geometry::<64>(&[(&l, &r)], 0),
+        Err(GeometryError::Inconsistent)
+    );
+}
+
+/// An adversarial review: a boundary seen only at the horizon (no finite
+/// ground position, so no width) made the whole answer `Inconsistent`
+/// although a tilt and a height agree with every stick; and an `outliers`
+/// allowance of every point made it `Inconsistent` too, where every
+/// `(θ, h)` agrees.
+#[test]
+fn no_width_is_no_width_and_every_point_allowed_is_an_error() {
+    let (h, tilt) = (0.3f64, 60f64.to_radians());
+    let left: Vec<Sample> = (0..10)
+        .map(|i| ground_sample(h, tilt, -0.5, 1.0 + 0.5 * i as f64, 1e-4))
+        .collect();
+    // The right boundary 10⁶ ahead: its rays meet the ground at a
+    // slope under 10⁻⁶, past where the width is taken.
+    let right: Vec<Sample> = (0..10)
+        .map(|i| ground_sample(h, tilt, 2.0 + 0.1 * i as f64, 1.0e6, 1e-3))
+        .collect();
+    let g = road_geometry::<64>(&[(&left, &right)], 0).expect("geometry");
+    assert!(g.width.is_none(), "{g:?}");
+    assert!(
+        g.height.contains(h as f32) && g.tilt.contains(tilt as f32),
+        "{g:?}"
+    );
+    let (l, r) = planar_road(12);
+    assert!(road_geometry::<64>(&[(&l, &r)], 23).is_ok());
+    for outliers in [24, 25, usize::MAX] {
+        assert_eq!(
+            road_geometry::<64>(&[(&l, &r)], outliers),
+            Err(GeometryError::TooManyOutliers)
         );
     }
 }

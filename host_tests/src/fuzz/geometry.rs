@@ -123,7 +123,7 @@ pub fn generate(src: &mut Source) -> Case {
 }
 
 /// The documented input error of `views`, if any.
-fn expected_error(views: &[(&[Sample], &[Sample])]) -> Option<GeometryError> {
+fn expected_error(views: &[(&[Sample], &[Sample])], outliers: usize) -> Option<GeometryError> {
     if views.is_empty() {
         return Some(GeometryError::TooFewPoints);
     }
@@ -160,6 +160,14 @@ fn expected_error(views: &[(&[Sample], &[Sample])]) -> Option<GeometryError> {
             }
         }
     }
+    // The plane fit: every point if they fit, else the same largest share
+    // of each boundary that fits (at least one each: 2 · 16 ≤ CAP).
+    let lens: Vec<usize> = views.iter().flat_map(|(l, r)| [l.len(), r.len()]).collect();
+    let taken = |q: usize| lens.iter().map(|&n| n.min(q)).sum::<usize>();
+    let q = (1..=CAP).take_while(|&q| taken(q) <= CAP).last()?;
+    if outliers >= taken(q) {
+        return Some(GeometryError::TooManyOutliers);
+    }
     None
 }
 
@@ -176,7 +184,7 @@ pub fn check(case: &Case) -> Outcome {
         .map(|(l, r)| (l.as_slice(), r.as_slice()))
         .collect();
     let r = road_geometry::<CAP>(&views, case.outliers);
-    let want = expected_error(&views);
+    let want = expected_error(&views, case.outliers);
     let bit = match (&r, want) {
         (Err(e), Some(w)) => {
             assert_eq!(*e, w, "road_geometry: input error");
@@ -201,7 +209,12 @@ pub fn check(case: &Case) -> Outcome {
             7
         }
         (Ok(g), None) => {
-            for (name, x) in [("height", g.height), ("tilt", g.tilt), ("width", g.width)] {
+            let ranges = [
+                ("height", Some(g.height)),
+                ("tilt", Some(g.tilt)),
+                ("width", g.width),
+            ];
+            for (name, x) in ranges.into_iter().filter_map(|(n, x)| Some((n, x?))) {
                 assert!(
                     x.lo.is_finite() && x.hi.is_finite() && x.lo <= x.hi,
                     "road_geometry: {name} {x:?} in {g:?}"

@@ -53,10 +53,12 @@ pub fn camera_to_vehicle(p: [f32; 3], tilt: f32) -> Result<[f32; 3], AngleError>
 
 /// Eq. 3.1: vertical disparity (pixels) of a ground point at distance `z`
 /// for an untilted camera at height `h` moving forward by `w`
-/// (`U = V = 0`): `d_y = f h w / (z (z − w))`. Infinite when `z ≤ w`.
+/// (`U = V = 0`): `d_y = f h w / (z (z − w))`. Infinite when the point is
+/// not in front of both cameras (`z ≤ 0` or `z ≤ w`). (Until an adversarial
+/// review only the product was tested, positive for a point behind both.)
 pub fn disparity_flat(f: f32, h: f32, w: f32, z: f32) -> f32 {
     let den = z * (z - w);
-    if den > 0.0 {
+    if z > 0.0 && z - w > 0.0 && den > 0.0 {
         f * h * w / den
     } else {
         f32::INFINITY
@@ -86,7 +88,8 @@ pub fn disparity_tilted(f: f32, h: f32, w: f32, z: f32, tilt: f32) -> Result<f32
 /// camera and negative behind it. The far end is `+∞` when the upper
 /// edge of the view is at or above the horizon ahead, the near end `−∞`
 /// when the lower edge is at or past the horizon behind. `Ok(None)` if the
-/// ground is not seen. `half_fov` must be in `(0, π/2)`
+/// ground is not seen, and when `h` is not positive and finite (no camera
+/// above a ground). `half_fov` must be in `(0, π/2)`
 /// ([`AngleError::OutOfDomain`] otherwise); `tilt` is reduced to `[−π, π]`.
 ///
 /// A ray at the angle `α` below the horizontal ahead meets the ground
@@ -106,6 +109,10 @@ pub fn ground_interval(h: f32, tilt: f32, half_fov: f32) -> Result<Option<Range>
         return Err(AngleError::OutOfDomain);
     }
     let tilt = reduce_angle(tilt)?;
+    // (A NaN fails.)
+    if !(h > 0.0 && h < f32::INFINITY) {
+        return Ok(None);
+    }
     // `h cot α` for `α` in `(0, π)` (the tangent of the forward rays as
     // [`ground_in_view`] takes it, the same bits there).
     let at = |a: f32| {
@@ -192,8 +199,11 @@ pub fn motion_factor(n: f32, w: f32, z_prime: f32, tilt: f32) -> Result<f32, Ang
 /// The rows lost are those of the strip the vehicle drives past.
 /// `Ok(None)` if the ground is not seen ahead with the view's lower edge
 /// short of the vertical (`tilt + half_fov < π/2`, the model of rows
-/// here), or `rows`, `f_y` do not give a field of view; `tilt` is reduced
-/// to `[−π, π]`.
+/// here), or `rows`, `f_y` do not give a field of view, or `h` is not
+/// positive and finite, or `w` not at least 0 and finite (the model is a
+/// camera above the ground moving forward; until an adversarial review a
+/// NaN height gave `Some(0)` and a backward `w` a "fraction" of 1.53);
+/// `tilt` is reduced to `[−π, π]`.
 pub fn common_rows_motion(
     h: f32,
     tilt: f32,
@@ -202,6 +212,10 @@ pub fn common_rows_motion(
     w: f32,
 ) -> Result<Option<f32>, AngleError> {
     let tilt = reduce_angle(tilt)?;
+    // (A NaN fails.)
+    if !(h > 0.0 && h < f32::INFINITY && w >= 0.0 && w < f32::INFINITY) {
+        return Ok(None);
+    }
     let half = rows * 0.5;
     let half_fov = atan(half / f_y);
     if !(half_fov > 0.0 && half_fov < core::f32::consts::FRAC_PI_2) {

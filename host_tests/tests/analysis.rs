@@ -225,3 +225,47 @@ fn axis_misalignment_against_quantisation_error() {
         assert!(far2 < 1.0, "W {w}: 2° ratio beyond Z = 3: {far2}");
     }
 }
+
+/// An adversarial review: `disparity_flat` gave finite disparities for
+/// points behind both cameras (`z (z − w) > 0` with both factors
+/// negative), and the ground functions took heights and motions outside
+/// their model (a NaN height seen as `Some(0)`, a backward motion as a
+/// "fraction" of 1.53, a negative height as a range with its ends
+/// swapped). Points behind a camera have no disparity; the rest is `None`.
+#[test]
+fn points_behind_and_heights_outside_the_model() {
+    for (w, z) in [
+        (0.5f32, -1.0f32),
+        (-0.5, -1.0),
+        (0.5, 0.0),
+        (0.5, 0.5),
+        (2.0, 1.0),
+    ] {
+        assert_eq!(
+            disparity_flat(800.0, 1.0, w, z),
+            f32::INFINITY,
+            "w {w} z {z}"
+        );
+    }
+    // In front of both: as eq. 3.1 gives it (backwards too).
+    let d = disparity_flat(800.0, 1.0, -0.5, 4.0);
+    assert!((d - 800.0 * -0.5 / (4.0 * 4.5)).abs() < 1e-4, "{d}");
+    let tilt = 20f32.to_radians();
+    for h in [0.0f32, -1.0, f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        assert_eq!(ground_interval(h, tilt, 0.3), Ok(None), "h {h}");
+        assert_eq!(
+            common_rows_motion(h, tilt, 800.0, 480.0, 0.5),
+            Ok(None),
+            "h {h}"
+        );
+    }
+    for w in [-0.5f32, f32::NAN, f32::INFINITY] {
+        assert_eq!(
+            common_rows_motion(1.0, tilt, 800.0, 480.0, w),
+            Ok(None),
+            "w {w}"
+        );
+    }
+    assert!(matches!(common_rows_motion(1.0, tilt, 800.0, 480.0, 0.0), Ok(Some(f)) if f > 0.99));
+    assert!(ground_interval(1.0, tilt, 0.3).unwrap().is_some());
+}

@@ -213,7 +213,7 @@ pub fn common_rows_motion(
 ) -> Result<Option<f32>, AngleError> {
     let tilt = reduce_angle(tilt)?;
     // (A NaN fails.)
-    if !(h > 0.0 && h < f32::INFINITY && w >= 0.0 && w < f32::INFINITY) {
+    if !(h > 0.0 && h < f32::INFINITY && (0.0..f32::INFINITY).contains(&w)) {
         return Ok(None);
     }
     let half = rows * 0.5;

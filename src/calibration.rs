@@ -574,9 +574,16 @@ impl Intrinsics {
 /// (in that order: round the image, so neighbours are adjacent). Each
 /// within ±[`MAX_COORD_PX`]; [`CalibrationError::Overflow`] if a result
 /// would not be finite; [`CalibrationError::Degenerate`] if no `r² > 0`
-/// fits, or if the rolls the four FOEs give disagree (their mean turn
+/// fits, if the rolls the four FOEs give disagree (their mean turn
 /// shorter than half a unit: e.g. the four in mirrored order, which no
-/// roll of the model gives).
+/// roll of the model gives), or if the fit is ill-conditioned: the roll
+/// within about 2.9° of 45° + k·90° ([`MIN_STEPWISE_CONDITION`]), where
+/// the diagonal FOEs lie near the image axes and the perpendicularity
+/// test cannot tell the aspect ratio. Elsewhere an FOE error of `δ` px
+/// moves `r² = (f_x/f_y)²` by about `4 δ / (L |cos 2γ|)` of itself, `L`
+/// the diagonal FOEs' distance from the straight one (at the limit, `δ =
+/// 0.5` and `L = 1 000`: 2 %); away from those rolls the error is about
+/// `4 δ / L`.
 pub fn calibrate_stepwise(
     straight: Pixel,
     diagonal: [Pixel; 4],
@@ -606,6 +613,32 @@ pub fn calibrate_stepwise(
         return Err(CalibrationError::Degenerate);
     }
     let r = sqrt(r2);
+    // The fit's conditioning: in the corrected offsets `e = (d_x, r d_y)`
+    // adjacent FOEs are perpendicular, `|b| r² = |e_p| |e_q| |cos 2γ| / 2`
+    // at the roll `γ`, so the mean of `r² |b| / (|e_p| |e_q|)` is `|cos 2γ|
+    // / 2`; an FOE error of `δ` px moves `r²` by about `4 δ / (L |cos
+    // 2γ|)` of itself (`L` the offsets' length), unbounded towards rolls of
+    // 45° + k·90°, where the diagonal FOEs lie on the image axes and every
+    // product is near 0. Below [`MIN_STEPWISE_CONDITION`]: `Degenerate`.
+    // (Until an adversarial review only the exact roll was, and 44.9° with
+    // FOEs on the pixel grid gave f_x 545, f_y 890 for 600, 800.)
+    let mut cond = 0.0f32;
+    for k in 0..4 {
+        let (p, q) = (
+            d.get(k).copied().unwrap_or_default(),
+            d.get((k + 1) % 4).copied().unwrap_or_default(),
+        );
+        let (ep, eq) = ([p[0], r * p[1]], [q[0], r * q[1]]);
+        let den = sqrt(dot(ep, ep)) * sqrt(dot(eq, eq));
+        // (A NaN fails.)
+        if !(den > 0.0) {
+            return Err(CalibrationError::Degenerate);
+        }
+        cond += (r2 * p[1] * q[1]).abs() / den;
+    }
+    if !(cond * 0.25 >= MIN_STEPWISE_CONDITION) {
+        return Err(CalibrationError::Degenerate);
+    }
     let signs = [[1.0f32, 1.0], [-1.0, 1.0], [-1.0, -1.0], [1.0, -1.0]];
     // Roll: e_k = (d_x, r d_y) ∝ R_zᵀ s_k, i.e. e_k is s_k turned by −γ.
     let (mut sin_sum, mut cos_sum, mut fy_sum) = (0.0f32, 0.0f32, 0.0f32);
@@ -671,6 +704,12 @@ pub struct JointFit {
     pub iterations: usize,
 }
 
+/// The least conditioning [`calibrate_stepwise`] accepts: the mean, over
+/// the four adjacent pairs of diagonal FOEs, of `|cos 2γ| / 2` at the roll
+/// `γ` (exactly, for FOEs the model gives). 0.05: rolls at least 2.87°
+/// from 45° + k·90°.
+pub const MIN_STEPWISE_CONDITION: f32 = 0.05;
+
 /// Gauss–Newton iterations of [`calibrate_jointly`] at most.
 pub const JOINT_ITERATIONS: usize = 10;
 
@@ -684,9 +723,11 @@ pub const JOINT_ITERATIONS: usize = 10;
 ///
 /// Input: translations as for [`Intrinsics::predicted_foe`], flows as for
 /// [`focus_of_expansion`], `start` finite with its roll within
-/// ±[`crate::MAX_ANGLE_RAD`]. The result's roll is in `[−π, π]`; every
-/// number of the result is finite ([`CalibrationError::Overflow`]
-/// otherwise). Work: at most `JOINT_ITERATIONS + 1` passes over the flows,
+/// ±[`crate::MAX_ANGLE_RAD`]. The result's roll is in `[−π, π]` and its
+/// focal lengths are positive (a fit with both negative is the same camera,
+/// given with them positive and the roll turned by π; one not positive is
+/// [`CalibrationError::Degenerate`]); every number of the result is finite
+/// ([`CalibrationError::Overflow`] otherwise). Work: at most `JOINT_ITERATIONS + 1` passes over the flows,
 /// each `O(n²)` per motion of `n ≤ N` flows (the median of the masks).
 pub fn calibrate_jointly<const N: usize>(
     motions: &[MotionFlows<'_>],
@@ -910,6 +951,20 @@ fn joint_fit(p: &Params, eq: &Normal, iterations: usize) -> Result<JointFit, Cal
     // (Within the reduction's range: the last pass took its sine.)
     intrinsics.roll =
         roll_in_half_turn(intrinsics.roll).map_err(|_| CalibrationError::Degenerate)?;
+    // Both focal lengths negative is the same camera with the roll turned
+    // by π (`diag(−f) R_z(γ + π)ᵀ = diag(f) R_z(γ)ᵀ`): given as that one.
+    // One of them not positive is a mirror image no camera gives. (Until an
+    // adversarial review a start with negative focal lengths returned `Ok`
+    // with them.)
+    if intrinsics.fx < 0.0 && intrinsics.fy < 0.0 {
+        intrinsics.fx = -intrinsics.fx;
+        intrinsics.fy = -intrinsics.fy;
+        let pi = core::f32::consts::PI;
+        intrinsics.roll += if intrinsics.roll > 0.0 { -pi } else { pi };
+    }
+    if !(intrinsics.fx > 0.0 && intrinsics.fy > 0.0) {
+        return Err(CalibrationError::Degenerate);
+    }
     let k = &intrinsics;
     let numbers = [k.cx, k.cy, k.roll, k.fx, k.fy, rms];
     if !numbers.iter().chain(sigma.iter()).all(|x| x.is_finite()) {

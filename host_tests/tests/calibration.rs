@@ -707,9 +707,9 @@ fn mirrored_diagonal_foes_are_degenerate() {
         calibrate_stepwise(c, mirrored),
         Err(CalibrationError::Degenerate)
     );
-    // Every roll of the documented order, and its mirror image. (At rolls
-    // of exactly ±45° and ±135° the fit of `r²` is degenerate, a known
-    // limit: those may be `Degenerate` too.)
+    // Every roll of the documented order, and its mirror image. (Near
+    // rolls of ±45° and ±135° the fit of `r²` is ill-conditioned: those
+    // are `Degenerate` too.)
     let mut calibrated = 0;
     for k in 0..360 {
         let g = (k as f32).to_radians();
@@ -735,5 +735,110 @@ fn mirrored_diagonal_foes_are_degenerate() {
             "roll {k}° mirrored"
         );
     }
-    assert!(calibrated >= 356, "{calibrated} of 360 rolls calibrated");
+    // (Within 2.87° of ±45° and ±135° the fit is ill-conditioned and
+    // `Degenerate`, below: 5 whole degrees each side of each.)
+    assert!(calibrated >= 340, "{calibrated} of 360 rolls calibrated");
+}
+
+/// An adversarial review: near rolls of 45° + k·90° the diagonal FOEs lie
+/// near the image axes and the perpendicularity test cannot tell the
+/// aspect ratio: at 44.9° with FOEs on the pixel grid `calibrate_stepwise`
+/// gave `Ok` with f_x 545, f_y 890 for 600, 800. Now it is `Degenerate`
+/// within 2.87° of those rolls (`MIN_STEPWISE_CONDITION`) and elsewhere
+/// within the documented sensitivity `4 δ / (L |cos 2γ|)` (here with
+/// twice that allowed): every 0.05° of roll, FOEs of the paper-like camera
+/// computed in `f64` and rounded to the pixel grid.
+#[test]
+fn stepwise_is_degenerate_only_near_the_axes_and_accurate_elsewhere() {
+    let (cx, cy, fx, fy) = (256.0f64, 240.0f64, 600.0f64, 800.0f64);
+    let foe = |g: f64, tx: f64, ty: f64| {
+        let (s, c) = g.sin_cos();
+        let (x, y) = (c * tx + s * ty, -s * tx + c * ty);
+        Pixel::new((cx + fx * x).round() as f32, (cy + fy * y).round() as f32)
+    };
+    let (mut ok, mut degenerate, mut worst) = (0, 0, 0.0f64);
+    for k in 0..7200 {
+        let g = (k as f64 * 0.05).to_radians();
+        let straight = foe(g, 0.0, 0.0);
+        let diagonal = [
+            foe(g, 1.0, 1.0),
+            foe(g, -1.0, 1.0),
+            foe(g, -1.0, -1.0),
+            foe(g, 1.0, -1.0),
+        ];
+        // Off the nearest 45° + k·90°, in degrees.
+        let d = (k as f64 * 0.05 - 45.0).rem_euclid(90.0);
+        let off = d.min(90.0 - d);
+        let cos2 = (2.0 * g).cos().abs();
+        match calibrate_stepwise(straight, diagonal) {
+            Ok(c) => {
+                ok += 1;
+                assert!(off > 2.8, "{:.2}°: {c:?}", k as f64 * 0.05);
+                // L: the shortest offset of a diagonal FOE; δ: the grid's
+                // rounding, half a pixel each way.
+                let l = diagonal
+                    .iter()
+                    .map(|p| (f64::from(p.u) - cx).hypot(f64::from(p.v) - cy))
+                    .fold(f64::INFINITY, f64::min);
+                let allowed = 2.0 * 4.0 * 0.5f64.hypot(0.5) / (l * cos2);
+                let e = ((f64::from(c.fx) - fx) / fx)
+                    .abs()
+                    .max(((f64::from(c.fy) - fy) / fy).abs());
+                assert!(
+                    e <= allowed,
+                    "{:.2}°: {c:?}, {e} > {allowed}",
+                    k as f64 * 0.05
+                );
+                worst = worst.max(e / allowed);
+            }
+            Err(e) => {
+                assert_eq!(e, CalibrationError::Degenerate);
+                assert!(off < 2.9, "{:.2}°: Degenerate", k as f64 * 0.05);
+                degenerate += 1;
+            }
+        }
+    }
+    println!("stepwise over 7 200 rolls: {ok} Ok, {degenerate} Degenerate; largest error {worst:.2} of the allowed");
+    assert!(ok > 6000, "{ok}");
+}
+
+/// An adversarial review: `calibrate_jointly` started from negative focal
+/// lengths returned them (the same camera with the roll turned by π); now
+/// the result has them positive and the roll turned.
+#[test]
+fn joint_calibration_gives_positive_focal_lengths() {
+    let cam = TrueCamera::default();
+    let mut rng = host_tests::synth::Rng(7);
+    let sets: Vec<Vec<Flow>> = paper_motions()
+        .iter()
+        .map(|&t| host_tests::calib::flows(&cam, t, 50, 0.0, &mut rng))
+        .collect();
+    let views: Vec<MotionFlows> = paper_motions()
+        .iter()
+        .zip(&sets)
+        .map(|(t, f)| MotionFlows {
+            translation: t.map(|x| x as f32),
+            flows: f,
+        })
+        .collect();
+    let positive = Intrinsics {
+        cx: cam.cx as f32,
+        cy: cam.cy as f32,
+        roll: cam.roll as f32,
+        fx: cam.fx as f32,
+        fy: cam.fy as f32,
+    };
+    let mirrored = Intrinsics {
+        roll: positive.roll + std::f32::consts::PI,
+        fx: -positive.fx,
+        fy: -positive.fy,
+        ..positive
+    };
+    let a = calibrate_jointly::<512>(&views, &positive).expect("converges");
+    let b = calibrate_jointly::<512>(&views, &mirrored).expect("converges");
+    for k in [a.intrinsics, b.intrinsics] {
+        assert!(k.fx > 0.0 && k.fy > 0.0, "{k:?}");
+        let e = Errors::of(&k, &cam);
+        assert!(e.within_issue_tolerances(), "{k:?}");
+    }
 }

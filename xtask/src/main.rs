@@ -20,8 +20,11 @@
 //!   pair, ...) traced instruction by instruction on QEMU, counted per
 //!   function and per source line with an estimate of Cortex-M4F cycles
 //!   beside the instructions, and an annotated disassembly written to
-//!   `target/profile/annotated.txt`; fails when the representative window
-//!   costs more than 718 estimated cycles per point (see `--help`).
+//!   `target/profile/annotated.txt`; reports a miss when the representative
+//!   window costs more than 718 estimated cycles per point (a budget issue
+//!   11 owns: printed, not enforced until it lands), and fails when it
+//!   rises above 953.3, the figure the issue says must not rise (see
+//!   `--help`).
 //! * `fuzz`    — the seeded fuzz pass of `host_tests` (frame path,
 //!   calibration, road geometry, replay parser) with its oracles, in the
 //!   overflow-checked `checked` profile; arguments go to the pass

@@ -6,7 +6,7 @@
 //! tables with
 //!
 //! ```text
-//! cd host_tests && cargo test --release --test certify certify_containment -- --nocapture
+//! cd host_tests && cargo test --profile checked --test certify certify_containment -- --nocapture
 //! ```
 //!
 //! and check the yield targets too with `-- --ignored`.
@@ -384,7 +384,7 @@ fn indexed_equals_reference_without_the_fold_test() {
 /// Issue 11's yield targets: actual >= 90 % of the ideal yield over all
 /// families and >= 80 % in each, in every variant. Not met today (README,
 /// "What the tests show", gives the figures and where the points go):
-/// `cargo test --release --test certify -- --ignored` checks them.
+/// `cargo test --profile checked --test certify -- --ignored` checks them.
 #[test]
 #[ignore = "issue 11's yield targets are not met yet (README gives the figures)"]
 fn certify_yield_targets() {

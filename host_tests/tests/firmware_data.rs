@@ -170,3 +170,56 @@ fn adversarial_base_is_the_representative_pair() {
         assert_eq!(drive::encode(&k, &f), drive::encode(&kb, &fb), "N = {n}");
     }
 }
+
+/// The pairs a review found by hill climbing (`src/bin/data/rev_*.bin`,
+/// the bench's `FOUND`, stored as found): each decodes as the firmware
+/// reads it, two frames of two boundaries of the N the bench runs it at,
+/// every boundary accepted by `Frame::push_boundary`, the motion by
+/// `Motion::new`; and the bench's table names every file.
+#[test]
+fn found_pairs_pass_validation() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../src/bin/data");
+    let bench = std::fs::read_to_string(dir.join("../bench.rs")).expect("bench.rs");
+    let found = [
+        ("rev_a1", 64),
+        ("rev_b1", 256),
+        ("rev_b2", 64),
+        ("rev_c1", 512),
+        ("rev_c2", 256),
+        ("rev_d2", 512),
+    ];
+    for (name, n) in found {
+        assert!(
+            bench.contains(&format!(
+                "(\"{name}\", {n}, include_bytes!(\"data/{name}.bin\"))"
+            )),
+            "{name} in FOUND"
+        );
+        let bytes = std::fs::read(dir.join(format!("{name}.bin"))).expect("found pair");
+        let (cam, back) = drive::decode(&bytes).expect("decodes");
+        assert_eq!(back.len(), 2, "{name}: a pair");
+        for f in &back {
+            assert_eq!(f.boundaries.len(), 2, "{name}: two boundaries");
+            let bs: Vec<Vec<roadstereo::Pixel>> = f
+                .boundaries
+                .iter()
+                .map(|b| {
+                    b.iter()
+                        .map(|q| roadstereo::Pixel::new(q[0], q[1]))
+                        .collect()
+                })
+                .collect();
+            for b in &bs {
+                assert_eq!(b.len(), n, "{name}: N points a boundary");
+            }
+            let _ = host_tests::frame(cam, &bs); // panics if rejected
+        }
+        assert!(roadstereo::Motion::new(back[1].translation, back[1].rotation).is_ok());
+    }
+    let on_disk = std::fs::read_dir(&dir)
+        .expect("data dir")
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|f| f.starts_with("rev_"))
+        .count();
+    assert_eq!(on_disk, found.len(), "stray rev_*.bin files");
+}

@@ -19,12 +19,13 @@ const LIMIT: Duration = Duration::from_secs(20);
 fn overflow_checks_and_debug_assertions_are_on() {
     assert!(
         std::hint::black_box(cfg!(debug_assertions)),
-        "debug assertions are off"
+        "debug assertions are off (run the host tests with `--profile checked`)"
     );
     let r = std::panic::catch_unwind(|| std::hint::black_box(u32::MAX) + std::hint::black_box(1));
     assert!(
         r.is_err(),
-        "an overflowing add did not panic: overflow checks are off"
+        "an overflowing add did not panic: overflow checks are off (run the host tests in the \
+         `checked` profile, as `cargo xtask test` does: `cargo test --profile checked`)"
     );
 }
 

@@ -19,9 +19,9 @@
 //!   each): `C_B` their difference, `C0` the one-boundary frame less `C_B`.
 //! * `C_U`: the largest marginal cost of a unit, over the 2 × 256 members
 //!   of the adversarial family run at budgets from the smallest accepted
-//!   to 16 × the default (the `sweep` rows): per member, the instructions'
-//!   rise from its cheapest to its costliest budget over the units' rise
-//!   (members whose units move by fewer than 256 are left out), and the
+//!   to 16 × the default (the `sweep` rows): per member, the largest
+//!   rise of the instructions between two of its budgets over the units'
+//!   rise (pairs whose units move by fewer than 256 are left out), and the
 //!   same over the configuration probes (`PROBES` in `src/bin/bench.rs`:
 //!   members' pairs, or windows of them, under other valid configurations),
 //!   which the firmware logs as sweep rows too.
@@ -74,23 +74,27 @@ fn measure(log: &str) -> Result<Formula, String> {
     };
     let cb = f2.saturating_sub(f1);
     let c0 = f1.saturating_sub(cb);
-    // C_U: per member, the rise from its cheapest budget to its costliest.
+    // C_U: per member, the largest rise between two of its budgets, in
+    // the order of the units spent, over the units' rise (of 256 or
+    // more). (Until a third review it was the rise from the cheapest
+    // budget to the costliest, which averaged a dear middle away.)
     let sweep = records(log, "sweep name=");
     let mut cu = 0.0f64;
     let mut names: Vec<&str> = sweep.iter().filter_map(|r| field(r, "name")).collect();
     names.dedup();
     for name in &names {
-        let rows: Vec<(u64, u64)> = sweep
+        let mut rows: Vec<(u64, u64)> = sweep
             .iter()
             .filter(|r| field(r, "name") == Some(name))
             .map(|r| (num(r, "work_spent"), num(r, "instr")))
             .collect();
-        let lo = rows.iter().min_by_key(|r| r.0);
-        let hi = rows.iter().max_by_key(|r| r.0);
-        if let (Some(lo), Some(hi)) = (lo, hi) {
-            if hi.0 >= lo.0 + 256 {
-                let slope = (hi.1 as f64 - lo.1 as f64) / (hi.0 - lo.0) as f64;
-                cu = cu.max(slope);
+        rows.sort_unstable();
+        for (i, lo) in rows.iter().enumerate() {
+            for hi in rows.iter().skip(i + 1) {
+                if hi.0 >= lo.0 + 256 {
+                    let slope = (hi.1 as f64 - lo.1 as f64) / (hi.0 - lo.0) as f64;
+                    cu = cu.max(slope);
+                }
             }
         }
     }

@@ -66,18 +66,51 @@ use crate::search::Work;
 /// (see the module docs).
 pub const CARRY: u32 = 2;
 
+/// The seal of [`Deadline::never`]: a public type in a private module,
+/// which no other crate can name.
+mod sealed {
+    #[derive(Debug, Clone, Copy)]
+    pub struct Token;
+}
+
+/// Whether `D` is [`NoDeadline`], whose checks are compiled out.
+#[inline(always)]
+pub(crate) fn never<D: Deadline>() -> bool {
+    D::never(sealed::Token)
+}
+
 /// The caller's clock: whether the frame's time is up. Asked one to
 /// three times a point (step 1 where the pair is not certified, the fold
 /// queries, step 4) and a few times a boundary, so it should be cheap (a
 /// cycle counter's read and a comparison); it may also rate-limit itself.
 /// Any `FnMut() -> bool` is one (also `&mut dyn FnMut() -> bool`; the
 /// trait itself is not object-safe).
+///
+/// Only [`NoDeadline`] has its checks compiled out; no other
+/// implementation can claim that and have its clock ignored:
+///
+/// ```compile_fail
+/// struct Clock;
+/// impl roadstereo::Deadline for Clock {
+///     fn expired(&mut self) -> bool {
+///         true
+///     }
+///     fn never(_: roadstereo::deadline::sealed::Token) -> bool {
+///         true
+///     }
+/// }
+/// ```
 pub trait Deadline {
     /// A deadline that never expires: the checks are compiled out. Not
-    /// part of the API (hidden): [`NoDeadline`]'s; an implementation that
-    /// sets it has its clock ignored.
+    /// part of the API: [`NoDeadline`]'s alone. Sealed by its argument, a
+    /// type no other crate can name, so no other implementation can say
+    /// yes and have its clock ignored (until an integrator's review it
+    /// was a hidden constant any implementation could set).
     #[doc(hidden)]
-    const NEVER: bool = false;
+    #[inline(always)]
+    fn never(_: sealed::Token) -> bool {
+        false
+    }
 
     /// Whether the time is up.
     fn expired(&mut self) -> bool;
@@ -105,7 +138,10 @@ impl<F: FnMut() -> bool> Deadline for F {
 pub struct NoDeadline;
 
 impl Deadline for NoDeadline {
-    const NEVER: bool = true;
+    #[inline(always)]
+    fn never(_: sealed::Token) -> bool {
+        true
+    }
 
     #[inline(always)]
     fn expired(&mut self) -> bool {
@@ -140,7 +176,7 @@ impl<'d, D: Deadline> Guard<'d, D> {
     /// credit is capped for the point, the rest held back.
     #[inline(always)]
     pub(crate) fn proceed(&mut self, work: &mut Work) -> bool {
-        if D::NEVER {
+        if never::<D>() {
             return true;
         }
         if self.expired || self.deadline.expired() {
@@ -158,7 +194,7 @@ impl<'d, D: Deadline> Guard<'d, D> {
     /// had not yet).
     #[inline(always)]
     pub(crate) fn check(&mut self) -> bool {
-        if D::NEVER {
+        if never::<D>() {
             return false;
         }
         self.expired = self.expired || self.deadline.expired();
@@ -168,14 +204,14 @@ impl<'d, D: Deadline> Guard<'d, D> {
     /// Whether the deadline was seen to expire.
     #[inline(always)]
     pub(crate) fn has_expired(&self) -> bool {
-        !D::NEVER && self.expired
+        !never::<D>() && self.expired
     }
 
     /// The units held back given back to `work` (before it reports its
     /// usage).
     #[inline(always)]
     pub(crate) fn settle(&mut self, work: &mut Work) {
-        if D::NEVER {
+        if never::<D>() {
             return;
         }
         work.set_credit(work.credit().saturating_add(self.reserve));

@@ -82,7 +82,7 @@ pub(crate) fn step<const N: usize, D: Deadline>(
             NO_KEY
         }
     };
-    if D::NEVER {
+    if crate::deadline::never::<D>() {
         fold_index.push_all_stored(slots.iter().map(key));
     } else {
         // Under a deadline, in parts of `CHUNK` points with the clock
@@ -96,7 +96,11 @@ pub(crate) fn step<const N: usize, D: Deadline>(
         }
     }
     let mut ask = || guard.check();
-    let mut tick: Tick = if D::NEVER { None } else { Some(&mut ask) };
+    let mut tick: Tick = if crate::deadline::never::<D>() {
+        None
+    } else {
+        Some(&mut ask)
+    };
     if !fold_index.finish(None, &mut tick) {
         return;
     }

@@ -467,7 +467,11 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             // Under a deadline the clock is asked before every `CHUNK`
             // vertices or segments of each pass of the build.
             let mut ask = || guard.check();
-            let mut tick: Tick = if D::NEVER { None } else { Some(&mut ask) };
+            let mut tick: Tick = if crate::deadline::never::<D>() {
+                None
+            } else {
+                Some(&mut ask)
+            };
             let built = frame2_keys(index, &keying, b2, (orient, checking), &mut tick).is_some_and(
                 |builder| {
                     let radius = near_foe + 2.0 * (r1_max + pair.e2());
@@ -726,7 +730,7 @@ fn step1_certified<D: Deadline, const BOUNDED: bool>(
     key: impl Fn([f32; 2]) -> (f32, f32),
     guard: &mut Guard<'_, D>,
 ) {
-    if D::NEVER {
+    if crate::deadline::never::<D>() {
         return compensate_all_certified::<BOUNDED>(pair, r1, (slots, b1, margins), order, key);
     }
     let mut parts = slots

@@ -22,7 +22,7 @@
 //! bound grows with the travel since the key frame, the rotation bound with
 //! the number of frames. Without configured bounds the composed motion is
 //! taken as exact, and its `f32` rounding (about `5 u` of the rotation a
-//! frame, `10⁻⁴` px at f = 800 over 64 frames) is left to the localisation
+//! frame, at worst about `0.015` px at f = 800 over 64 frames) is left to the localisation
 //! errors' slack: the pairs' sticks do not carry it (README, "Limits" of
 //! the fusion); the road map's radius does (`crate::map`, "The radius").
 //!

@@ -69,6 +69,7 @@ pub fn check(raw: &[u8]) -> Result<Checked<'_>, WireError> {
 
 /// A report packet's content.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Report {
     /// The error's kind.
     pub kind: ErrorKind,
@@ -162,9 +163,20 @@ pub struct ResultView<'a> {
     body: &'a [u8],
 }
 
-/// Why a result payload could not be parsed.
+/// Why a result payload could not be parsed: it is shorter than its
+/// header, a point's status code is unknown, or the boundaries and points
+/// it announces do not fill it exactly.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct BadResult;
+
+impl core::fmt::Display for BadResult {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("result payload malformed")
+    }
+}
+
+impl core::error::Error for BadResult {}
 
 impl<'a> ResultView<'a> {
     /// Parse a result payload (from [`check`]); every boundary and point

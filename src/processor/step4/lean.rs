@@ -81,7 +81,7 @@ impl LeanWalk<'_> {
         hint: usize,
         (work, guard): (&mut Work, &mut Guard<'_, D>),
     ) -> usize {
-        if D::NEVER {
+        if crate::deadline::never::<D>() {
             self.points::<WALK, D>(slots, hint, (work, guard))
         } else {
             self.points_within::<WALK, D>(slots, hint, (work, guard))

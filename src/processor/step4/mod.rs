@@ -74,7 +74,10 @@ pub(super) fn match_boundary<const N: usize, D: Deadline>(
         }
         _ => {}
     }
-    if !D::NEVER && matcher == Matcher::Indexed && matches!(keying.pencil, Pencil::Half { .. }) {
+    if !crate::deadline::never::<D>()
+        && matcher == Matcher::Indexed
+        && matches!(keying.pencil, Pencil::Half { .. })
+    {
         // Under a deadline: the radial levels the band queries use built
         // before the first point's search, not inside it, the clock asked
         // before and during the build (between parts of `CHUNK` blocks).

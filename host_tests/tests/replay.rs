@@ -330,3 +330,34 @@ fn the_replay_tool_reports_each_bad_line_and_goes_on() {
     );
     assert!(stderr.contains("2 line(s) rejected"), "{stderr}");
 }
+
+/// The worked example of README ("Replay") is current: `docs/example_out.jsonl`
+/// is what the replay gives for `docs/example.jsonl` today, and the point
+/// README quotes from it is in it. (A check that the docs did not go
+/// stale, not of the results' accuracy, which the generator's truth
+/// checks elsewhere: regenerate both with `cargo xtask figures`. An
+/// integrator's review found the file 202 fields behind the code.)
+#[test]
+fn the_worked_example_in_the_docs_is_current() {
+    let expected = include_str!("../../docs/example_out.jsonl");
+    let mut p = Box::new(Processor::<N, B>::new(Config::default()));
+    let mut got = String::new();
+    for (i, line) in example().iter().enumerate() {
+        let out = process_line(&mut p, i + 1, line);
+        got.push_str(&serde_json::to_string(&out).expect("serialises"));
+        got.push('\n');
+    }
+    assert!(
+        got == expected,
+        "docs/example_out.jsonl is stale: run `cargo xtask figures`"
+    );
+    let readme = include_str!("../../README.md");
+    let start = readme
+        .find("{\"p1\":[108.0,240.0]")
+        .expect("README quotes a point of the example");
+    let quoted = readme[start..].lines().next().expect("a line");
+    assert!(
+        expected.contains(quoted),
+        "README's quoted point is not in docs/example_out.jsonl: {quoted}"
+    );
+}

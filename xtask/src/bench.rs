@@ -55,8 +55,7 @@ pub const BENCH_USAGE: &str =
   points, and the lateness where it is worst (cut after each pair's longest gaps between questions,
   at 2 x 256 and 2 x 512) with the limit that keeps every pair within the deadline, and the demo
   drive's fusion steps within a deadline. Budgets there: the lateness where it is worst <= 40 000
-  instructions at both sizes (the margin README quoted; owned by issue 11 since a review's pair
-  passed it), every demo-drive step within a deadline inside the deadline, the expiry flag agrees with
+  instructions at both sizes (the margin README quotes), every demo-drive step within a deadline inside the deadline, the expiry flag agrees with
   the clock, a passed deadline leaves no point ok.
   Not here: the representative window's estimated Cortex-M4F cycles per point <= 718 is
   checked by `cargo xtask profile` (see its --help).";
@@ -483,10 +482,8 @@ lateness where it is worst (a limit just before each pair's four longest gaps be
         deadline.saturating_sub(lmax)
     );
     if lmax > LATENESS {
-        // Owned by issue 11 since a review's hill climbing found a pair
-        // past it (`rev_d2`, 40 583): printed, not enforced until it lands.
         misses.push(format!(
-            "{OPEN}the call within a deadline is {lmax} instructions late > {LATENESS} (README's margin)"
+            "the call within a deadline is {lmax} instructions late > {LATENESS} (README's margin)"
         ));
     }
 }

@@ -28,14 +28,18 @@ pub(super) fn match_wedge_angular<const N: usize, D: Deadline>(
     let (e2, e2_csc, cot_twice) = (pair.e2(), pair.e2_csc(), pair.config.cot_twice);
     let segments = b2.len().saturating_sub(1);
     let mut deferred = false;
-    for r in slots.iter_mut() {
+    let mut rest = slots.iter_mut();
+    while let Some(r) = rest.next() {
         if r.status != Status::NoIntersection {
             continue;
         }
         let (p1, iz, r1) = (r.pixel1, r.z, r.z_near);
         if !guard.proceed(work) {
+            // The time is up: this point and the rest flagged in a loop of
+            // their own (those left for the deferred refinement too).
             *r = PointResult::flagged(p1, Status::OverBudget);
-            continue;
+            super::flag_pending(rest.into_slice(), Status::OverBudget);
+            break;
         }
         let lean = index.lean();
         let wedge = match angular_wedge(r, (foe, e2, e2_csc), keying, &lean) {

@@ -144,11 +144,15 @@ impl LeanWalk<'_> {
         mut hint: usize,
         (work, guard): (&mut Work, &mut Guard<'_, D>),
     ) -> usize {
-        for r in slots.iter_mut() {
+        let mut rest = slots.iter_mut();
+        while let Some(r) = rest.next() {
             if r.status == Status::NoIntersection {
                 if !guard.proceed(work) {
+                    // The time is up: this point and the rest flagged in a
+                    // loop of their own.
                     *r = PointResult::flagged(r.pixel1, Status::OverBudget);
-                    continue;
+                    super::flag_pending(rest.into_slice(), Status::OverBudget);
+                    break;
                 }
                 let (h, refine) = self.walk_out::<WALK>(r, hint, work);
                 hint = h;

@@ -91,13 +91,18 @@ pub(super) fn match_boundary<const N: usize, D: Deadline>(
             return;
         }
     }
-    for r in slots.iter_mut() {
+    let mut rest = slots.iter_mut();
+    while let Some(r) = rest.next() {
         if r.status == Status::NoIntersection {
-            *r = if matcher == Matcher::Reference || guard.proceed(&mut credit) {
-                match_point(pair, keying, near_foe, r, b2, index, &mut credit, matcher)
+            if matcher == Matcher::Reference || guard.proceed(&mut credit) {
+                *r = match_point(pair, keying, near_foe, r, b2, index, &mut credit, matcher);
             } else {
-                PointResult::flagged(r.pixel1, Status::OverBudget)
-            };
+                // The time is up: this point and the rest flagged in a
+                // loop of their own, out of this one's way.
+                *r = PointResult::flagged(r.pixel1, Status::OverBudget);
+                flag_pending(rest.into_slice(), Status::OverBudget);
+                break;
+            }
         }
     }
     *work = credit;

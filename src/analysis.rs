@@ -57,11 +57,15 @@ pub fn camera_to_vehicle(p: [f32; 3], tilt: f32) -> Result<[f32; 3], AngleError>
 /// not in front of both cameras (`z ≤ 0` or `z ≤ w`). (Until an adversarial
 /// review only the product was tested, positive for a point behind both.)
 pub fn disparity_flat(f: f32, h: f32, w: f32, z: f32) -> f32 {
+    if !(z > 0.0 && z - w > 0.0) {
+        return f32::INFINITY;
+    }
     let den = z * (z - w);
-    if z > 0.0 && z - w > 0.0 && den > 0.0 {
+    if den > 0.0 {
         f * h * w / den
     } else {
-        f32::INFINITY
+        // The product underflowed (a point just in front of the camera).
+        f * h * w / z / (z - w)
     }
 }
 

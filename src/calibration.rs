@@ -582,8 +582,9 @@ impl Intrinsics {
 /// test cannot tell the aspect ratio. Elsewhere an FOE error of `δ` px
 /// moves `r² = (f_x/f_y)²` by about `4 δ / (L |cos 2γ|)` of itself, `L`
 /// the diagonal FOEs' distance from the straight one (at the limit, `δ =
-/// 0.5` and `L = 1 000`: 2 %); away from those rolls the error is about
-/// `4 δ / L`.
+/// 0.5` and `L = 1 000`: 2 %; a review measured up to 1.45 times the
+/// formula for `f = (300, 1 200)`); away from those rolls the error is
+/// about `4 δ / L`.
 pub fn calibrate_stepwise(
     straight: Pixel,
     diagonal: [Pixel; 4],

@@ -228,15 +228,18 @@ fn heights<const N: usize>(points: &[Sample], cell: &Cell, m: usize) -> Option<R
     let mut lo = [0.0f32; N];
     let mut hi = [0.0f32; N];
     let mut n = 0;
-    for ((l, h), p) in lo.iter_mut().zip(hi.iter_mut()).zip(points) {
+    for p in points {
         let Some((a, b)) = cell.interval(p) else {
             // No ray of the cell meets the plane ahead: this point
-            // disagrees.
+            // disagrees. (Until a review this skipped the point's slot
+            // too, and the sweep took the first `n` slots: a left-out
+            // point's empty `[0, 0]` in, the last point's interval out.)
             continue;
         };
-        *l = a;
-        *h = b;
-        n += 1;
+        if let (Some(l), Some(h)) = (lo.get_mut(n), hi.get_mut(n)) {
+            (*l, *h) = (a, b);
+            n += 1;
+        }
     }
     let need = points.len().saturating_sub(m);
     if n < need || need == 0 {

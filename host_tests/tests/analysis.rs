@@ -247,9 +247,11 @@ fn points_behind_and_heights_outside_the_model() {
             "w {w} z {z}"
         );
     }
-    // In front of both: as eq. 3.1 gives it (backwards too).
+    // In front of both: as eq. 3.1 gives it (backwards too, and where
+    // `z (z − w)` underflows: no motion, no disparity).
     let d = disparity_flat(800.0, 1.0, -0.5, 4.0);
     assert!((d - 800.0 * -0.5 / (4.0 * 4.5)).abs() < 1e-4, "{d}");
+    assert_eq!(disparity_flat(800.0, 1.0, 0.0, 1e-30), 0.0);
     let tilt = 20f32.to_radians();
     for h in [0.0f32, -1.0, f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
         assert_eq!(ground_interval(h, tilt, 0.3), Ok(None), "h {h}");

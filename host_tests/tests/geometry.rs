@@ -584,3 +584,38 @@ fn no_width_is_no_width_and_every_point_allowed_is_an_error() {
         );
     }
 }
+
+/// A review: a point whose ray misses the plane at some tilts (a wrong
+/// match above the horizon) left an empty interval in the height sweep
+/// and pushed the last point's out, so with one outlier allowed the
+/// answer was `Inconsistent` or not, depending on where the point stood
+/// in the input. Now every position gives the same ranges, holding the
+/// truth.
+#[test]
+fn a_wrong_match_above_the_horizon_anywhere_in_the_input() {
+    let (h, tilt) = (1.5f64, 20f64.to_radians());
+    let (l, r) = planar_road(12);
+    let bad = Sample {
+        x: -0.2,
+        y: -0.5,
+        z_near: 5.0,
+        z_far: 6.0,
+    };
+    let mut results = Vec::new();
+    for at in 0..=(l.len() + r.len()) {
+        let (mut l2, mut r2) = (l.clone(), r.clone());
+        if at <= l.len() {
+            l2.insert(at, bad);
+        } else {
+            r2.insert(at - l.len() - 1, bad);
+        }
+        let g = road_geometry::<64>(&[(&l2, &r2)], 1)
+            .unwrap_or_else(|e| panic!("bad point at {at}: {e:?}"));
+        assert!(
+            g.height.contains(h as f32) && g.tilt.contains(tilt as f32),
+            "bad point at {at}: {g:?}"
+        );
+        results.push((g.height, g.tilt));
+    }
+    assert!(results.windows(2).all(|w| w[0] == w[1]), "{results:?}");
+}

@@ -22,8 +22,9 @@ pub const BENCH_USAGE: &str =
                          [--per-point-256 390]
   every budget is hard (exit code 1 when one is missed) except those an open issue owns, printed
   as \"budget NOT MET: [open: issue 11] ...\" on every run and not enforced until the issue
-  lands (today: the per-point and scaling budgets, the 2 x 256 frame, the adversarial worst
-  case, the worst-case bound, the fusion's steps); the deadline is share-percent of a
+  lands (today: the per-point budgets, the 2 x 256 frame with and without the fusion, the
+  adversarial worst case and scaling, the worst-case bound, the demo's steps with the fusion);
+  the deadline is share-percent of a
   frame-ms frame at cpu-mhz, one instruction = one cycle (default 277 200 instructions).
   The representative pair (the Fig. 6 set-up, one detector point per row, N = 32 ... 512):
     - instructions per point <= per-point (400) at every N

@@ -6,7 +6,10 @@
 //! input errors exactly as documented, naming the first bad sample (an
 //! independent check of the rules); every `Ok` finite with `lo <= hi`,
 //! the tilt within `[0°, 60°]` widened by a grid step, the outliers as
-//! given; same input, same output.
+//! given; same input, same output; and where the samples are as drawn
+//! from one road (sticks of ±1 % or more) with no more wrong matches than
+//! allowed (some above the horizon), `Ok` with that road's height and
+//! tilt in the ranges.
 
 use roadstereo::geometry::{
     road_geometry, GeometryError, Sample, SampleIndex, MAX_NORMALISED, MAX_SAMPLE_DEPTH, MAX_VIEWS,
@@ -25,20 +28,36 @@ pub struct Case {
     pub views: Vec<(Vec<Sample>, Vec<Sample>)>,
     /// Points that may disagree.
     pub outliers: usize,
+    /// The road's camera height and tilt (radians) the samples were drawn
+    /// from, when every sample is as drawn (no mutation) and every stick
+    /// is at least ±1 % (so the `f32` rounding of a sample cannot put the
+    /// truth outside it); with the number of wrong matches drawn.
+    pub truth: Option<(f64, f64, usize)>,
 }
 
-fn side(src: &mut Source, h: f64, tilt: f64, lateral: f64, n: usize) -> Vec<Sample> {
+/// A boundary's samples, the wrong matches among them and the stick's
+/// half-width.
+fn side(src: &mut Source, h: f64, tilt: f64, lateral: f64, n: usize) -> (Vec<Sample>, usize, f64) {
     let (s, c) = tilt.sin_cos();
     let stick = src.pick(&[0.0, 0.01, 0.05, 0.3]);
-    (0..n)
+    let mut wrong = 0;
+    let v = (0..n)
         .map(|i| {
             // Rows below the horizon, nearest first.
             let k = src.range(0.02, 0.6) * (1.0 - i as f64 / (n as f64 + 1.0)) + 0.005;
-            let y = (k - s) / c;
+            let mut y = (k - s) / c;
             let z = h / k;
             let mut z = z;
             if src.chance(1, 12) {
-                z *= src.range(0.3, 3.0); // a wrong match
+                wrong += 1;
+                if src.chance(1, 3) {
+                    // A wrong match above the horizon of the true tilt
+                    // (its ray misses the plane there; a review found the
+                    // height sweep mishandling such points).
+                    y = -s / c - src.range(0.01, 0.5);
+                } else {
+                    z *= src.range(0.3, 3.0);
+                }
             }
             Sample {
                 x: (lateral / z) as f32,
@@ -47,7 +66,8 @@ fn side(src: &mut Source, h: f64, tilt: f64, lateral: f64, n: usize) -> Vec<Samp
                 z_far: (z * (1.0 + stick)) as f32,
             }
         })
-        .collect()
+        .collect();
+    (v, wrong, stick)
 }
 
 /// Draw a case.
@@ -65,14 +85,16 @@ pub fn generate(src: &mut Source) -> Case {
         1 => CAP + 1,
         _ => MIN_POINTS + src.index(16),
     };
+    let (mut wrong, mut least_stick) = (0usize, f64::INFINITY);
     let mut views: Vec<(Vec<Sample>, Vec<Sample>)> = (0..nv)
         .map(|_| {
             let (nl, nr) = (count(src), count(src));
             let w = src.range(2.0, 12.0);
-            (
-                side(src, h, tilt, -w / 2.0, nl),
-                side(src, h, tilt, w / 2.0, nr),
-            )
+            let (l, wl, sl) = side(src, h, tilt, -w / 2.0, nl);
+            let (r, wr, sr) = side(src, h, tilt, w / 2.0, nr);
+            wrong += wl + wr;
+            least_stick = least_stick.min(sl).min(sr);
+            (l, r)
         })
         .collect();
     let mutations = if src.chance(1, 2) {
@@ -80,6 +102,7 @@ pub fn generate(src: &mut Source) -> Case {
     } else {
         1 + src.below(3)
     };
+    let truth = (mutations == 0 && least_stick >= 0.01).then_some((h, tilt, wrong));
     for _ in 0..mutations {
         if views.is_empty() {
             break;
@@ -119,7 +142,11 @@ pub fn generate(src: &mut Source) -> Case {
         1..=3 => src.index(4),
         _ => 0,
     };
-    Case { views, outliers }
+    Case {
+        views,
+        outliers,
+        truth,
+    }
 }
 
 /// The documented input error of `views`, if any.
@@ -206,6 +233,15 @@ pub fn check(case: &Case) -> Outcome {
                 GeometryError::Inconsistent,
                 "road_geometry: valid input rejected"
             );
+            // Drawn from one road with no more wrong matches than allowed:
+            // that road's `(θ, h)` agrees, so it is not inconsistent.
+            if let Some((h, tilt, wrong)) = case.truth {
+                assert!(
+                    wrong > case.outliers,
+                    "road_geometry: Inconsistent, but h {h} tilt {tilt} agree with all but {wrong} ≤ {} points",
+                    case.outliers
+                );
+            }
             7
         }
         (Ok(g), None) => {
@@ -227,6 +263,17 @@ pub fn check(case: &Case) -> Outcome {
                 g.tilt
             );
             assert_eq!(g.outliers_allowed, case.outliers);
+            // The road the samples were drawn from is in the ranges (the
+            // guarantee: every `(θ, h)` that agrees with all but
+            // `outliers` of the plane fit's points).
+            if let Some((h, tilt, wrong)) = case.truth {
+                if wrong <= case.outliers {
+                    assert!(
+                        g.height.contains(h as f32) && g.tilt.contains(tilt as f32),
+                        "road_geometry: h {h} tilt {tilt} (wrong {wrong}) outside {g:?}"
+                    );
+                }
+            }
             0
         }
         (Ok(g), Some(w)) => panic!("road_geometry: Ok {g:?}, expected {w:?}"),

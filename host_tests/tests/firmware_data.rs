@@ -113,15 +113,7 @@ fn adversarial_frames_match_the_generator_and_pass_validation() {
             assert_eq!(back.len(), 2, "{} {n}: a pair", m.name);
             for f in &back {
                 assert_eq!(f.boundaries.len(), 2, "{} {n}: two boundaries", m.name);
-                let bs: Vec<Vec<roadstereo::Pixel>> = f
-                    .boundaries
-                    .iter()
-                    .map(|b| {
-                        b.iter()
-                            .map(|q| roadstereo::Pixel::new(q[0], q[1]))
-                            .collect()
-                    })
-                    .collect();
+                let bs = pixels(&f.boundaries);
                 for b in &bs {
                     assert_eq!(b.len(), n, "{} {n}: N points per boundary", m.name);
                     // Rows strictly one way (the library's own rule); most
@@ -200,15 +192,7 @@ fn found_pairs_pass_validation() {
         assert_eq!(back.len(), 2, "{name}: a pair");
         for f in &back {
             assert_eq!(f.boundaries.len(), 2, "{name}: two boundaries");
-            let bs: Vec<Vec<roadstereo::Pixel>> = f
-                .boundaries
-                .iter()
-                .map(|b| {
-                    b.iter()
-                        .map(|q| roadstereo::Pixel::new(q[0], q[1]))
-                        .collect()
-                })
-                .collect();
+            let bs = pixels(&f.boundaries);
             for b in &bs {
                 assert_eq!(b.len(), n, "{name}: N points a boundary");
             }
@@ -222,4 +206,16 @@ fn found_pairs_pass_validation() {
         .filter(|f| f.starts_with("rev_"))
         .count();
     assert_eq!(on_disk, found.len(), "stray rev_*.bin files");
+}
+
+/// A decoded frame's boundaries as the library's pixels.
+fn pixels(boundaries: &[Vec<[f32; 2]>]) -> Vec<Vec<roadstereo::Pixel>> {
+    boundaries
+        .iter()
+        .map(|b| {
+            b.iter()
+                .map(|q| roadstereo::Pixel::new(q[0], q[1]))
+                .collect()
+        })
+        .collect()
 }

@@ -375,19 +375,9 @@ fn bad_samples_are_typed_errors_and_never_hang() {
 /// edges (±1.3) from 4 to 23 ahead, 20 points each, in `f64`: exact
 /// normalised coordinates and sticks of `±eps` around the exact depths.
 fn tight_road(h: f64, tilt: f64, eps: f64) -> (Vec<Sample>, Vec<Sample>) {
-    let (s, c) = tilt.sin_cos();
     let edge = |x: f64| -> Vec<Sample> {
         (0..20)
-            .map(|i| {
-                let z = 4.0 + i as f64;
-                let (yc, zc) = (h * c - z * s, z * c + h * s);
-                Sample {
-                    x: (x / zc) as f32,
-                    y: (yc / zc) as f32,
-                    z_near: (zc * (1.0 - eps)) as f32,
-                    z_far: (zc * (1.0 + eps)) as f32,
-                }
-            })
+            .map(|i| ground_sample(h, tilt, x, 4.0 + i as f64, eps))
             .collect()
     };
     (edge(-1.3), edge(1.3))

@@ -37,16 +37,20 @@ pub fn calibrate_run(
         return Err(CalibrationError::TooFewFlows);
     };
     let stepwise = calibrate_stepwise(straight, [p, q, r, s])?;
-    let mf: Vec<MotionFlows<'_>> = motions
+    let joint = calibrate_jointly::<CAP>(&motion_flows(motions, &sets), &stepwise)?;
+    Ok((sets, stepwise, joint))
+}
+
+/// Each motion's translation with its flows, as the joint fit takes them.
+pub fn motion_flows<'a>(motions: &[[f64; 3]], sets: &'a [Vec<Flow>]) -> Vec<MotionFlows<'a>> {
+    motions
         .iter()
-        .zip(&sets)
+        .zip(sets)
         .map(|(t, f)| MotionFlows {
             translation: t.map(|x| x as f32),
             flows: f,
         })
-        .collect();
-    let joint = calibrate_jointly::<CAP>(&mf, &stepwise)?;
-    Ok((sets, stepwise, joint))
+        .collect()
 }
 
 /// The true camera (the paper's values: c = (273.59, 233.96), r = 0.787,

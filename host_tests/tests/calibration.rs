@@ -813,14 +813,7 @@ fn joint_calibration_gives_positive_focal_lengths() {
         .iter()
         .map(|&t| host_tests::calib::flows(&cam, t, 50, 0.0, &mut rng))
         .collect();
-    let views: Vec<MotionFlows> = paper_motions()
-        .iter()
-        .zip(&sets)
-        .map(|(t, f)| MotionFlows {
-            translation: t.map(|x| x as f32),
-            flows: f,
-        })
-        .collect();
+    let views = host_tests::calib::motion_flows(&paper_motions(), &sets);
     let positive = Intrinsics {
         cx: cam.cx as f32,
         cy: cam.cy as f32,

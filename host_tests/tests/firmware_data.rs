@@ -163,11 +163,13 @@ fn adversarial_base_is_the_representative_pair() {
     }
 }
 
-/// The pairs a review found by hill climbing (`src/bin/data/rev_*.bin`,
+/// The pairs reviews found by hill climbing (`src/bin/data/rev_*.bin`,
 /// the bench's `FOUND`, stored as found): each decodes as the firmware
 /// reads it, two frames of two boundaries of the N the bench runs it at,
-/// every boundary accepted by `Frame::push_boundary`, the motion by
-/// `Motion::new`; and the bench's table names every file.
+/// every boundary accepted by `Frame::push_boundary` (with the file's
+/// camera; `rev_e4`'s frame 1 has its own too, `CAMERA1`, which the bench
+/// checks as it loads it), the motion by `Motion::new`; and the bench's
+/// table names every file.
 #[test]
 fn found_pairs_pass_validation() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../src/bin/data");
@@ -179,6 +181,8 @@ fn found_pairs_pass_validation() {
         ("rev_c1", 512),
         ("rev_c2", 256),
         ("rev_d2", 512),
+        ("rev_e2", 64),
+        ("rev_e4", 64),
     ];
     for (name, n) in found {
         assert!(

@@ -743,49 +743,86 @@ fn member_config(errors: u8, w: u32) -> Option<Config> {
         8 => Config::DEFAULT.with_localisation_error(3.0, 3.0).ok()?,
         // The deadline's probe (`deadline_gaps`).
         9 => Config::DEFAULT.with_localisation_error(100.0, 100.0).ok()?,
-        // The [`FOUND`] pairs' (a review's hill climbing).
-        10 => Config::new(0.187_798_7, 3.886_967_7, 0.1, 1000.0)
-            .ok()?
-            .with_translation_error(0.000_036_500_76)
-            .ok()?
-            .with_rotation_error([5.444_365e-9, 6.994_154_7e-7, 0.000_011_191_911])
-            .ok()?,
-        11 => Config::new(0.039_700_568, 7.797_034_3, 0.1, 1000.0)
-            .ok()?
-            .with_rotation_error([2.330_313_3e-7, 0.000_001_234_004_8, 0.000_011_155_589])
-            .ok()?,
-        12 => Config::new(0.002_421_314_8, 3.546_954_2, 1.560_985_1, 1000.0)
-            .ok()?
-            .with_rotation_error([0.000_001_897_681, 1.341_467_9e-7, 0.000_001_043_540_7])
-            .ok()?,
-        13 => Config::new(7.236_438_8, 1.773_699_4, 0.1, 1000.0)
-            .ok()?
-            .with_translation_error(0.000_329_890_38)
-            .ok()?
-            .with_rotation_error([0.000_069_144_04, 0.000_004_483_309_6, 0.000_148_353_72])
-            .ok()?,
-        14 => Config::new(0.039_460_093, 7.563_63, 0.230_282_22, 1000.0)
-            .ok()?
-            .with_rotation_error([0.000_001_031_347_8, 1.524_648_6e-7, 0.000_011_155_589])
-            .ok()?,
-        15 => Config::new(1.156_408_3, 20.876_842, 0.1, 1000.0)
-            .ok()?
-            .with_translation_error(0.000_057_453_27)
-            .ok()?,
-        16 => Config::new(0.177_312_46, 0.514_759_96, 0.1, 1000.0)
-            .ok()?
-            .with_translation_error(0.000_036_500_76)
-            .ok()?
-            .with_rotation_error([2.912_029_2e-7, 3.432_673_3e-9, 5.980_558_6e-8])
-            .ok()?,
-        17 => Config::new(0.057_810_06, 0.091_832_56, 89.0, 1000.0)
-            .ok()?
-            .with_rotation_error([0.000_019_466_439, 0.000_011_047_276_5, 5.317_562_6e-7])
-            .ok()?,
-        _ => return None,
+        // The [`FOUND`] pairs' (reviews' hill climbing).
+        id @ 10.. => {
+            let &(e1, e2, angle, t, r) = FOUND_CONFIGS.get(usize::from(id - 10))?;
+            let mut c = Config::new(e1, e2, angle, 1000.0).ok()?;
+            if let Some(t) = t {
+                c = c.with_translation_error(t).ok()?;
+            }
+            if let Some(r) = r {
+                c = c.with_rotation_error(r).ok()?;
+            }
+            c
+        }
     };
     c.with_work_budget(w).ok()
 }
+
+/// The configurations the [`FOUND`] pairs' climbs settled on, ids 10 …
+/// of [`member_config`]: `e₁`, `e₂` (px), the minimum angle (°), the
+/// translation and the rotation error bounds where configured.
+#[allow(clippy::type_complexity)]
+const FOUND_CONFIGS: [(f32, f32, f32, Option<f32>, Option<[f32; 3]>); 8] = [
+    // 10: rev_a1
+    (
+        0.187_798_7,
+        3.886_967_7,
+        0.1,
+        Some(0.000_036_500_76),
+        Some([5.444_365e-9, 6.994_154_7e-7, 0.000_011_191_911]),
+    ),
+    // 11: rev_b1
+    (
+        0.039_700_568,
+        7.797_034_3,
+        0.1,
+        None,
+        Some([2.330_313_3e-7, 0.000_001_234_004_8, 0.000_011_155_589]),
+    ),
+    // 12: rev_b2
+    (
+        0.002_421_314_8,
+        3.546_954_2,
+        1.560_985_1,
+        None,
+        Some([0.000_001_897_681, 1.341_467_9e-7, 0.000_001_043_540_7]),
+    ),
+    // 13: rev_c1
+    (
+        7.236_438_8,
+        1.773_699_4,
+        0.1,
+        Some(0.000_329_890_38),
+        Some([0.000_069_144_04, 0.000_004_483_309_6, 0.000_148_353_72]),
+    ),
+    // 14: rev_c2
+    (
+        0.039_460_093,
+        7.563_63,
+        0.230_282_22,
+        None,
+        Some([0.000_001_031_347_8, 1.524_648_6e-7, 0.000_011_155_589]),
+    ),
+    // 15: rev_d2
+    (1.156_408_3, 20.876_842, 0.1, Some(0.000_057_453_27), None),
+    // 16: rev_e2
+    (
+        0.177_312_46,
+        0.514_759_96,
+        0.1,
+        Some(0.000_036_500_76),
+        Some([2.912_029_2e-7, 3.432_673_3e-9, 5.980_558_6e-8]),
+    ),
+    // 17: rev_e4
+    (
+        0.057_810_06,
+        0.091_832_56,
+        89.0,
+        None,
+        Some([0.000_019_466_439, 0.000_011_047_276_5, 5.317_562_6e-7]),
+    ),
+];
 
 /// Configuration probes of the worst-case sweep: a member's frame pair (its
 /// name and N in the family) under another valid configuration (an id of

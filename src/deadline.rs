@@ -41,8 +41,8 @@
 //!   instructions), not a boundary's worth. What does grow with `N` is
 //!   the flags after the yes (one store a point) and the number of
 //!   questions. The bench measures the lateness where it is worst at
-//!   2 × 256 and 2 × 512 (README, "Within a deadline": 27 770 and 35 737
-//!   instructions; 51 051 and 101 082 before these questions).
+//!   2 × 256 and 2 × 512 (`docs/VEHICLE.md`, "Within a deadline": 26 051 and
+//!   34 564 instructions; 51 051 and 101 082 before these questions).
 //!
 //! **What the cap costs.** The cap holds even while the clock says no, so
 //! a point whose search needs more than `CARRY · w` units at once comes
@@ -120,7 +120,7 @@ pub trait Deadline {
     /// larger carry caps fewer points (`u32::MAX`: none, every result
     /// that of [`crate::Processor::process`] while the clock says no) and
     /// makes the stretches between questions longer, up to about `C_U · w`
-    /// instructions more for each allowance (README, "Within a deadline").
+    /// instructions more for each allowance (`docs/VEHICLE.md`, "Within a deadline").
     fn carry(&self) -> u32 {
         CARRY
     }

@@ -68,7 +68,7 @@ use step4::{flag_pending, match_boundary};
 /// Size (bytes, 32-bit target): `8·B·N` (previous frame) + about
 /// `24.75·N` (search index) + `32·B·N` (output) + a few dozen; for `N =
 /// 256, B = 2` exactly 26 892 B, asserted at compile time below (issue 11
-/// allows up to 28 KiB; README, "Memory", says what the index's bytes buy).
+/// allows up to 28 KiB; `docs/VEHICLE.md`, "Memory", says what the index's bytes buy).
 ///
 /// ```
 /// use roadstereo::{Camera, Config, Frame, Motion, Pixel, Processor, Step};
@@ -277,7 +277,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     /// crossing in the band, where one piece is that crossing's and two
     /// separate ones make the point ambiguous), and without it the search
     /// meets every fold. The fold test protects the points whose
-    /// correspondent is *not* in frame 2 (README, "What the fold test
+    /// correspondent is *not* in frame 2 (`docs/TESTS.md`, "What the fold test
     /// buys").
     #[cfg(any(test, feature = "_reference"))]
     #[doc(hidden)]
@@ -911,7 +911,7 @@ fn segment_distance2(p: [f32; 2], a: [f32; 2], b: [f32; 2]) -> f32 {
 }
 
 // `Processor<256, 2>` is 26 892 B on the vehicle controller (README,
-// "Memory"): a change that grows it fails the build, one that shrinks it
+// "Memory"; every figure in `docs/VEHICLE.md`): a change that grows it fails the build, one that shrinks it
 // lowers this figure.
 #[cfg(target_pointer_width = "32")]
 const _: () = assert!(core::mem::size_of::<Processor<256, 2>>() <= 26_892);

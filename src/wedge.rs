@@ -584,8 +584,8 @@ pub(crate) const REFINE_GAP: f32 = 4.0;
 /// on top of what the walk paid to clip it. A paid segment costs about 245
 /// instructions more than an unpaid one (measured on the bench's `+e_3`
 /// probes against a build that charges but skips the bounds), so at four
-/// units a unit of it costs about 61, less than the band path's (README,
-/// "Worst case": `C_U` 105); at two it would cost about 122.
+/// units a unit of it costs about 61, less than the band path's (`docs/VEHICLE.md`,
+/// "Worst case": `C_U`, 120 today); at two it would cost about 122.
 pub(crate) const REFINE_UNITS: u32 = 4;
 
 /// A depth estimate and the stick's ends in the compensated frame, `(s,

@@ -243,7 +243,7 @@ fn certify_containment() {
     );
 }
 
-/// The search alone holds the guarantee (README, "What the fold test
+/// The search alone holds the guarantee (`docs/TESTS.md`, "What the fold test
 /// buys"): with the library's fold test switched off, so that every point
 /// on a fold is searched as well, the truth lies inside the stick of
 /// 100 % of the `ok` points with a correspondent, in every variant of the
@@ -382,11 +382,11 @@ fn indexed_equals_reference_without_the_fold_test() {
 }
 
 /// Issue 11's yield targets: actual >= 90 % of the ideal yield over all
-/// families and >= 80 % in each, in every variant. Not met today (README,
-/// "What the tests show", gives the figures and where the points go):
+/// families and >= 80 % in each, in every variant. Not met today (`docs/TESTS.md`
+/// gives the figures and where the points go):
 /// `cargo test --profile checked --test certify -- --ignored` checks them.
 #[test]
-#[ignore = "issue 11's yield targets are not met yet (README gives the figures)"]
+#[ignore = "issue 11's yield targets are not met yet (docs/TESTS.md gives the figures)"]
 fn certify_yield_targets() {
     let (families, per, full) = families_from_env();
     let rep = certify(&families, 0..per);

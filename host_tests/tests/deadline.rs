@@ -3,7 +3,7 @@
 //! not done is `over_budget` and the call returns; the points done before
 //! are complete results. Here the clock is a count of the questions it is
 //! asked, so every cut is reproducible; the firmware bench measures the
-//! same with SysTick as the clock (README, "Within a deadline").
+//! same with SysTick as the clock (`docs/VEHICLE.md`, "Within a deadline").
 //!
 //! The results are compared with the same configuration's with the
 //! largest work budget and no deadline (whose sticks the certification
@@ -248,7 +248,7 @@ fn every_cut_of_the_adversarial_family_is_complete_or_flagged() {
             pairs += 1;
         }
     }
-    // What the cap costs here is reported (README, "Within a deadline").
+    // What the cap costs here is reported (`docs/VEHICLE.md`, "Within a deadline").
     eprintln!("{pairs} pairs: {total:?}");
     assert!(pairs >= 40, "{pairs} pairs");
     assert!(

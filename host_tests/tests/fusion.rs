@@ -126,7 +126,7 @@ fn containment(noise: Noise, motion: Option<MotionNoise>, per_family: usize) -> 
 }
 
 /// What the work budget and the cap of a deadline cost on the fusion's
-/// drives, whose pairs reach across up to eight frames (README, "Within a
+/// drives, whose pairs reach across up to eight frames (`docs/VEHICLE.md`, "Within a
 /// deadline" and "Worst case"):
 ///
 /// * **The default budget, no clock.** A point the budget flags
@@ -143,7 +143,7 @@ fn containment(noise: Noise, motion: Option<MotionNoise>, per_family: usize) -> 
 ///   drive's first changed point (after it the key frames may differ). An
 ///   adversarial review found such a drive of its own.
 ///
-/// The figures printed are README's.
+/// The figures printed are `docs/FUSION.md`'s.
 #[test]
 fn the_deadline_cap_on_the_drives() {
     let policy = FusionConfig::DEFAULT;
@@ -264,7 +264,7 @@ fn the_deadline_cap_on_the_drives() {
     assert!(pairs > compared * (FRAMES / 2), "{pairs} pairs compared");
     assert!(
         all_points > 2_000_000 && !budget_flagged.is_empty(),
-        "the budget binds nowhere: {budget_flagged:?} (README's figure to update)"
+        "the budget binds nowhere: {budget_flagged:?} (docs/FUSION.md's figure to update)"
     );
     assert_eq!(
         budget_flagged.get("ok"),
@@ -1055,7 +1055,7 @@ fn the_map_radius_covers_the_key_frames_localisation_error() {
     assert!(checked >= 6, "{checked} map points");
 }
 
-/// The limit of the consistency check, pinned (README, "Limits"; found by
+/// The limit of the consistency check, pinned (`docs/FUSION.md`, "Limits"; found by
 /// an adversarial review, reduced from its crest family): every pair's
 /// stick is guaranteed only where the point's true correspondent is in
 /// that partner's data. Here the vehicle drives over a crest; the key
@@ -1069,7 +1069,7 @@ fn the_map_radius_covers_the_key_frames_localisation_error() {
 /// one the key frame saw. No pair here contradicts it (the first has no
 /// match), and no check on these polylines could: the three views agree.
 /// (The per-frame rotation errors are inside the configured bounds.) If a
-/// change catches it, this test fails: update README's limits with it.
+/// change catches it, this test fails: update `docs/FUSION.md`'s limits with it.
 #[test]
 fn limit_two_partners_past_a_crest_agree_on_the_hidden_stretch() {
     let cam = roadstereo::Camera::new(2040.024, 1751.3557, 555.9182, 350.90897, 1280, 720)
@@ -1137,7 +1137,7 @@ fn limit_two_partners_past_a_crest_agree_on_the_hidden_stretch() {
     assert!(iv.z_near > 4.0 * z_seen && iv.z_far < 70.0, "{iv:?}");
 }
 
-/// The same limit with one pair (README, "Limits"): the partner sees only
+/// The same limit with one pair (`docs/FUSION.md`, "Limits"): the partner sees only
 /// another stretch of the boundary, at the image's left edge, 670 px from
 /// the point's true image; the pair matches it and the point is `Single`
 /// at depth 2.28 where the truth is 52.8. A `Single` point is a two-view

@@ -1,5 +1,5 @@
 //! State + output of the per-frame processor fit their budget: exactly
-//! what they need (README, "Memory"; issue 11 allows up to 28 KiB).
+//! what they need (`docs/VEHICLE.md`, "Memory"; issue 11 allows up to 28 KiB).
 
 use roadstereo::{Frame, Processor, Structure};
 

@@ -50,7 +50,7 @@
 //! with the composed motion as given: without configured motion errors
 //! its sticks do not see this rounding (about `5 u`, `3·10⁻⁷`, of the
 //! rotation a frame as measured: at worst about `0.015` px at f = 800 over
-//! 64 frames; README, "Limits" of the fusion).
+//! 64 frames; `docs/FUSION.md`, "Limits").
 
 use crate::config::{Config, ConfigError};
 use crate::math::{mat3_mul, mat3_transpose, mat3_vec, sqrt, Mat3};

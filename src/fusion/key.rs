@@ -61,7 +61,7 @@ pub enum FusedStatus {
     /// Two or more pairs have, and all their intervals share the fused one.
     /// (Agreement is evidence, not proof: pairs whose partners all see
     /// another stretch of the boundary along the same rays, e.g. one the
-    /// key frame's view hid behind a crest, can agree on its depth; README,
+    /// key frame's view hid behind a crest, can agree on its depth; `docs/FUSION.md`,
     /// "Limits".)
     Consistent,
     /// Some interval missed the others: a pair matched wrongly. The

@@ -23,8 +23,8 @@
 //! the number of frames. Without configured bounds the composed motion is
 //! taken as exact, and its `f32` rounding (about `5 u` of the rotation a
 //! frame, at worst about `0.015` px at f = 800 over 64 frames) is left to the localisation
-//! errors' slack: the pairs' sticks do not carry it (README, "Limits" of
-//! the fusion); the road map's radius does (`crate::map`, "The radius").
+//! errors' slack: the pairs' sticks do not carry it (`docs/FUSION.md`,
+//! "Limits"); the road map's radius does (`crate::map`, "The radius").
 //!
 //! # Longer baselines, informative pairs
 //! Pairing with the key frame rather than with the previous frame makes the
@@ -76,8 +76,8 @@
 //! one more pass to copy its points into the map. The depths of the map
 //! and of the rival intervals are 16-bit codes relative to a power of two
 //! at or above the configuration's maximum depth (resolution `2⁻¹²` of the
-//! depth for depths within `2¹⁵` of it, rounded outwards). README
-//! ("Fusing many frames") gives the instructions measured.
+//! depth for depths within `2¹⁵` of it, rounded outwards). `docs/FUSION.md`
+//! ("What the fusion tests show") gives the instructions measured.
 
 mod chain;
 pub(crate) mod code;
@@ -434,7 +434,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// matched" rule (a frame the clock cut short says nothing about how
     /// much of the key frame is still in view). The fusion's own work after
     /// the matching (one pass over the key frame's points, the map) is not
-    /// cut: it is bounded by the points (README, "Fusing many frames"), so
+    /// cut: it is bounded by the points (`docs/FUSION.md`), so
     /// leave room for it in the limit.
     pub fn step_within<D: Deadline>(
         &mut self,

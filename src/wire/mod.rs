@@ -192,7 +192,7 @@ impl Default for DataIds {
 }
 
 /// The CRC's implementation: one 256-entry table (1 KiB of flash), about
-/// five instructions a byte on the Cortex-M4F; README ("The link") gives
+/// five instructions a byte on the Cortex-M4F; `docs/VEHICLE.md` ("The link") gives
 /// the measured trade-off against no table and 16 tables. (The decoder
 /// runs its own register over this table, a word at a time, inside its
 /// pass over the points: see `decode`.)

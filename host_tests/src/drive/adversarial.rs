@@ -421,7 +421,7 @@ pub fn hand_members() -> Vec<Member> {
     // Found by an adversarial review (issue 11): backward motion (every
     // point on the band path), forward log spirals about an FOE inside the
     // image, and configured motion errors; the formula of README's "Worst
-    // case" did not hold on them until they joined the family.
+    // case" (`docs/VEHICLE.md`) did not hold on them until they joined the family.
     let get = |name: &str| {
         v.iter()
             .find(|x| x.name == name)

@@ -18,7 +18,7 @@ use roadstereo::calibration::{
 };
 use roadstereo::fusion::{ChainedMotion, Fusion, FusionConfig};
 use roadstereo::geometry::Sample;
-use roadstereo::link::{write_packet, UartLink};
+use roadstereo::link::{write_packet, SpiLink, UartLink};
 use roadstereo::wire::{encode, result, DataIds, Event, Receiver, ResultView};
 use roadstereo::{Camera, Config, Frame, Motion, Pixel, Processor, Step};
 
@@ -42,6 +42,41 @@ impl embedded_io::Write for Opaque {
     }
     fn flush(&mut self) -> Result<(), Self::Error> {
         Ok(())
+    }
+}
+
+/// An SPI bus and a data-ready pin the optimiser cannot see through.
+struct OpaqueSpi;
+impl embedded_hal::spi::ErrorType for OpaqueSpi {
+    type Error = embedded_hal::spi::ErrorKind;
+}
+impl embedded_hal::spi::SpiDevice for OpaqueSpi {
+    fn transaction(
+        &mut self,
+        ops: &mut [embedded_hal::spi::Operation<'_, u8>],
+    ) -> Result<(), Self::Error> {
+        for op in ops.iter_mut() {
+            if let embedded_hal::spi::Operation::Read(buf) = op {
+                for b in buf.iter_mut() {
+                    *b = black_box(0x5A);
+                }
+            }
+        }
+        if black_box(false) {
+            return Err(embedded_hal::spi::ErrorKind::Other);
+        }
+        Ok(())
+    }
+}
+impl embedded_hal::digital::ErrorType for OpaqueSpi {
+    type Error = core::convert::Infallible;
+}
+impl embedded_hal::digital::InputPin for OpaqueSpi {
+    fn is_high(&mut self) -> Result<bool, Self::Error> {
+        Ok(black_box(true))
+    }
+    fn is_low(&mut self) -> Result<bool, Self::Error> {
+        Ok(black_box(false))
     }
 }
 
@@ -220,6 +255,13 @@ fn main() -> ! {
                     }
                 }
                 _ => {}
+            });
+        }
+        // The SPI driver into the same receiver.
+        let mut spi = SpiLink::new(OpaqueSpi, OpaqueSpi);
+        for _ in 0..black_box(3) {
+            let _ = spi.poll(&mut rx, |ev| {
+                black_box(matches!(ev, Event::Frame(_)));
             });
         }
         let bytes = black_box(&raw[..]);

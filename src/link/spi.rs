@@ -21,7 +21,7 @@ use embedded_hal::digital::InputPin;
 use embedded_hal::spi::{Operation, SpiDevice};
 
 use super::{cut, Error};
-use crate::wire::{cobs_max, frame_packet_max, Event, Receiver};
+use crate::wire::{cobs_max, input_packet_max, Event, Receiver};
 
 /// Bytes of the length header.
 pub const SPI_HEADER_LEN: usize = 4;
@@ -71,7 +71,9 @@ impl<SPI: SpiDevice, DR: InputPin> SpiLink<SPI, DR> {
         if len == 0 || u16::from_le_bytes([c, d]) != !len {
             return Err(Error::BadHeader { raw: head });
         }
-        let max = u16::try_from(cobs_max(frame_packet_max(N, B))).unwrap_or(u16::MAX);
+        // (Any packet the receiver takes: at a small capacity a motion
+        // packet is larger than the largest frame packet.)
+        let max = u16::try_from(cobs_max(input_packet_max(N, B))).unwrap_or(u16::MAX);
         let too_large = len > max;
         let mut left = usize::from(len);
         while left > 0 {

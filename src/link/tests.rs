@@ -223,6 +223,47 @@ fn spi_bus_error_mid_frame_ends_the_packet_and_the_next_decodes() {
     pin.done();
 }
 
+/// At a small capacity a motion packet (68 bytes on the link) is larger
+/// than the largest frame packet: the SPI driver still takes it, and a
+/// camera packet (until a review, it read and dropped a motion packet as
+/// `TooLarge` at `B` = 2, `N` = 2).
+#[test]
+fn spi_small_capacity_takes_motion_and_camera_packets() {
+    let cam_b = camera_bytes(0);
+    let mut raw = [0u8; 80];
+    let m = encode::MotionFields {
+        from: 1,
+        to: 2,
+        translation: [0.0, 0.0, 0.4],
+        rotation: [0.0; 3],
+        translation_error: None,
+        rotation_error: None,
+    };
+    let n = encode::motion(&mut raw, IDS.motion, 0, &m).unwrap();
+    let mot = framed(&raw[..n]);
+    assert!(mot.len() > cobs_max(crate::wire::frame_packet_max(2, 2)));
+    let mut spi_t = spi_script(&cam_b);
+    spi_t.extend(spi_script(&mot));
+    let pin = Pin::new(&[PinT::get(State::High), PinT::get(State::High)]);
+    let mut link = SpiLink::new(Spi::new(&spi_t), pin);
+    let mut rx = Receiver::<2, 2>::new(IDS, Config::DEFAULT);
+    let mut log = Vec::new();
+    for _ in 0..2 {
+        let polled = link.poll(&mut rx, |e| {
+            log.push(match e {
+                Event::Camera => "camera",
+                Event::Motion(_) => "motion",
+                _ => "other",
+            })
+        });
+        assert_eq!(polled, Ok(true));
+    }
+    assert_eq!(log, ["camera", "motion"]);
+    let (mut spi, mut pin) = link.release();
+    spi.done();
+    pin.done();
+}
+
 #[test]
 fn spi_data_ready_stuck_high_gives_bad_headers_and_returns() {
     // A floating bus reads all ones: the header's check fails every time.

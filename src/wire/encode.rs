@@ -152,11 +152,39 @@ impl<'a> FramePacket<'a> {
         Ok(Self { w, count: 0 })
     }
 
-    /// Append the next boundary (points rounded to 1/16 px).
+    /// Append the next boundary (points rounded to 1/16 px). On an error
+    /// nothing of the boundary is kept: the packet is as it was before the
+    /// call, so a caller may skip the boundary and go on, and
+    /// [`FramePacket::finish`] gives the boundaries that were appended.
     pub fn boundary(&mut self, head: &BoundaryHead, points: &[Pixel]) -> Result<(), EncodeError> {
+        // (Every check before the count moves; the bytes written before a
+        // failing one are taken back, so no partial boundary reaches
+        // `finish`.)
+        let index = self.count;
+        let count = index.checked_add(1).ok_or(EncodeError::TooLarge)?;
+        let start = self.w.at;
+        match self.write_boundary(index, head, points) {
+            Ok(()) => {
+                self.count = count;
+                Ok(())
+            }
+            Err(e) => {
+                self.w.at = start;
+                Err(e)
+            }
+        }
+    }
+
+    /// The bytes of boundary `index`; on an error some may be written.
+    fn write_boundary(
+        &mut self,
+        index: u8,
+        head: &BoundaryHead,
+        points: &[Pixel],
+    ) -> Result<(), EncodeError> {
         let n = u16::try_from(points.len()).map_err(|_| EncodeError::TooLarge)?;
         let r = radius_to_raw(head.radius_px).ok_or(EncodeError::Radius)?;
-        self.w.u8(self.count)?;
+        self.w.u8(index)?;
         self.w.u8(head.quality)?;
         self.w.u16(r)?;
         self.w.u16(n)?;
@@ -166,7 +194,6 @@ impl<'a> FramePacket<'a> {
             self.w.u16(u)?;
             self.w.u16(v)?;
         }
-        self.count = self.count.checked_add(1).ok_or(EncodeError::TooLarge)?;
         Ok(())
     }
 

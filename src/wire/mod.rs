@@ -88,6 +88,24 @@ pub const fn frame_payload_max(n: usize, b: usize) -> usize {
 pub const fn frame_packet_max(n: usize, b: usize) -> usize {
     HEADER_LEN + frame_payload_max(n, b) + CRC_LEN
 }
+/// Largest packet (header, payload, CRC) before COBS that a receiver of
+/// `B` boundaries of up to `N` points takes in: its largest frame packet,
+/// or a motion or camera packet where that is larger (a small capacity).
+pub const fn input_packet_max(n: usize, b: usize) -> usize {
+    let frame = frame_packet_max(n, b);
+    let fixed = HEADER_LEN
+        + CRC_LEN
+        + if MOTION_LEN > CAMERA_LEN {
+            MOTION_LEN
+        } else {
+            CAMERA_LEN
+        };
+    if frame > fixed {
+        frame
+    } else {
+        fixed
+    }
+}
 /// Largest result packet before COBS.
 pub const fn result_packet_max(n: usize, b: usize) -> usize {
     HEADER_LEN + RESULT_HEAD_LEN + b * (RESULT_BOUNDARY_LEN + RESULT_POINT_MAX * n) + CRC_LEN

@@ -440,3 +440,57 @@ fn px_to_raw_rounds_exactly() {
     }
     assert!(checked > 1_000_000, "{checked}");
 }
+
+/// A boundary the encoder refuses leaves nothing behind: a packet with
+/// refused boundaries between the good ones is, byte for byte, the packet
+/// of the good ones alone (until a review, the refused boundary's head and
+/// points before the bad one stayed in the packet, with a valid CRC, and
+/// decoded as another boundary than any the caller wrote).
+#[test]
+fn a_refused_boundary_leaves_the_packet_as_it_was() {
+    use encode::EncodeError;
+    let head = FrameHead {
+        timestamp_us: 7,
+        frame_id: 3,
+        width: 512,
+        height: 480,
+    };
+    let bh = |k: u8, r: f32| BoundaryHead {
+        quality: k,
+        radius_px: r,
+    };
+    let (p1, p2) = (line(40, 100.0), line(30, 140.0));
+    let mut want = vec![0u8; 1024];
+    let goods = [(bh(1, 0.25), &p1[..]), (bh(2, 0.5), &p2[..])];
+    let n = encode::frame(&mut want, IDS.frame, 4, &head, &goods).unwrap();
+    want.truncate(n);
+    let mut bad_late = line(25, 300.0);
+    bad_late[17] = Pixel::new(5000.0, 200.0);
+    let mut bad_first = line(12, 300.0);
+    bad_first[0] = Pixel::new(-3.0, 200.0);
+    let big = line(60, 300.0);
+    // (A roomy buffer: refused for a point or the radius; a buffer of the
+    // good packet's size: refused for want of room part way through.)
+    let cases: [(usize, &[(BoundaryHead, &[Pixel], EncodeError)]); 2] = [
+        (
+            1024,
+            &[
+                (bh(5, 1.0), &bad_late, EncodeError::PointRange),
+                (bh(6, 1.0), &bad_first, EncodeError::PointRange),
+                (bh(7, 1000.0), &p2, EncodeError::Radius),
+            ],
+        ),
+        (n, &[(bh(8, 1.0), &big, EncodeError::BufferTooSmall)]),
+    ];
+    for (room, refused) in cases {
+        let mut got = vec![0u8; room];
+        let mut p = encode::FramePacket::begin(&mut got, IDS.frame, 4, &head).unwrap();
+        p.boundary(&goods[0].0, goods[0].1).unwrap();
+        for (h, pts, e) in refused {
+            assert_eq!(p.boundary(h, pts), Err(*e), "{e:?}");
+        }
+        p.boundary(&goods[1].0, goods[1].1).unwrap();
+        let len = p.finish().unwrap();
+        assert_eq!(&got[..len], &want[..], "room {room}");
+    }
+}

@@ -130,7 +130,11 @@ pub enum Event<'a, const N: usize, const B: usize> {
     Motion(MotionPacket),
     /// A camera packet was taken.
     Camera,
-    /// A typed error (see [`WireError`]).
+    /// A typed error (see [`WireError`]). A damaged stream can give one
+    /// for every two bytes (`01 00` repeated is a truncated packet each
+    /// time): a firmware that answers each with a packet of its own, as
+    /// the `link` firmware's report does, sends more than it receives and
+    /// should limit the rate (the receiver's [`Counters`] count them all).
     Error(WireError),
     /// The end of the stream.
     End,

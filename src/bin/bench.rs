@@ -225,7 +225,7 @@ fn fusion_within(fusion: &mut Fusion<256, 2, 512>) -> bool {
         return false;
     };
     let mut frame = Frame::<256, 2>::new(drive.camera);
-    let budget = ticks_of(DRIVE_LIMIT);
+    let budget = fw::ticks_of(DRIVE_LIMIT);
     for i in 0..drive.frames {
         let Ok(motion) = drive.next_frame(&mut frame) else {
             return false;
@@ -508,13 +508,6 @@ const DEADLINE_LIMITS: [u32; 15] = [
     220_000, 240_000, 260_000, 280_000,
 ];
 
-/// Core-clock ticks of `instructions` instructions under `-icount shift=5`
-/// (the inverse of [`fw::instructions`]).
-fn ticks_of(instructions: u32) -> u64 {
-    let ns = u128::from(instructions) * 32;
-    u64::try_from(ns * u128::from(fw::board::CORE_HZ) / 1_000_000_000).unwrap_or(u64::MAX)
-}
-
 /// The per-frame call of frame pair `(f1, f2)` within a deadline of
 /// `limit` instructions, by SysTick (what a firmware's cycle counter
 /// would be): the measured call, and when the clock first said the time
@@ -524,7 +517,7 @@ fn measure_within(
     pair: (&Frame<CAP, 2>, &Frame<CAP, 2>, &roadstereo::Motion),
     limit: u32,
 ) -> (Measured, Option<u32>) {
-    let budget = ticks_of(limit);
+    let budget = fw::ticks_of(limit);
     let mut first = None;
     let r = call_within(processor, pair, &mut |dt| {
         let up = dt >= budget;

@@ -29,6 +29,19 @@ const B: usize = 2;
 /// counted as one cycle (as the demo).
 const BUDGET_INSTRUCTIONS: u32 = 33 * 168_000 / 20;
 
+/// With the feature `link-deadline`, each frame runs within SysTick as the
+/// deadline's clock ([`roadstereo::wire::FrameJob::run_within`]), the
+/// clock saying yes at [`LIMIT_INSTRUCTIONS`]: every frame then ends within
+/// [`BUDGET_INSTRUCTIONS`], the points the time did not reach flagged
+/// `over_budget` (`cargo xtask stream FILE --within` checks both). Without
+/// it the call is not bounded by a clock, and the host reproduces every
+/// result bit for bit.
+const WITHIN: bool = cfg!(feature = "link-deadline");
+
+/// The clock's limit within a deadline: the frame budget less the lateness
+/// README tells a firmware to allow for (40 000 instructions).
+const LIMIT_INSTRUCTIONS: u32 = BUDGET_INSTRUCTIONS - 40_000;
+
 /// UART0 of the mps2-an386 (CMSDK APB UART), register level. The library
 /// stays free of `unsafe`: the volatile register accesses live here.
 mod uart0 {
@@ -128,10 +141,12 @@ fn main() -> ! {
     let mut framed = [0u8; wire::cobs_max(RAW)];
     let (mut results, mut reports) = (0u16, 0u16);
     defmt::info!(
-        "roadstereo link: UART0, capacity {=usize} x {=usize}, budget {=u32} instructions/frame",
+        "roadstereo link: UART0, capacity {=usize} x {=usize}, budget {=u32} instructions/frame, within a deadline {=bool} (limit {=u32})",
         B,
         N,
-        BUDGET_INSTRUCTIONS
+        BUDGET_INSTRUCTIONS,
+        WITHIN,
+        LIMIT_INSTRUCTIONS
     );
     defmt::info!(
         "sizes receiver={=usize} uart_link={=usize} result_buffers={=usize}",
@@ -143,7 +158,13 @@ fn main() -> ! {
         let mut end = false;
         let polled = link.poll(rx, |ev| match ev {
             Event::Frame(job) => {
-                let (step, instr) = fw::measure(|| job.run(processor));
+                let (step, instr) = if WITHIN {
+                    let (t0, limit) = (fw::ticks(), fw::ticks_of(LIMIT_INSTRUCTIONS));
+                    let mut clock = || fw::ticks().saturating_sub(t0) >= limit;
+                    fw::measure(|| job.run_within(processor, &mut clock))
+                } else {
+                    fw::measure(|| job.run(processor))
+                };
                 let Ok(step) = step else {
                     defmt::error!("frame {=u32}: processor refused", job.info.frame_id);
                     return;

@@ -97,7 +97,8 @@ pub fn ci() -> Result<(), String> {
     // netduinoplus2: the same results, the same instruction counts.
     demo_on_both_boards()?;
     // The link: the README's example drive streamed over UART0, then the
-    // demo drive with faults injected; any divergence fails.
+    // demo drive with faults injected, without and within a deadline; any
+    // divergence fails.
     stream(&["docs/example.jsonl".into()])?;
     stream(&[
         "--drive".into(),
@@ -110,6 +111,22 @@ pub fn ci() -> Result<(), String> {
         "0.05".into(),
         "--seed".into(),
         "1".into(),
+    ])?;
+    // The same within a deadline on the firmware (feature `link-deadline`):
+    // every frame within the budget, each result the host's point for
+    // point or `over_budget`.
+    stream(&[
+        "--drive".into(),
+        "src/bin/data/drive.bin".into(),
+        "--corrupt".into(),
+        "0.1".into(),
+        "--drop".into(),
+        "0.05".into(),
+        "--duplicate".into(),
+        "0.05".into(),
+        "--seed".into(),
+        "1".into(),
+        "--within".into(),
     ])?;
     let bench = bench(&bench_args(&[])?);
     // The profiler too, so it cannot rot (about ten seconds), with its

@@ -67,9 +67,15 @@ pub fn build_firmware(bin: &str) -> Result<PathBuf, String> {
 
 /// Build a firmware binary (release) for `board` and return its ELF path.
 pub fn build_firmware_for(bin: &str, board: Board) -> Result<PathBuf, String> {
+    build_firmware_with(bin, board, "")
+}
+
+/// [`build_firmware_for`] with `extra` cargo features beside the board's.
+pub fn build_firmware_with(bin: &str, board: Board, extra: &str) -> Result<PathBuf, String> {
     let r = root();
     let dir = board.target_dir();
     let dir_s = dir.to_string_lossy().to_string();
+    let features = format!("{} {extra}", board.features());
     run(
         &r,
         "cargo",
@@ -81,7 +87,7 @@ pub fn build_firmware_for(bin: &str, board: Board) -> Result<PathBuf, String> {
             "--target-dir",
             &dir_s,
             "--features",
-            board.features(),
+            features.trim(),
             "--bin",
             bin,
         ],

@@ -1,21 +1,26 @@
 //! `cargo xtask stream FILE.jsonl [--drive] [--corrupt P] [--drop P]
-//! [--duplicate P] [--seed S] [--radius PX] [--frames K]`: a recorded drive
-//! streamed into the link firmware on the emulated controller over UART0,
-//! every result compared bit for bit with the host build (the comparison
-//! and the tables are `host_tests`' `stream` tool).
+//! [--duplicate P] [--seed S] [--radius PX] [--frames K] [--within]`: a
+//! recorded drive streamed into the link firmware on the emulated
+//! controller over UART0, every result compared bit for bit with the host
+//! build (the comparison and the tables are `host_tests`' `stream` tool);
+//! with `--within` the firmware runs each frame within a deadline (feature
+//! `link-deadline`), and each of its results must be the host's point for
+//! point or `over_budget`, within the frame budget.
 
-use crate::firmware::build_firmware;
+use crate::firmware::{build_firmware_with, Board};
 use crate::setup::setup_emulator;
 use crate::util::{root, run};
 
-pub const STREAM_USAGE: &str = "usage: cargo xtask stream FILE.jsonl [--drive] [--corrupt P] [--drop P] [--duplicate P] [--seed S] [--radius PX] [--frames K]
+pub const STREAM_USAGE: &str = "usage: cargo xtask stream FILE.jsonl [--drive] [--corrupt P] [--drop P] [--duplicate P] [--seed S] [--radius PX] [--frames K] [--within]
   FILE.jsonl   replay JSON Lines (README, \"Replay\"); with --drive, the firmware drive format (src/bin/data/drive.bin)
   --corrupt P  flip one bit in a packet with probability P (per packet)
   --drop P     drop a packet with probability P
   --duplicate P  send a packet twice with probability P
   --seed S     the fault injection's seed (default 0)
   --radius PX  every boundary's localisation-error radius (default 0.5)
-  --frames K   only the first K frames";
+  --frames K   only the first K frames
+  --within     each frame within a deadline on the firmware (SysTick, the frame budget less 40 000):
+               every result the host's point for point or over_budget, every frame within the budget";
 
 pub fn stream(args: &[String]) -> Result<(), String> {
     if args.is_empty() || args.iter().any(|a| a == "--help" || a == "-h") {
@@ -27,7 +32,12 @@ pub fn stream(args: &[String]) -> Result<(), String> {
         };
     }
     setup_emulator()?;
-    let elf = build_firmware("link")?;
+    let within = args.iter().any(|a| a == "--within");
+    let elf = build_firmware_with(
+        "link",
+        Board::Mps2,
+        if within { "link-deadline" } else { "" },
+    )?;
     let cwd = std::env::current_dir().map_err(|e| e.to_string())?;
     // The file as the user named it, from where they ran cargo.
     let mut a: Vec<String> = Vec::new();

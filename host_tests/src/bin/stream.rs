@@ -2,7 +2,12 @@
 //! compare every output packet with the host build, bit for bit.
 //!
 //! `stream --elf ELF [--drive] FILE [--corrupt P] [--drop P] [--duplicate P]
-//! [--seed S] [--radius PX] [--frames K]`
+//! [--seed S] [--radius PX] [--frames K] [--within]`
+//!
+//! With `--within` the firmware runs each frame within a deadline (its
+//! feature `link-deadline`): then each result must be the host's point for
+//! point, or `over_budget` where the deadline cut the frame, and every
+//! frame within the frame budget; every other packet bit for bit.
 //!
 //! FILE is replay JSON Lines, or with `--drive` the firmware drive format
 //! (`src/bin/data/drive.bin`). `cargo xtask stream` builds the firmware and
@@ -28,6 +33,7 @@ struct Args {
     faults: Faults,
     radius: f32,
     frames: Option<usize>,
+    within: bool,
 }
 
 fn args() -> Result<Args, String> {
@@ -38,6 +44,7 @@ fn args() -> Result<Args, String> {
         faults: Faults::default(),
         radius: 0.5,
         frames: None,
+        within: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(x) = it.next() {
@@ -45,6 +52,7 @@ fn args() -> Result<Args, String> {
         match x.as_str() {
             "--elf" => a.elf = val("--elf")?,
             "--drive" => a.drive = true,
+            "--within" => a.within = true,
             "--corrupt" => {
                 a.faults.corrupt = val("--corrupt")?
                     .parse()
@@ -83,7 +91,7 @@ fn args() -> Result<Args, String> {
         }
     }
     if a.elf.is_empty() || a.file.is_empty() {
-        return Err("usage: stream --elf ELF [--drive] FILE [--corrupt P] [--drop P] [--duplicate P] [--seed S] [--radius PX] [--frames K]".into());
+        return Err("usage: stream --elf ELF [--drive] FILE [--corrupt P] [--drop P] [--duplicate P] [--seed S] [--radius PX] [--frames K] [--within]".into());
     }
     Ok(a)
 }
@@ -250,6 +258,9 @@ fn main() -> ExitCode {
     // Every packet, bit for bit (a result's instruction count is the
     // firmware's own and is set to 0 for the comparison).
     let mut compared = 0usize;
+    // Within a deadline: the frames the clock cut, their points flagged
+    // for it, and the frames over the budget.
+    let (mut cut_frames, mut cut_points, mut looser_sticks) = (0usize, 0u64, 0u64);
     let mut fw_errors: BTreeMap<ErrorKind, u32> = BTreeMap::new();
     let mut host_errors: BTreeMap<ErrorKind, u32> = BTreeMap::new();
     let mut rows = Vec::new();
@@ -258,7 +269,18 @@ fn main() -> ExitCode {
         if link::type_of(f) == Some(PacketType::Result) {
             ResultView::zero_instructions(&mut f0);
         }
-        if &f0 != h {
+        let both_results = link::type_of(f) == Some(PacketType::Result)
+            && link::type_of(h) == Some(PacketType::Result);
+        if a.within && both_results {
+            match within_matches(f, h) {
+                Ok((flagged, looser, cut)) => {
+                    cut_frames += usize::from(cut);
+                    cut_points += flagged;
+                    looser_sticks += looser;
+                }
+                Err(e) => divergences.push(format!("output packet {i}: {e}")),
+            }
+        } else if &f0 != h {
             divergences.push(format!("output packet {i} differs"));
         }
         if let Ok(c) = check(f) {
@@ -315,14 +337,14 @@ fn main() -> ExitCode {
 
     println!();
     println!(
-        "| frame | kept | points | ok | flagged | instructions | instr/point | frame budget used |"
+        "| frame | kept | points | ok | flagged | instructions | instr/point | frame budget used | the deadline cut it |"
     );
-    println!("|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---:|---:|---:|---:|---:|---:|---:|---:|---|");
     for r in rows.iter().filter(|r| r.structure) {
         let points = r.total;
         let ok = u64::from(r.ok);
         println!(
-            "| {} | {} | {} | {} | {} | {} | {} | {:.1} % |",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.1} % | {} |",
             r.frame_id,
             r.kept_id,
             points,
@@ -330,7 +352,8 @@ fn main() -> ExitCode {
             points - ok,
             r.instructions,
             u64::from(r.instructions) / points.max(1),
-            f64::from(r.instructions) * 100.0 / BUDGET_INSTRUCTIONS as f64
+            f64::from(r.instructions) * 100.0 / BUDGET_INSTRUCTIONS as f64,
+            if r.deadline_expired { "yes" } else { "" }
         );
     }
     println!();
@@ -353,7 +376,14 @@ fn main() -> ExitCode {
         println!("| (none) | 0 | 0 |");
     }
     println!();
-    println!("| faults injected (corrupted / dropped / duplicated) | errors reported | frame packets sent | frames compared bit for bit | pairs also in the fault-free run, identical | divergences |");
+    println!(
+        "| faults injected (corrupted / dropped / duplicated) | errors reported | frame packets sent | frames compared {} | pairs also in the fault-free run, identical | divergences |",
+        if a.within {
+            "(within a deadline: the host's or `over_budget`)"
+        } else {
+            "bit for bit"
+        }
+    );
     println!("|---|---:|---:|---:|---:|---:|");
     println!(
         "| {} / {} / {} | {} | {} | {} | {} / {} | {} |",
@@ -367,11 +397,42 @@ fn main() -> ExitCode {
         shared,
         divergences.len()
     );
+    if a.within {
+        let worst = rows
+            .iter()
+            .filter(|r| r.structure)
+            .map(|r| r.instructions)
+            .max()
+            .unwrap_or(0);
+        let host_ok: u64 = host
+            .iter()
+            .filter_map(|h| check(h).ok())
+            .filter(|c| c.ptype == PacketType::Result)
+            .filter_map(|c| ResultView::parse(c.payload).ok())
+            .map(|v| u64::from(v.count(Status::Ok)))
+            .sum();
+        let fw_ok: u64 = rows.iter().map(|r| u64::from(r.ok)).sum();
+        println!();
+        println!(
+            "stream: within a deadline: the clock cut {cut_frames} of {compared} frames; {cut_points} points `over_budget` that were not without a deadline, {looser_sticks} sticks left looser; `ok` points {fw_ok} against {host_ok} without a deadline; the costliest frame {worst} instructions, {:.1} % of the budget {BUDGET_INSTRUCTIONS}",
+            f64::from(worst) * 100.0 / BUDGET_INSTRUCTIONS as f64
+        );
+        if u64::from(worst) > BUDGET_INSTRUCTIONS {
+            divergences.push(format!(
+                "a frame took {worst} instructions within a deadline, over the budget {BUDGET_INSTRUCTIONS}"
+            ));
+        }
+    }
     if divergences.is_empty() {
         println!(
-            "stream: firmware and host agree bit for bit on all {} output packets ({} frames with a structure)",
+            "stream: firmware and host agree on all {} output packets ({} frames with a structure; {})",
             fw.len(),
-            compared
+            compared,
+            if a.within {
+                "each result the host's or `over_budget` point for point, the rest bit for bit"
+            } else {
+                "bit for bit"
+            }
         );
         ExitCode::SUCCESS
     } else {
@@ -391,6 +452,7 @@ struct Row {
     /// Points counted, and `ok` ones.
     total: u64,
     ok: u16,
+    deadline_expired: bool,
 }
 
 trait Owned {
@@ -405,6 +467,63 @@ impl Owned for ResultView<'_> {
             instructions: self.instructions,
             total: self.total(),
             ok: self.count(Status::Ok),
+            deadline_expired: self.deadline_expired,
         }
     }
+}
+
+/// Within a deadline: the firmware's result packet `f` against the host's
+/// `h` (no deadline): the same pair, boundaries and point count, and each
+/// point the host's, or `over_budget` with no depth (the clock said yes
+/// first, or the deadline's cap on one point's search,
+/// `roadstereo::deadline::CARRY`, bound it), or the host's depth with a
+/// stick that holds the host's (the cap left a stick unrefined, looser and
+/// still guaranteed): nothing else (`roadstereo::deadline`). The count of
+/// points flagged and of sticks left looser, and whether the clock cut the
+/// frame.
+fn within_matches(f: &[u8], h: &[u8]) -> Result<(u64, u64, bool), String> {
+    let view = |raw| {
+        check(raw)
+            .ok()
+            .and_then(|c| ResultView::parse(c.payload).ok())
+            .ok_or("a result that does not parse")
+    };
+    let (vf, vh) = (view(f)?, view(h)?);
+    if (vf.frame_id, vf.kept_id, vf.structure) != (vh.frame_id, vh.kept_id, vh.structure) {
+        return Err("another pair".into());
+    }
+    let (bf, bh): (Vec<_>, Vec<_>) = (vf.boundaries().collect(), vh.boundaries().collect());
+    if bf.len() != bh.len() {
+        return Err("another boundary count".into());
+    }
+    let (mut flagged, mut looser) = (0u64, 0u64);
+    for (k, (x, y)) in bf.iter().zip(&bh).enumerate() {
+        if (x.len, x.quality) != (y.len, y.quality) {
+            return Err(format!("boundary {k}: another length or quality"));
+        }
+        for (j, (p, q)) in x.points().zip(y.points()).enumerate() {
+            if p == q {
+                continue;
+            }
+            if p.status == Status::OverBudget && p.values.is_none() {
+                flagged += 1;
+                continue;
+            }
+            // [X, Y, Z, z_near, z_far]: the same point, a stick holding
+            // the host's.
+            if let (Status::Ok, Status::Ok, Some(a), Some(b)) =
+                (p.status, q.status, p.values, q.values)
+            {
+                if a[..3] == b[..3] && a[3] <= b[3] && a[4] >= b[4] {
+                    looser += 1;
+                    continue;
+                }
+            }
+            return Err(format!(
+                "boundary {k} point {j}: {:?} {:?} where the host has {:?} {:?}",
+                p.status, p.values, q.status, q.values
+            ));
+        }
+    }
+    Ok((flagged, looser, vf.deadline_expired))
 }

@@ -66,6 +66,13 @@ pub fn instructions(ticks: u64) -> u32 {
     u32::try_from(ns / 32).unwrap_or(u32::MAX)
 }
 
+/// Core-clock ticks in which `instructions` run under `-icount shift=5`
+/// (the inverse of [`instructions`]).
+pub fn ticks_of(instructions: u32) -> u64 {
+    let ns = u128::from(instructions) * 32;
+    u64::try_from(ns * u128::from(board::CORE_HZ) / 1_000_000_000).unwrap_or(u64::MAX)
+}
+
 /// Run `f` and return its result with the instructions it took (the
 /// measurement's own overhead, measured once, subtracted).
 #[inline(never)]

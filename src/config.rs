@@ -213,7 +213,10 @@ impl Config {
     /// and one whose lines tighten a stick four more (a stick the budget
     /// cannot tighten keeps its looser, still guaranteed, bound). README
     /// ("Worst case") gives the instructions per unit and per point, which
-    /// bound a frame's cost.
+    /// bound a frame's cost. A processor of `B` boundaries of `N` points
+    /// gives a point at most `⌊(2³² − 1)/(B N)⌋` units, so that a frame's
+    /// units fit 32 bits: below [`Config::MAX_WORK_PER_POINT`] only when
+    /// `B N` passes 4 096.
     ///
     /// ```
     /// use roadstereo::Config;

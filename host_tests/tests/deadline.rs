@@ -419,3 +419,51 @@ fn an_uncapped_clock_is_process_at_every_budget() {
     }
     assert!(pairs > 300, "{pairs} pairs");
 }
+
+/// The work units a frame reports count every unit even where the
+/// frame's grants would pass 32 bits (`B N` points at the largest
+/// budget): until a review, a `Processor<512, 9>` at
+/// `Config::MAX_WORK_PER_POINT` reported 143 025 units spent with 8
+/// boundaries and 8 675 with 9, the saturated grant having wiped the
+/// count. Now a point's allowance is at most `⌊(2³² − 1)/(B N)⌋`: the
+/// units granted never saturate and the spent ones never fall as
+/// boundaries are added.
+#[test]
+fn the_work_units_never_saturate_at_the_largest_budget() {
+    use roadstereo::{Camera, Pixel};
+    const BN: usize = 512;
+    const BB: usize = 9;
+    let cam = Camera::new(800.0, 800.0, 1023.5, 1023.5, 2048, 2048).expect("camera");
+    let config = Config::DEFAULT
+        .with_work_budget(Config::MAX_WORK_PER_POINT)
+        .expect("budget");
+    let boundary = |k: usize, scale: f32| -> Vec<Pixel> {
+        (0..480)
+            .map(|i| {
+                let (u, v) = (1100.0 + 90.0 * k as f32 + 0.4 * i as f32, 1040.0 + 2.0 * i as f32);
+                Pixel::new(1023.5 + (u - 1023.5) * scale, 1023.5 + (v - 1023.5) * scale)
+            })
+            .collect()
+    };
+    let motion = Motion::new([0.0, 0.0, 0.3], [0.0; 3]).expect("motion");
+    let mut last = (0u32, 0u32);
+    for boundaries in 1..=BB {
+        let mut p = Box::new(Processor::<BN, BB>::new(config));
+        let (mut f1, mut f2) = (Frame::<BN, BB>::new(cam), Frame::<BN, BB>::new(cam));
+        for k in 0..boundaries {
+            f1.push_boundary(&boundary(k, 1.0)).expect("frame 1");
+            f2.push_boundary(&boundary(k, 1.03)).expect("frame 2");
+        }
+        assert!(matches!(p.process(&f1, None), Ok(Step::First)));
+        let Ok(Step::Structure(s)) = p.process(&f2, Some(&motion)) else {
+            panic!("a structure");
+        };
+        let (spent, granted) = s.work_units();
+        let points = (480 * boundaries) as u64;
+        assert!(granted < u32::MAX && spent <= granted, "{boundaries}: {spent} of {granted}");
+        assert!(u64::from(granted) <= points * u64::from(u32::MAX / (BN * BB) as u32));
+        assert!(spent >= last.0 && granted > last.1, "{boundaries}: {spent} of {granted} after {last:?}");
+        last = (spent, granted);
+    }
+    assert!(last.0 > 0);
+}

@@ -513,9 +513,9 @@ impl<const N: usize, const B: usize> Processor<N, B> {
 /// representative pair, its inlining changed.)
 const fn capped<const N: usize, const B: usize>(mut config: Config) -> Config {
     let points = (N as u64).saturating_mul(B as u64);
-    if points > 0 {
+    if let Some(cap) = (u32::MAX as u64).checked_div(points) {
         // (At most `u32::MAX`: the cast keeps the value.)
-        let cap = (u32::MAX as u64 / points) as u32;
+        let cap = cap as u32;
         if config.work_per_point > cap {
             config.work_per_point = cap;
         }

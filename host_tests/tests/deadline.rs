@@ -440,7 +440,10 @@ fn the_work_units_never_saturate_at_the_largest_budget() {
     let boundary = |k: usize, scale: f32| -> Vec<Pixel> {
         (0..480)
             .map(|i| {
-                let (u, v) = (1100.0 + 90.0 * k as f32 + 0.4 * i as f32, 1040.0 + 2.0 * i as f32);
+                let (u, v) = (
+                    1100.0 + 90.0 * k as f32 + 0.4 * i as f32,
+                    1040.0 + 2.0 * i as f32,
+                );
                 Pixel::new(1023.5 + (u - 1023.5) * scale, 1023.5 + (v - 1023.5) * scale)
             })
             .collect()
@@ -460,9 +463,15 @@ fn the_work_units_never_saturate_at_the_largest_budget() {
         };
         let (spent, granted) = s.work_units();
         let points = (480 * boundaries) as u64;
-        assert!(granted < u32::MAX && spent <= granted, "{boundaries}: {spent} of {granted}");
+        assert!(
+            granted < u32::MAX && spent <= granted,
+            "{boundaries}: {spent} of {granted}"
+        );
         assert!(u64::from(granted) <= points * u64::from(u32::MAX / (BN * BB) as u32));
-        assert!(spent >= last.0 && granted > last.1, "{boundaries}: {spent} of {granted} after {last:?}");
+        assert!(
+            spent >= last.0 && granted > last.1,
+            "{boundaries}: {spent} of {granted} after {last:?}"
+        );
         last = (spent, granted);
     }
     assert!(last.0 > 0);

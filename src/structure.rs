@@ -214,9 +214,10 @@ impl PointResult {
     /// The matched frame-2 pixel, if a crossing was chosen: the exact
     /// epipolar line's point there, on the frame-2 polyline up to `f32`
     /// rounding. Measured, not derived: within `2⁻¹⁶ S` px, `S` the largest
-    /// coordinate magnitude of the match, the compensated frame-1 point and
-    /// the FOE, at least 1 (the fuzz pass checks it on every match; with a
-    /// FOE far outside the image, nearly sideways motion, the tolerance is
+    /// coordinate magnitude of the match, the ends of the frame-2 segment
+    /// it lies on, the compensated frame-1 point and the FOE, at least 1
+    /// (the fuzz pass checks it on every match; with a FOE far outside the
+    /// image, nearly sideways motion, or a long segment, the tolerance is
     /// as loose as `S` is large: README, "Using the library").
     pub fn pixel2(&self) -> Option<Pixel> {
         self.status.has_match().then_some(self.pixel2)

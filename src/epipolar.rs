@@ -306,6 +306,11 @@ impl PairGeometry {
     /// c₂|)`. (A far focus rounds by many pixels, but its lines barely
     /// turn.)
     pub(crate) fn foe_shift(&self) -> f32 {
+        self.foe_shift_of(self.foe_rounding())
+    }
+
+    /// [`Self::foe_shift`] for a focus known to within `eps` pixels.
+    pub(crate) fn foe_shift_of(&self, eps: f32) -> f32 {
         let Some(e) = self.focus_of_expansion() else {
             return 0.0;
         };
@@ -320,10 +325,89 @@ impl PairGeometry {
         let de = crate::math::sqrt(ex * ex + ey * ey) * (1.0 - 1.0e-5);
         // (A NaN keeps the whole rounding.)
         if de > 2.0 * l {
-            self.foe_rounding() * (4.0 * l / de) * (1.0 + 1.0e-5)
+            eps * (4.0 * l / de) * (1.0 + 1.0e-5)
         } else {
-            self.foe_rounding()
+            eps
         }
+    }
+
+    /// Where the motion given may be off the true one by its composition's
+    /// rounding (`T` by at most `mt`, `R` by at most `mr` as a matrix,
+    /// `|R_t v − R v| ≤ mr |v|`: [`crate::Config`]'s `motion_rounding`),
+    /// `T' = Rᵀ T` is off by a vector `(a, c, b)` of length at most `dt =
+    /// mr (|T| + mt) + (1 + mr) mt` (`(R_t − R)ᵀ T_t + Rᵀ (T_t − T)`). The
+    /// focus `e = c₂ + (f_x U', f_y V')/W'` moves by exactly `(f_x a − d_x
+    /// b, f_y c − d_y b)/W'_t` (`d = e − c₂`), at most `√(f² + |d|²) dt /
+    /// (|W'| − dt)` (`f` the larger focal length; Cauchy–Schwarz), and
+    /// `W'` by a relative `dt/(|W'| − dt)`: once the focus's error is a
+    /// shift ([`Self::foe_rounding`]) the scale of every depth. Returns
+    /// `(focus error, pixels; scale)`, rounded up; both infinite when `dt`
+    /// is not below `|W'|/2` (no focus, or `W'`'s sign in doubt: nothing
+    /// can be certified).
+    pub(crate) fn composition_error(&self, mt: f32, mr: f32) -> (f32, f32) {
+        let tn = self.translation_norm() * (1.0 + 1.0e-5);
+        let dt = (mr * (tn + mt) + (1.0 + mr) * mt) * (1.0 + 1.0e-5);
+        let w = self.tp[2].abs();
+        // (A NaN fails.)
+        if !(dt < 0.5 * w) {
+            return (f32::INFINITY, f32::INFINITY);
+        }
+        let Some(e) = self.focus_of_expansion() else {
+            return (f32::INFINITY, f32::INFINITY);
+        };
+        let (fx, fy, _, _) = self.k2;
+        let f = fmax(fx, fy);
+        let (dx, dy) = (e.u - self.c2[0], e.v - self.c2[1]);
+        let wl = (w - dt) * (1.0 - 1.0e-5);
+        let eps = crate::math::sqrt(f * f + dx * dx + dy * dy) * dt / wl * (1.0 + 1.0e-5);
+        let scale = dt / wl * (1.0 + 1.0e-5);
+        if eps.is_finite() && scale.is_finite() {
+            (eps, scale)
+        } else {
+            (f32::INFINITY, f32::INFINITY)
+        }
+    }
+
+    /// How far the rotation compensation of a frame-1 pixel moves, in
+    /// frame-2 pixels, when the motion's matrix is off by at most `mr`
+    /// (`|R_t v − R v| ≤ mr |v|`, the composition's rounding), at a
+    /// compensated point whose normalised offset from the principal point
+    /// is at most that of `p` on each axis: the compensated ray `r' = Rᵀ
+    /// q` (`q` the frame-1 ray) moves by a vector `η`, `|η| ≤ mr |q| ≈ mr
+    /// |r'|`, so its image `(x', y')` by `(|η_xy| + ρ' |η_z|)/(r'_z −
+    /// |η_z|) ≤ mr (1 + ρ'²)/(1 − mr √(1 + ρ'²))` (Cauchy–Schwarz, `ρ'² =
+    /// x'² + y'²`), times the larger focal length in pixels; rounded up
+    /// (`|q| ≤ |r'| (1 + 10⁻⁵)`: `R` within `10⁻⁵` of a rotation).
+    /// Infinite where the bound fails.
+    pub(crate) fn composition_shift(&self, p: [f32; 2], mr: f32) -> f32 {
+        let (fx, fy, cx, cy) = self.k2;
+        let (x, y) = ((p[0] - cx) / fx, (p[1] - cy) / fy);
+        let rho2 = x * x + y * y;
+        let m = mr * (1.0 + 1.0e-5);
+        let den = 1.0 - m * crate::math::sqrt(1.0 + rho2);
+        // (A NaN fails.)
+        if !(den > 0.5) {
+            return f32::INFINITY;
+        }
+        let s = fmax(fx, fy) * m * (1.0 + rho2) / den * (1.0 + 1.0e-5);
+        if s.is_finite() {
+            s
+        } else {
+            f32::INFINITY
+        }
+    }
+
+    /// The point of the frame-2 view widened by `r` farthest from the
+    /// principal point along each axis (where a shift bound that grows
+    /// with both distances is largest over every point in view within `r`
+    /// of it).
+    pub(crate) fn far_corner(&self, r: f32) -> [f32; 2] {
+        let [u0, u1, v0, v1] = self.view;
+        let (cx, cy) = (self.c2[0], self.c2[1]);
+        [
+            cx + (fmax((u0 - cx).abs(), (u1 - cx).abs()) + r),
+            cy + (fmax((v0 - cy).abs(), (v1 - cy).abs()) + r),
+        ]
     }
 
     /// The rotation `R` of the motion.

@@ -41,6 +41,32 @@
 //! constant per frame, plus one per boundary, plus one per frame-1 and per
 //! frame-2 point, plus one per unit of budget: README ("Worst case") gives
 //! the measured constants.
+//!
+//! # The composition's rounding
+//! The motion the fusion pairs with is composed from the per-frame ones
+//! (`crate::fusion`, its chain), in `f32`: its translation may be off the
+//! exact composition by `m_t` and its matrix by `m_r` (`|R_t v − R v| ≤
+//! m_r |v|`), bounds the chain keeps (`Processor::process_composed_within`).
+//! The translation's rounding is about `2⁻²⁴` of the per-frame
+//! translations, not of their sum, so where they cancel (out by 10⁵ and
+//! back to 4) it is large against the composed one: an adversarial review
+//! found every fused interval missing the truth by 0.7–2.4 % there, until
+//! the pairs carried it. Now `Pair::new` carries it three ways:
+//! `T' = Rᵀ T` is off by at most `dt = m_r (|T| + m_t) + (1 + m_r) m_t`
+//! (`PairGeometry::composition_error`), which moves the focus by at most
+//! `√(f² + |d|²) dt/(|W'| − dt)`, added to its rounding (a shift of the
+//! frame-1 point moving forwards, of the correspondent backwards, as the
+//! focus's own rounding is), and scales `W'`, so every depth, by at most a
+//! relative `s = dt/(|W'| − dt)` (the wedge paths' `W'↑`/`W'↓` widened by
+//! `1 ± s`, the band path's sticks by `2 s` more); the matrix's error
+//! moves every compensated point by at most `f m_r (1 + ρ'²)/(1 − m_r
+//! √(1 + ρ'²))` (`PairGeometry::composition_shift`), added to `r₁`, and
+//! `q_z` by `m_r |q|`, added to its error. With `dt ≥ |W'|/2` nothing is
+//! certified (every point flagged); the chain asks for a new key frame
+//! before that, at `dt ≥ |W'|/4`. A motion given to [`Processor::process`]
+//! or [`Processor::process_against_kept`] is taken as exact: one a caller
+//! composes ([`Motion::then`]) brings its rounding for the configured
+//! motion errors to cover.
 
 use crate::boundary::Frame;
 use crate::camera::{Camera, Pixel};
@@ -199,7 +225,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             return Ok(Step::First);
         }
         let motion = motion.ok_or(ProcessError::MissingMotion)?;
-        self.reconstruct(frame, motion, Matcher::Indexed, deadline);
+        self.reconstruct(frame, motion, Matcher::Indexed, [0.0; 2], deadline);
         self.previous.assign(frame);
         Ok(Step::Structure(&self.output))
     }
@@ -241,7 +267,33 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         if !self.has_previous {
             return Err(ProcessError::NoKeptFrame);
         }
-        self.reconstruct(frame, motion, Matcher::Indexed, deadline);
+        self.reconstruct(frame, motion, Matcher::Indexed, [0.0; 2], deadline);
+        Ok(&self.output)
+    }
+
+    /// The fusion's pair ([`crate::fusion`]): `frame` against the kept
+    /// frame (kept with `keep`, else replaced by `frame` as
+    /// [`Self::process_within`] does) with a motion composed from the
+    /// kept frame's, which may be off the per-frame motions' exact
+    /// composition by its `f32` rounding, `rounding` (the translation by
+    /// at most `[0]`, the matrix by at most `[1]`: `|R_t v − R v| ≤ [1]
+    /// |v|`). The pair carries it: module docs, "The composition's
+    /// rounding".
+    pub(crate) fn process_composed_within<D: Deadline>(
+        &mut self,
+        frame: &Frame<N, B>,
+        motion: &Motion,
+        rounding: [f32; 2],
+        keep: bool,
+        deadline: &mut D,
+    ) -> Result<&Structure<N, B>, ProcessError> {
+        if !self.has_previous {
+            return Err(ProcessError::NoKeptFrame);
+        }
+        self.reconstruct(frame, motion, Matcher::Indexed, rounding, deadline);
+        if !keep {
+            self.previous.assign(frame);
+        }
         Ok(&self.output)
     }
 
@@ -267,7 +319,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         if !self.has_previous {
             return Err(ProcessError::NoKeptFrame);
         }
-        self.reconstruct(frame, motion, Matcher::Reference, &mut NoDeadline);
+        self.reconstruct(frame, motion, Matcher::Reference, [0.0; 2], &mut NoDeadline);
         Ok(&self.output)
     }
 
@@ -299,7 +351,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             Matcher::Indexed
         };
         self.fold_test = false;
-        self.reconstruct(frame, motion, matcher, &mut NoDeadline);
+        self.reconstruct(frame, motion, matcher, [0.0; 2], &mut NoDeadline);
         self.fold_test = true;
         Ok(&self.output)
     }
@@ -318,14 +370,17 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         self.checking = on;
     }
 
-    /// Steps 1–4 of the module docs for every boundary of the kept frame;
-    /// whether `deadline` expired before they were done goes into the
-    /// output ([`Structure::deadline_expired`]).
+    /// Steps 1–4 of the module docs for every boundary of the kept frame,
+    /// the motion within `rounding` of the true one
+    /// ([`Self::process_composed_within`]; `[0, 0]`: exact); whether
+    /// `deadline` expired before they were done goes into the output
+    /// ([`Structure::deadline_expired`]).
     fn reconstruct<D: Deadline>(
         &mut self,
         frame: &Frame<N, B>,
         motion: &Motion,
         matcher: Matcher,
+        rounding: [f32; 2],
         deadline: &mut D,
     ) {
         #[cfg(any(test, feature = "_reference"))]
@@ -341,7 +396,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             output,
             ..
         } = self;
-        let pair = Pair::new(config, previous.camera(), frame.camera(), motion);
+        let pair = Pair::new(config, previous.camera(), frame.camera(), motion, rounding);
         output.camera1 = *previous.camera();
         // (At most `B`, below 2¹⁶: `Structure::EMPTY`.)
         output.count = u16::try_from(previous.boundaries().len()).unwrap_or(u16::MAX);
@@ -561,12 +616,24 @@ struct Pair<'c> {
     /// `2/sin φ_min = √(4 + (2 cot φ_min)²)`, for the grazing test.
     csc_twice: f32,
     /// `W'` with the stick's outward rounding folded in
-    /// ([`crate::wedge::stick_w`]).
+    /// ([`crate::wedge::stick_w`]), and the composition's scale error.
     w_stick: [f32; 3],
+    /// The composition's error of the matrix (`motion_rounding[1]`), which
+    /// `r₁` allows for point by point where it is not frame-wide.
+    composed_mr: f32,
+    /// What the band path's sticks add to their relative widening for the
+    /// composition's scale error (`2 s`, see [`Pair::new`]).
+    kappa_motion: f32,
 }
 
 impl<'c> Pair<'c> {
-    fn new(config: &'c Config, cam1: &Camera, cam2: &Camera, motion: &Motion) -> Self {
+    fn new(
+        config: &'c Config,
+        cam1: &Camera,
+        cam2: &Camera,
+        motion: &Motion,
+        rounding: [f32; 2],
+    ) -> Self {
         let geom = PairGeometry::new(cam1, cam2, motion);
         let [ex, ey, ez] = config.rotation_error;
         let rotation = ex + ey + ez > 0.0;
@@ -598,20 +665,51 @@ impl<'c> Pair<'c> {
         };
         let scale = geom.coordinate_scale();
         let slack = scale * 9.54e-7;
+        // The composition's rounding (a composed motion, `crate::fusion`;
+        // module docs, "The composition's rounding"): the focus's error
+        // and `W'`'s relative error from `T'`'s, and the rotation's as a
+        // rotation error box.
+        let [mt, mr] = rounding;
+        let composed = mt > 0.0 || mr > 0.0;
+        let (foe_comp, scale_comp) = if composed {
+            geom.composition_error(mt, mr)
+        } else {
+            (0.0, 0.0)
+        };
         // The focus's rounding (`PairGeometry::foe_shift`): moving
         // forwards as a shift of the frame-1 point, backwards as one of
         // the correspondent in frame 2.
-        let foe = geom.foe_shift();
+        let foe = if composed {
+            geom.foe_shift_of(geom.foe_rounding() + foe_comp)
+        } else {
+            geom.foe_shift()
+        };
         let (slack_r1, slack_e2) = if geom.w() > 0.0 {
             (slack + foe, slack)
         } else {
             (slack, slack + foe)
         };
+        // (No focus, or one not known to half of `W'`: nothing certified.)
+        let slack_r1 = if foe_comp.is_finite() {
+            slack_r1
+        } else {
+            f32::INFINITY
+        };
         let frame_r1 = match geom.frame_disc_radius(config.e1) {
+            // The composition's error of the matrix shifts every
+            // compensated point: at most its bound where the view,
+            // widened by the disc, is farthest from the principal point.
+            Some(r) if !rotation && mr > 0.0 => {
+                let shift = geom.composition_shift(geom.far_corner(r + slack_r1), mr);
+                Some(r + shift + slack_r1).filter(|r| r.is_finite())
+            }
             Some(r) if !rotation => Some(r + slack_r1).filter(|r| r.is_finite()),
             _ => None,
         };
-        let depth_scale_error = geom.depth_scale_error(config.e1, config.rotation_error);
+        // (`q_z` moves by at most `mr |q|` with the matrix, as by a
+        // rotation error of `mr` about one axis.)
+        let [ex0, ey0, ez0] = config.rotation_error;
+        let depth_scale_error = geom.depth_scale_error(config.e1, [ex0 + mr, ey0, ez0]);
         Self {
             config,
             foe: geom.focus_of_expansion().map(Pixel::arr),
@@ -625,7 +723,18 @@ impl<'c> Pair<'c> {
             translation,
             spread_w,
             csc_twice: crate::math::sqrt_pos(4.0 + config.cot_twice * config.cot_twice),
-            w_stick: crate::wedge::stick_w(geom.w()),
+            w_stick: if composed {
+                // (Moving forwards, the wedge paths: the ends widened by
+                // the scale, `(1 + s)` outwards, before `q_z`'s.)
+                let [w, up, down] = crate::wedge::stick_w(geom.w());
+                let s = scale_comp * 1.0001;
+                [w, up * (1.0 + s), down * (1.0 - s)]
+            } else {
+                crate::wedge::stick_w(geom.w())
+            },
+            composed_mr: mr,
+            // (`(1 + κ)(1 + s) ≤ 1 + κ + 2 s` for `κ ≤ 1`.)
+            kappa_motion: 2.0 * scale_comp * 1.0001,
             geom,
         }
     }
@@ -712,9 +821,14 @@ fn compensate_point(
                     k2.2 + ((c.pixel[0] - k2.2).abs() + disc),
                     k2.3 + ((c.pixel[1] - k2.3).abs() + disc),
                 ];
-                let r1 = disc
+                let mut r1 = disc
                     + crate::motion_error::shift_bound(far, k2, config.rotation_error)
                     + pair.slack_r1;
+                // (A composed motion's matrix: [`PairGeometry::composition_shift`].)
+                if pair.composed_mr > 0.0 {
+                    core::hint::cold_path();
+                    r1 += pair.geom.composition_shift(far, pair.composed_mr);
+                }
                 // Far off the camera's axis the rotation error's shift has
                 // no bound (`rotation_shift_bound`): such a point is out of
                 // the view the stick can be certified in, and must not set
@@ -987,7 +1101,7 @@ mod tests {
                 .with_translation_error(delta)
                 .and_then(|c| c.with_rotation_error(eps))
                 .expect("config");
-            let pair = Pair::new(&config, &cam, &cam, &m);
+            let pair = Pair::new(&config, &cam, &cam, &m, [0.0; 2]);
             let r = m.rotation_matrix().map(|row| row.map(f64::from));
             let t = m.translation().map(f64::from);
             for k in 0..64 {

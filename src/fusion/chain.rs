@@ -46,11 +46,19 @@
 //! the orientation's error so far turning `T₂`); the sums are rounded up.
 //! The step assumes each frame's motion as [`Motion::new`] makes it (a
 //! caller that composes motions itself brings their rounding, for
-//! [`crate::Config::with_rotation_error`] to cover). The processor pairs
-//! with the composed motion as given: without configured motion errors
-//! its sticks do not see this rounding (about `5 u`, `3·10⁻⁷`, of the
-//! rotation a frame as measured: at worst about `0.015` px at f = 800 over
-//! 64 frames; `docs/FUSION.md`, "Limits").
+//! [`crate::Config::with_rotation_error`] to cover).
+//!
+//! For the pairs the chain keeps a second, tighter pair of bounds
+//! (`pair_t`, `pair_r`): against the per-frame matrices as given, which
+//! are what the processor takes for a pair's truth, with no angle to
+//! matrix error, so `2⁻²⁰` a step for the product and `2⁻²¹ (|T₁|₁ +
+//! |T₂|₁)` for the translation ([`PAIR_R_ROUNDING`], [`PAIR_T_ROUNDING`]),
+//! and none for the first step from the key frame (exact). The processor
+//! carries them (`crate::processor`, "The composition's rounding"; until
+//! an adversarial review it took the composed motion as exact, and a
+//! translation composed out by 10⁵ and back to 4 left every fused
+//! interval 0.7–2.4 % off the truth), and [`Chain::config`] starts a new
+//! key frame where they could move `W'` by a quarter of itself.
 
 use crate::config::{Config, ConfigError};
 use crate::math::{mat3_mul, mat3_transpose, mat3_vec, sqrt, Mat3};
@@ -65,6 +73,15 @@ const ROUND_UP: f32 = 1.0 + 1.0 / 65_536.0;
 /// (`2⁻¹⁹ = 32 u`, [`crate::map`], "The radius"); a translation's is
 /// twice this times the 1-norms involved.
 pub(crate) const STEP_ROUNDING: f32 = 1.0 / 524_288.0;
+
+/// The `f32` rounding of one composition step against the per-frame
+/// matrices as given (module docs, "Rounding"): the product `R₁ R₂`, at
+/// most `3 u` an entry (unit rows and columns), `9 u` as an operator,
+/// below `2⁻²⁰ = 16 u`; and the translation `T₁ + R₁ T₂`, at most `u (3
+/// |T₂|₁ + |T₁ + R₁ T₂|) ≤ u (4 |T₂|₁ + |T₁|₁)` a component, `√3` times
+/// that as a length, below `2⁻²¹ (|T₁|₁ + |T₂|₁) = 8 u (…)`.
+const PAIR_R_ROUNDING: f32 = 1.0 / 1_048_576.0;
+const PAIR_T_ROUNDING: f32 = 1.0 / 2_097_152.0;
 
 /// `|v|₁`.
 pub(crate) fn norm1(v: [f32; 3]) -> f32 {
@@ -118,6 +135,11 @@ pub(crate) struct Chain {
     /// and of the orientation as an angle.
     pub(crate) round_t: f32,
     pub(crate) round_r: f32,
+    /// The same against the per-frame motions' matrices as given (what
+    /// the processor takes for the truth of a pair, module docs), for the
+    /// pair's configuration ([`Chain::config`]).
+    pub(crate) pair_t: f32,
+    pub(crate) pair_r: f32,
 }
 
 fn norm(v: [f32; 3]) -> f32 {
@@ -134,6 +156,8 @@ impl Chain {
         omega: 0.0,
         round_t: 0.0,
         round_r: 0.0,
+        pair_t: 0.0,
+        pair_r: 0.0,
     };
 
     /// The chain continued by one frame's motion `m` with error bounds `b`
@@ -150,12 +174,29 @@ impl Chain {
             + self.round_r * norm1(t2))
             * ROUND_UP;
         let round_r = (self.round_r + STEP_ROUNDING) * ROUND_UP;
+        // The same against the per-frame matrices as given (the pair's
+        // truth, module docs): none on the first step, which composes
+        // with the identity exactly (`1 x + 0 y + 0 z = x` in `f32`).
+        let (pair_t, pair_r) =
+            if self.pair_r == 0.0 && self.r == Chain::IDENTITY.r && self.t == [0.0; 3] {
+                (0.0, 0.0)
+            } else {
+                (
+                    (self.pair_t
+                        + PAIR_T_ROUNDING * (norm1(self.t) + norm1(t2))
+                        + self.pair_r * norm1(t2))
+                        * ROUND_UP,
+                    (self.pair_r + PAIR_R_ROUNDING) * ROUND_UP,
+                )
+            };
         if !(b.any() || self.delta > 0.0 || self.omega > 0.0) {
             return Chain {
                 t,
                 r,
                 round_t,
                 round_r,
+                pair_t,
+                pair_r,
                 ..*self
             };
         }
@@ -183,7 +224,17 @@ impl Chain {
             omega: (self.omega + b.omega) * ROUND_UP,
             round_t,
             round_r,
+            pair_t,
+            pair_r,
         }
+    }
+
+    /// How far the composed motion may be from the per-frame matrices'
+    /// exact composition by its `f32` rounding, for the processor
+    /// (`Processor::process_composed_within`): the translation by at most
+    /// `[0]`, the matrix by at most `[1]` (`|R_t v − R v| ≤ [1] |v|`).
+    pub(crate) fn rounding(&self) -> [f32; 2] {
+        [self.pair_t, self.pair_r]
     }
 
     /// The composed motion, for the processor.
@@ -192,13 +243,32 @@ impl Chain {
     }
 
     /// `base` with the composed error bounds in place of the per-frame
-    /// ones (`base` itself when there are none).
+    /// ones (`base` itself when there are none);
+    /// [`ConfigError::TranslationError`] also when the composition's
+    /// rounding ([`Chain::rounding`], which the processor carries) could
+    /// move `W'` by a quarter of itself or more (the processor could
+    /// certify little or nothing: the fusion starts a new key frame
+    /// instead).
     pub(crate) fn config(&self, base: &Config) -> Result<Config, ConfigError> {
-        if !(self.delta > 0.0 || self.omega > 0.0) {
-            return Ok(*base);
+        let with_bounds = if self.delta > 0.0 || self.omega > 0.0 {
+            base.with_translation_error(self.delta)?
+                .with_rotation_error(self.eps)?
+        } else {
+            *base
+        };
+        let (mt, mr) = (self.pair_t, self.pair_r);
+        if mt == 0.0 && mr == 0.0 {
+            return Ok(with_bounds);
         }
-        base.with_translation_error(self.delta)?
-            .with_rotation_error(self.eps)
+        // `W' = (Rᵀ T)_z`, against `T'`'s error from the rounding
+        // (`crate::epipolar::PairGeometry::composition_error`).
+        let w = self.r[0][2] * self.t[0] + self.r[1][2] * self.t[1] + self.r[2][2] * self.t[2];
+        let dt = (mr * (norm(self.t) + mt) + (1.0 + mr) * mt) * ROUND_UP;
+        // (A NaN fails.)
+        if !(dt < 0.25 * w.abs()) {
+            return Err(ConfigError::TranslationError);
+        }
+        Ok(with_bounds)
     }
 
     /// The current frame's pose of key-frame points, `P = A P_K + b`

@@ -95,7 +95,7 @@ use crate::map::{Retired, RoadMap};
 use crate::math::{fmax, sin_cos, sqrt};
 use crate::motion::Motion;
 use crate::processor::Processor;
-use crate::structure::{Step, Structure};
+use crate::structure::Structure;
 use code::DepthScale;
 use key::Added;
 
@@ -489,9 +489,9 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             out.new_key = self.start_key(id, frame, reason, shown);
             return Ok(out);
         };
-        if bounds.any() {
-            self.processor.set_config(*cfg);
-        }
+        // (The composed bounds and the composition's rounding, for this
+        // pair: `Chain::config`.)
+        self.processor.set_config(*cfg);
         let fused = self.fuse_pair(frame, motion, last_partner, deadline);
         let cut = self.processor.deadline_expired();
         // 4. The pair fused; a last partner retires the key frame.
@@ -534,20 +534,18 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         last_partner: bool,
         deadline: &mut D,
     ) -> PairFused {
-        if last_partner {
-            match self.processor.process_within(frame, Some(motion), deadline) {
-                Ok(Step::Structure(s)) => self.key.fuse(s),
-                // (A kept frame exists and a motion is given: not reached.)
-                _ => PairFused::default(),
-            }
-        } else {
-            match self
-                .processor
-                .process_against_kept_within(frame, motion, deadline)
-            {
-                Ok(s) => self.key.fuse(s),
-                Err(_) => PairFused::default(),
-            }
+        // (The composition's rounding, which the processor carries.)
+        let rounding = self.chain.rounding();
+        match self.processor.process_composed_within(
+            frame,
+            motion,
+            rounding,
+            !last_partner,
+            deadline,
+        ) {
+            Ok(s) => self.key.fuse(s),
+            // (A kept frame exists: not reached.)
+            Err(_) => PairFused::default(),
         }
     }
 

@@ -129,5 +129,12 @@ fn conclude(
         Outcome::Flag(s) => return PointResult::flagged(p1, s),
     };
     let p2 = band.point_at(lam);
-    finish_point(pair, p1, p2, iz, band.depths(errors, lam, lo, hi))
+    finish_point(
+        pair,
+        p1,
+        p2,
+        iz,
+        band.depths(errors, lam, lo, hi),
+        pair.kappa_motion,
+    )
 }

@@ -58,7 +58,7 @@
 //! frame-1 point moving forwards, of the correspondent backwards, as the
 //! focus's own rounding is), and scales `W'`, so every depth, by at most a
 //! relative `s = dt/(|W'| − dt)` (the wedge paths' `W'↑`/`W'↓` widened by
-//! `1 ± s`, the band path's sticks by `2 s` more); the matrix's error
+//! `1 ± s`, the band path's stick ends likewise); the matrix's error
 //! moves every compensated point by at most `f m_r (1 + ρ'²)/(1 − m_r
 //! √(1 + ρ'²))` (`PairGeometry::composition_shift`), added to `r₁`, and
 //! `q_z` by `m_r |q|`, added to its error. With `dt ≥ |W'|/2` nothing is
@@ -297,6 +297,21 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         Ok(&self.output)
     }
 
+    /// [`Self::process_composed_within`] without a deadline, for the
+    /// project's bench firmware (which replays the fusion's pairs). Not
+    /// part of the API.
+    #[cfg(feature = "firmware")]
+    #[doc(hidden)]
+    pub fn process_composed(
+        &mut self,
+        frame: &Frame<N, B>,
+        motion: &Motion,
+        rounding: [f32; 2],
+        keep: bool,
+    ) -> Result<&Structure<N, B>, ProcessError> {
+        self.process_composed_within(frame, motion, rounding, keep, &mut NoDeadline)
+    }
+
     /// The output of the last successful reconstruction (empty before one).
     pub fn structure(&self) -> &Structure<N, B> {
         &self.output
@@ -396,7 +411,24 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             output,
             ..
         } = self;
-        let pair = Pair::new(config, previous.camera(), frame.camera(), motion, rounding);
+        // A composed motion: the points' rotation box holds the matrix's
+        // error ([`composition_box`]; the flags of the configured box stay
+        // the configured one's).
+        let boxed;
+        let point_config: &Config = if rounding[1] > 0.0 {
+            boxed = composition_box(config, frame.camera(), rounding[1]);
+            &boxed
+        } else {
+            config
+        };
+        let pair = Pair::new(
+            point_config,
+            config.rotation_error,
+            previous.camera(),
+            frame.camera(),
+            motion,
+            rounding,
+        );
         output.camera1 = *previous.camera();
         // (At most `B`, below 2¹⁶: `Structure::EMPTY`.)
         output.count = u16::try_from(previous.boundaries().len()).unwrap_or(u16::MAX);
@@ -618,24 +650,27 @@ struct Pair<'c> {
     /// `W'` with the stick's outward rounding folded in
     /// ([`crate::wedge::stick_w`]), and the composition's scale error.
     w_stick: [f32; 3],
-    /// The composition's error of the matrix (`motion_rounding[1]`), which
-    /// `r₁` allows for point by point where it is not frame-wide.
-    composed_mr: f32,
-    /// What the band path's sticks add to their relative widening for the
-    /// composition's scale error (`2 s`, see [`Pair::new`]).
-    kappa_motion: f32,
+    /// The composition's scale error `s` (module docs, "The
+    /// composition's rounding"), by which the band path's stick ends
+    /// move outwards.
+    scale_motion: f32,
 }
 
 impl<'c> Pair<'c> {
+    /// The pair of `motion` with `config`, whose rotation error box is the
+    /// configured one (`configured`) or, for a motion composed within
+    /// `rounding` of the true one, that box widened to hold the matrix's
+    /// error too ([`composition_box`]).
     fn new(
         config: &'c Config,
+        configured: [f32; 3],
         cam1: &Camera,
         cam2: &Camera,
         motion: &Motion,
         rounding: [f32; 2],
     ) -> Self {
         let geom = PairGeometry::new(cam1, cam2, motion);
-        let [ex, ey, ez] = config.rotation_error;
+        let [ex, ey, ez] = configured;
         let rotation = ex + ey + ez > 0.0;
         // A rotation error turns the true compensated translation
         // `R_tᵀ T_t` away from `Rᵀ T_t` by up to `θ |T_t|` (`θ ≤ Σε`, 5 %
@@ -707,9 +742,9 @@ impl<'c> Pair<'c> {
             _ => None,
         };
         // (`q_z` moves by at most `mr |q|` with the matrix, as by a
-        // rotation error of `mr` about one axis.)
-        let [ex0, ey0, ez0] = config.rotation_error;
-        let depth_scale_error = geom.depth_scale_error(config.e1, [ex0 + mr, ey0, ez0]);
+        // rotation error of `mr` about one axis: the configured box, not
+        // the one widened for the points' shift.)
+        let depth_scale_error = geom.depth_scale_error(config.e1, [ex + mr, ey, ez]);
         Self {
             config,
             foe: geom.focus_of_expansion().map(Pixel::arr),
@@ -732,9 +767,7 @@ impl<'c> Pair<'c> {
             } else {
                 crate::wedge::stick_w(geom.w())
             },
-            composed_mr: mr,
-            // (`(1 + κ)(1 + s) ≤ 1 + κ + 2 s` for `κ ≤ 1`.)
-            kappa_motion: 2.0 * scale_comp * 1.0001,
+            scale_motion: scale_comp * 1.0001,
             geom,
         }
     }
@@ -779,6 +812,28 @@ impl<'c> Pair<'c> {
     }
 }
 
+/// `config` with its rotation error box widened by `m = 2.01 m_r
+/// f_max/f_min` on every axis (`f` frame 2's focal lengths), which holds a
+/// composed motion's matrix error `m_r` ([`Processor::process_composed_within`])
+/// where `r₁` is bounded point by point: the box's first-order term alone,
+/// `m Σ |c_k| ≥ m f_min (2 + ρ + ρ²)` (the columns of
+/// `motion_error::shift_bound`), is at least twice the numerator `f_max
+/// m_r (1 + ρ²)` of `PairGeometry::composition_shift`, and that shift's
+/// denominator is at least `1/2` wherever the box's bound is finite (`m ρ
+/// ≤ dz < 1/2`, so `m_r √(1 + ρ²) < 1/2`); the bound grows with the box,
+/// so the sum holds both the configured error and the matrix's. Frame-wide
+/// the exact shift is added instead ([`Pair::new`]). (The widened copy
+/// keeps the per-point code as it was: a branch there for the exact shift
+/// cost every pair two instructions a point in the bench firmware.)
+fn composition_box(config: &Config, cam2: &Camera, mr: f32) -> Config {
+    let m = 2.01
+        * mr
+        * (crate::math::fmax(cam2.fx(), cam2.fy()) / crate::math::fmin(cam2.fx(), cam2.fy()));
+    let mut c = *config;
+    c.rotation_error = c.rotation_error.map(|e| e + m);
+    c
+}
+
 /// Step 1 for one frame-1 point: compensate it and make its output slot
 /// hold it until step 4 overwrites it: `p₁'` in `pixel2`, `1/q_z` in `z`,
 /// `r₁` in `z_near`, the key of its epipolar line in `z_far`, and the
@@ -821,14 +876,9 @@ fn compensate_point(
                     k2.2 + ((c.pixel[0] - k2.2).abs() + disc),
                     k2.3 + ((c.pixel[1] - k2.3).abs() + disc),
                 ];
-                let mut r1 = disc
+                let r1 = disc
                     + crate::motion_error::shift_bound(far, k2, config.rotation_error)
                     + pair.slack_r1;
-                // (A composed motion's matrix: [`PairGeometry::composition_shift`].)
-                if pair.composed_mr > 0.0 {
-                    core::hint::cold_path();
-                    r1 += pair.geom.composition_shift(far, pair.composed_mr);
-                }
                 // Far off the camera's axis the rotation error's shift has
                 // no bound (`rotation_shift_bound`): such a point is out of
                 // the view the stick can be certified in, and must not set
@@ -1101,7 +1151,7 @@ mod tests {
                 .with_translation_error(delta)
                 .and_then(|c| c.with_rotation_error(eps))
                 .expect("config");
-            let pair = Pair::new(&config, &cam, &cam, &m, [0.0; 2]);
+            let pair = Pair::new(&config, config.rotation_error, &cam, &cam, &m, [0.0; 2]);
             let r = m.rotation_matrix().map(|row| row.map(f64::from));
             let t = m.translation().map(f64::from);
             for k in 0..64 {

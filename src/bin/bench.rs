@@ -165,14 +165,15 @@ fn fusion_bench() -> bool {
             (None, m) => m,
             _ => None,
         };
+        // (The pair with its composition's rounding, as the fusion gave it.)
+        let rounding = fusion.pair_rounding();
         let matching = match (step.new_key.is_some(), step.paired.is_some(), composed) {
             (true, false, _) => {
                 copy.reset();
                 fw::measure(|| copy.process(&frame, None).is_ok()).1
             }
-            (true, true, Some(m)) => fw::measure(|| copy.process(&frame, Some(&m)).is_ok()).1,
-            (false, true, Some(m)) => {
-                fw::measure(|| copy.process_against_kept(&frame, &m).is_ok()).1
+            (last, true, Some(m)) => {
+                fw::measure(|| copy.process_composed(&frame, &m, rounding, !last).is_ok()).1
             }
             _ => 0,
         };

@@ -337,6 +337,8 @@ pub struct Fusion<const N: usize, const B: usize, const M: usize> {
     /// `key` still shows the one that just retired (its id, its lengths).
     pending: Option<(u32, [u16; B])>,
     map: RoadMap<B, M>,
+    /// The rounding of the last pair's composed motion (`Chain::rounding`).
+    pair_rounding: [f32; 2],
 }
 
 impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
@@ -355,6 +357,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             due: false,
             pending: None,
             map: RoadMap::new(config.tilt_sc, scale),
+            pair_rounding: [0.0; 2],
         }
     }
 
@@ -536,6 +539,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     ) -> PairFused {
         // (The composition's rounding, which the processor carries.)
         let rounding = self.chain.rounding();
+        self.pair_rounding = rounding;
         match self.processor.process_composed_within(
             frame,
             motion,
@@ -547,6 +551,16 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             // (A kept frame exists: not reached.)
             Err(_) => PairFused::default(),
         }
+    }
+
+    /// The rounding of the last pair's composed motion, as the processor
+    /// took it (`Processor::process_composed`): for the project's bench
+    /// firmware, which replays the pair on a copy of the processor. Not
+    /// part of the API.
+    #[cfg(feature = "firmware")]
+    #[doc(hidden)]
+    pub fn pair_rounding(&self) -> [f32; 2] {
+        self.pair_rounding
     }
 
     /// Whether the deadline of the last [`Fusion::step_within`] cut its

@@ -129,12 +129,14 @@ fn conclude(
         Outcome::Flag(s) => return PointResult::flagged(p1, s),
     };
     let p2 = band.point_at(lam);
-    finish_point(
-        pair,
-        p1,
-        p2,
-        iz,
-        band.depths(errors, lam, lo, hi),
-        pair.kappa_motion,
-    )
+    let mut depths = band.depths(errors, lam, lo, hi);
+    // A composed motion's scale error (`Pair::scale_motion`): the ends
+    // outwards by `1 ± s`, and a rounding more (the wedge paths have it in
+    // `W'↑`, `W'↓`).
+    let s = pair.scale_motion;
+    if s > 0.0 {
+        depths =
+            depths.map(|(z, near, far)| (z, near * (1.0 - s - 2.4e-7), far * (1.0 + s + 2.4e-7)));
+    }
+    finish_point(pair, p1, p2, iz, depths)
 }

@@ -152,7 +152,7 @@ fn conclude_coarse(
     };
     let p2 = wedge.point_at(lam);
     let depths = wedge.depths(pair.w_stick, r1, (lam, lo, hi));
-    finish_point(pair, p1, p2, iz, depths, 0.0)
+    finish_point(pair, p1, p2, iz, depths)
 }
 
 /// The point's result from a wedge walk's outcome: depth and stick
@@ -192,7 +192,7 @@ fn conclude_refined(
     match wedge.refined(b2, end, (pair.w_stick, r1), credit) {
         // Unbounded only because the credit fell short: the budget's flag.
         Some((_, None, true)) => PointResult::flagged(p1, Status::OverBudget),
-        Some((x, depths, _)) => finish_point(pair, p1, wedge.point_at(x), iz, depths, 0.0),
+        Some((x, depths, _)) => finish_point(pair, p1, wedge.point_at(x), iz, depths),
         // (Not reached: the walk found this piece with this wedge.)
         None => PointResult::flagged(p1, Status::NoIntersection),
     }
@@ -200,10 +200,7 @@ fn conclude_refined(
 
 /// A matched point's result from its frame-2 point and `(s, s_near,
 /// s_far)` (`None`: the stick is unbounded): eq. 2.3's depth `Z = s/q_z`,
-/// the checks on it, and the stick widened by `q_z`'s uncertainty and by
-/// a relative `widen` more (the band path's share of a composed motion's
-/// scale error, `Pair::kappa_motion`; the wedge paths have it in `W'`,
-/// and give 0).
+/// the checks on it, and the stick widened by `q_z`'s uncertainty.
 #[inline(always)]
 fn finish_point(
     pair: &Pair,
@@ -211,7 +208,6 @@ fn finish_point(
     p2: [f32; 2],
     iz: f32,
     depths: Option<(f32, f32, f32)>,
-    widen: f32,
 ) -> PointResult {
     let mut r = PointResult {
         pixel1: p1,
@@ -235,7 +231,7 @@ fn finish_point(
         return r;
     }
     // κ = 2Δ/q_z (Δ/q_z ≤ 1/2 by step 1), plus the rounding of `iz`.
-    let kappa = 2.0 * pair.depth_scale_error * iz + 2.4e-7 + widen;
+    let kappa = 2.0 * pair.depth_scale_error * iz + 2.4e-7;
     let Some(stick) = interval(s_near, s_far, iz, kappa) else {
         return r;
     };

@@ -1159,4 +1159,136 @@ mod tests {
         }
         assert!(ratio < 5.0, "{ratio}");
     }
+
+    /// The composition's bounds (`composition_error`, `composition_shift`
+    /// and the rotation box that stands for the shift point by point,
+    /// `processor::composition_box`) against `f64`: a motion whose matrix
+    /// is off by any `E` with `‖E‖ ≤ m_r` and translation by any `d` with
+    /// `|d| ≤ m_t` moves the compensated point, the focus and `W'` by no
+    /// more than they allow, over cameras from `f` = 2 to 10⁵ px (one
+    /// anisotropic), rotations to 60° and bounds from `10⁻⁷` to `10⁻³`.
+    #[test]
+    fn the_composition_bounds_hold_against_f64() {
+        type M = [[f64; 3]; 3];
+        let mv = |m: &M, v: [f64; 3]| m.map(|r| r[0] * v[0] + r[1] * v[1] + r[2] * v[2]);
+        let tr = |m: &M| [0, 1, 2].map(|i| [m[0][i], m[1][i], m[2][i]]);
+        let mut rng = Rng(0xc0_3905);
+        let (mut points, mut worst_shift, mut worst_box, mut worst_foe) =
+            (0, 0.0f64, 0.0f64, 0.0f64);
+        for case in 0..4000 {
+            let (f, side) = [
+                (2.0f32, 64u16),
+                (300.0, 512),
+                (800.0, 512),
+                (5000.0, 4096),
+                (1.0e5, 16384),
+            ][case % 5];
+            let fy = if case % 7 == 0 && f < 1.0e4 {
+                f * 1.6
+            } else {
+                f
+            };
+            let c = f32::from(side) / 2.0 - 0.5;
+            let cam = Camera::new(f, fy, c, c, side, side).expect("camera");
+            let deg = [1.0f32, 10.0, 60.0][case % 3];
+            let a = [0.0; 3].map(|_: f32| (rng.next() - 0.5) * 2.0 * deg.to_radians());
+            let t = [rng.next() - 0.5, rng.next() - 0.5, 0.3 + rng.next()];
+            let m = Motion::new(t, a).expect("motion");
+            let g = PairGeometry::new(&cam, &cam, &m);
+            let mr = [1.0e-7f32, 1.0e-5, 1.0e-3][case % 3 / 1 % 3] * rng.next();
+            let mt = [1.0e-7f32, 1.0e-4, 1.0e-2][(case / 3) % 3] * rng.next();
+            // A perturbation of norm at most `mr` (a random direction times
+            // `mr`, spectral norm at most its Frobenius norm) and one of `T`.
+            let mut e = [[0.0f64; 3]; 3];
+            let mut fro = 0.0;
+            for x in e.iter_mut().flatten() {
+                *x = f64::from(rng.next() - 0.5);
+                fro += *x * *x;
+            }
+            let k = f64::from(mr) / fro.sqrt();
+            e = e.map(|r| r.map(|x| x * k));
+            let dir = [0.0; 3].map(|_: f64| f64::from(rng.next() - 0.5));
+            let dn = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
+            let d = dir.map(|x| x / dn * f64::from(mt));
+            let r: M = m.rotation_matrix().map(|row| row.map(f64::from));
+            let rt: M = [0, 1, 2].map(|i| [0, 1, 2].map(|j| r[i][j] + e[i][j]));
+            let t64 = t.map(f64::from);
+            let tt = [t64[0] + d[0], t64[1] + d[1], t64[2] + d[2]];
+            // The focus and W' of both.
+            let (tp, tpt) = (mv(&tr(&r), t64), mv(&tr(&rt), tt));
+            let (eps, scale) = g.composition_error(mt, mr);
+            if eps.is_finite() {
+                let foe = |tp: [f64; 3]| {
+                    [
+                        f64::from(c) + f64::from(f) * tp[0] / tp[2],
+                        f64::from(c) + f64::from(fy) * tp[1] / tp[2],
+                    ]
+                };
+                let (e0, e1) = (foe(tp), foe(tpt));
+                let moved = (e0[0] - e1[0]).hypot(e0[1] - e1[1]);
+                assert!(
+                    moved <= f64::from(eps),
+                    "case {case}: the focus moved {moved} > {eps}"
+                );
+                worst_foe = worst_foe.max(moved / f64::from(eps));
+                let rel = (tpt[2] / tp[2] - 1.0).abs();
+                assert!(
+                    rel <= f64::from(scale),
+                    "case {case}: W' moved {rel} > {scale}"
+                );
+            }
+            // The compensated points of a grid of pixels.
+            let k2 = g.camera2_intrinsics();
+            let box_m = 2.01 * mr * (f.max(fy) / f.min(fy));
+            for (i, j) in [(0, 0), (1, 2), (3, 3), (4, 1), (2, 4)] {
+                let p = [
+                    f64::from(side) * i as f64 / 4.0,
+                    f64::from(side) * j as f64 / 4.0,
+                ];
+                let q = [
+                    (p[0] - f64::from(c)) / f64::from(f),
+                    (p[1] - f64::from(c)) / f64::from(fy),
+                    1.0,
+                ];
+                let (a0, a1) = (mv(&tr(&r), q), mv(&tr(&rt), q));
+                if !(a0[2] > 1e-3 && a1[2] > 1e-3) {
+                    continue;
+                }
+                let px = |a: [f64; 3]| {
+                    [
+                        f64::from(c) + f64::from(f) * a[0] / a[2],
+                        f64::from(c) + f64::from(fy) * a[1] / a[2],
+                    ]
+                };
+                let (u0, u1) = (px(a0), px(a1));
+                let moved = (u0[0] - u1[0]).hypot(u0[1] - u1[1]);
+                // At the point itself (the bounds grow with the distance
+                // from the principal point along each axis).
+                let at = [u0[0] as f32, u0[1] as f32];
+                let shift = g.composition_shift(at, mr);
+                let boxed = crate::motion_error::shift_bound(at, k2, [box_m; 3]);
+                if shift.is_finite() {
+                    assert!(
+                        moved <= f64::from(shift),
+                        "case {case}: moved {moved} > {shift}"
+                    );
+                    worst_shift = worst_shift.max(moved / f64::from(shift));
+                }
+                if boxed.is_finite() {
+                    assert!(
+                        moved <= f64::from(boxed),
+                        "case {case}: moved {moved} > box {boxed}"
+                    );
+                    worst_box = worst_box.max(moved / f64::from(boxed));
+                }
+                points += 1;
+            }
+        }
+        assert!(points > 10_000, "{points}");
+        // The bounds are not vacuous.
+        assert!(
+            worst_shift > 0.3 && worst_foe > 0.2,
+            "{worst_shift} {worst_foe} {worst_box}"
+        );
+    }
 }

@@ -382,6 +382,22 @@ fn boundary(
                 })
                 .collect()
         }
+        // A far vertex at the image's side, then points close to the
+        // principal point: a long segment ending where a straight-ahead
+        // motion's FOE is (a review's shape: the crossing there carried
+        // the far end's rounding, `check_on_polyline`).
+        7 => {
+            let n = 2 + src.index(cap);
+            let (cx, cy) = (f64::from(k[2]), f64::from(k[3]));
+            let dir = if src.chance(1, 2) { 1.0 } else { -1.0 };
+            let mut v = cy + src.range(-3.0, 3.0);
+            let mut out = vec![[src.pick(&[-m, w - 1.0 + m]), v]];
+            for _ in 1..n {
+                v += dir * src.range(0.05, 1.0);
+                out.push([cx + src.range(-2.0, 2.0), v]);
+            }
+            out
+        }
         // The same boundary of the previous frame (no disparity).
         6 if previous.is_some() => previous
             .map(|p| p.iter().map(|q| q.map(f64::from)).collect())

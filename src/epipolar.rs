@@ -1195,8 +1195,8 @@ mod tests {
             let t = [rng.next() - 0.5, rng.next() - 0.5, 0.3 + rng.next()];
             let m = Motion::new(t, a).expect("motion");
             let g = PairGeometry::new(&cam, &cam, &m);
-            let mr = [1.0e-7f32, 1.0e-5, 1.0e-3][case % 3 / 1 % 3] * rng.next();
-            let mt = [1.0e-7f32, 1.0e-4, 1.0e-2][(case / 3) % 3] * rng.next();
+            let mr = [1.0e-7f32, 1.0e-5, 1.0e-3][(case / 5) % 3] * rng.next();
+            let mt = [1.0e-7f32, 1.0e-4, 1.0e-2][(case / 15) % 3] * rng.next();
             // A perturbation of norm at most `mr` (a random direction times
             // `mr`, spectral norm at most its Frobenius norm) and one of `T`.
             let mut e = [[0.0f64; 3]; 3];

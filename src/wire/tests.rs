@@ -471,7 +471,8 @@ fn a_refused_boundary_leaves_the_packet_as_it_was() {
     let big = line(60, 300.0);
     // (A roomy buffer: refused for a point or the radius; a buffer of the
     // good packet's size: refused for want of room part way through.)
-    let cases: [(usize, &[(BoundaryHead, &[Pixel], EncodeError)]); 2] = [
+    type Refused<'a> = &'a [(BoundaryHead, &'a [Pixel], EncodeError)];
+    let cases: [(usize, Refused); 2] = [
         (
             1024,
             &[

@@ -100,34 +100,28 @@ pub fn ci() -> Result<(), String> {
     // demo drive with faults injected, without and within a deadline; any
     // divergence fails.
     stream(&["docs/example.jsonl".into()])?;
-    stream(&[
-        "--drive".into(),
-        "src/bin/data/drive.bin".into(),
-        "--corrupt".into(),
-        "0.1".into(),
-        "--drop".into(),
-        "0.05".into(),
-        "--duplicate".into(),
-        "0.05".into(),
-        "--seed".into(),
-        "1".into(),
-    ])?;
-    // The same within a deadline on the firmware (feature `link-deadline`):
-    // every frame within the budget, each result the host's point for
-    // point or `over_budget`.
-    stream(&[
-        "--drive".into(),
-        "src/bin/data/drive.bin".into(),
-        "--corrupt".into(),
-        "0.1".into(),
-        "--drop".into(),
-        "0.05".into(),
-        "--duplicate".into(),
-        "0.05".into(),
-        "--seed".into(),
-        "1".into(),
-        "--within".into(),
-    ])?;
+    // (The same faults both times; the second within a deadline on the
+    // firmware, feature `link-deadline`: every frame within the budget,
+    // each result the host's point for point or `over_budget`.)
+    let faulty = [
+        "--drive",
+        "src/bin/data/drive.bin",
+        "--corrupt",
+        "0.1",
+        "--drop",
+        "0.05",
+        "--duplicate",
+        "0.05",
+        "--seed",
+        "1",
+    ];
+    for within in [false, true] {
+        let mut args: Vec<String> = faulty.iter().map(|a| a.to_string()).collect();
+        if within {
+            args.push("--within".into());
+        }
+        stream(&args)?;
+    }
     let bench = bench(&bench_args(&[])?);
     // The profiler too, so it cannot rot (about ten seconds), with its
     // cycles budget; it runs even when a bench budget is missed, so both

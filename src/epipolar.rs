@@ -300,11 +300,12 @@ impl PairGeometry {
     /// backwards of the correspondent in frame 2, `(1 − k) |ε| = d |ε| /
     /// |p₁' − e|` (`d` the disparity; module docs). With `L` the largest
     /// distance from the principal point of anything in view
-    /// ([`Self::in_view`]), `d ≤ 2L`; and for a focus farther than `2L`
-    /// from the principal point both distances from it are at least `|e −
-    /// c₂| − L ≥ |e − c₂|/2`, so the shift is at most `|ε| min(1, 4L/|e −
-    /// c₂|)`. (A far focus rounds by many pixels, but its lines barely
-    /// turn.)
+    /// ([`Self::in_view`]), `d ≤ 2L`; and for a true focus farther than
+    /// `2L` from the principal point both distances from it are at least
+    /// `|e − c₂| − L ≥ |e − c₂|/2`, so the shift is at most `|ε| min(1,
+    /// 4L/|e − c₂|)`, with `|e − c₂|` at least the computed focus's
+    /// distance less `|ε|`. (A far focus rounds by many pixels, but its
+    /// lines barely turn.)
     pub(crate) fn foe_shift(&self) -> f32 {
         self.foe_shift_of(self.foe_rounding())
     }
@@ -322,7 +323,11 @@ impl PairGeometry {
         // (Rounded up by a relative 10⁻⁵.)
         let l = crate::math::sqrt(dx * dx + dy * dy) * (1.0 + 1.0e-5);
         let (ex, ey) = (e.u - self.c2[0], e.v - self.c2[1]);
-        let de = crate::math::sqrt(ex * ex + ey * ey) * (1.0 - 1.0e-5);
+        // (The true focus is within `eps` of the computed one: at least
+        // this far from the principal point. Until a review it was the
+        // computed focus's distance, which a composed motion's focus
+        // error, `composition_error`, can make far too large.)
+        let de = crate::math::sqrt(ex * ex + ey * ey) * (1.0 - 1.0e-5) - eps;
         // (A NaN keeps the whole rounding.)
         if de > 2.0 * l {
             eps * (4.0 * l / de) * (1.0 + 1.0e-5)

@@ -216,7 +216,7 @@ impl Config {
     /// bound a frame's cost. A processor of `B` boundaries of `N` points
     /// gives a point at most `⌊(2³² − 1)/(B N)⌋` units, so that a frame's
     /// units fit 32 bits: below [`Config::MAX_WORK_PER_POINT`] only when
-    /// `B N` passes 4 096.
+    /// `B N` is 4 096 or more.
     ///
     /// ```
     /// use roadstereo::Config;

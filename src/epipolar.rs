@@ -350,8 +350,7 @@ impl PairGeometry {
     /// is not below `|W'|/2` (no focus, or `W'`'s sign in doubt: nothing
     /// can be certified).
     pub(crate) fn composition_error(&self, mt: f32, mr: f32) -> (f32, f32) {
-        let tn = self.translation_norm() * (1.0 + 1.0e-5);
-        let dt = (mr * (tn + mt) + (1.0 + mr) * mt) * (1.0 + 1.0e-5);
+        let dt = composition_dt(self.translation_norm() * (1.0 + 1.0e-5), mt, mr);
         let w = self.tp[2].abs();
         // (A NaN fails.)
         if !(dt < 0.5 * w) {
@@ -728,6 +727,14 @@ fn foe_rounding(tp: [f32; 3], tp_abs: [f32; 3], f: [f32; 2], c: [f32; 2]) -> f32
     } else {
         f32::INFINITY
     }
+}
+
+/// The error of `T' = Rᵀ T` when `T` (length `tn`) is off by at most `mt`
+/// and the matrix by at most `mr` (`|R_t v − R v| ≤ mr |v|`): `mr (tn +
+/// mt) + (1 + mr) mt`, from `(R_t − R)ᵀ T_t + Rᵀ (T_t − T)`, rounded up
+/// ([`PairGeometry::composition_error`], and the fusion's chain).
+pub(crate) fn composition_dt(tn: f32, mt: f32, mr: f32) -> f32 {
+    (mr * (tn + mt) + (1.0 + mr) * mt) * (1.0 + 1.0e-5)
 }
 
 /// An upper bound on `|K⁻¹ p|` over the image of `cam` with its margin.

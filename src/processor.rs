@@ -62,8 +62,14 @@
 //! moves every compensated point by at most `f m_r (1 + ρ'²)/(1 − m_r
 //! √(1 + ρ'²))` (`PairGeometry::composition_shift`), added to `r₁`, and
 //! `q_z` by `m_r |q|`, added to its error. With `dt ≥ |W'|/2` nothing is
-//! certified (every point flagged); the chain asks for a new key frame
-//! before that, at `dt ≥ |W'|/4`. A motion given to [`Processor::process`]
+//! certified (every point flagged `out_of_view`, `r₁` infinite). The
+//! focus's bound is loose by `|T'|/|W'|` (it turns the lines by
+//! `dt/|T'|`), so where `dt ≥ |W'|/4` or `|W'| < |T|/2` (nearly
+//! sideways motion) the chain puts `dt` into the configuration's
+//! translation error instead (`Rounding::in_config`), which the band path
+//! carries for any `W'`, zero included; only the matrix's shift is then
+//! added here. (A review found sideways drives no longer fusing while
+//! the chain refused such pairs.) A motion given to [`Processor::process`]
 //! or [`Processor::process_against_kept`] is taken as exact: one a caller
 //! composes ([`Motion::then`]) brings its rounding for the configured
 //! motion errors to cover.
@@ -139,7 +145,7 @@ pub struct Processor<const N: usize, const B: usize> {
 impl<const N: usize, const B: usize> Processor<N, B> {
     /// A processor with no previous frame. (Its work budget is at most
     /// `⌊(2³² − 1)/(B N)⌋` units a point, below
-    /// [`Config::MAX_WORK_PER_POINT`] only where `B N > 4 096`: see
+    /// [`Config::MAX_WORK_PER_POINT`] only where `B N ≥ 4 096`: see
     /// [`Config::with_work_budget`]; [`Self::config`] gives it.)
     pub const fn new(config: Config) -> Self {
         Self {
@@ -225,7 +231,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             return Ok(Step::First);
         }
         let motion = motion.ok_or(ProcessError::MissingMotion)?;
-        self.reconstruct(frame, motion, Matcher::Indexed, [0.0; 2], deadline);
+        self.reconstruct(frame, motion, Matcher::Indexed, Rounding::NONE, deadline);
         self.previous.assign(frame);
         Ok(Step::Structure(&self.output))
     }
@@ -267,7 +273,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         if !self.has_previous {
             return Err(ProcessError::NoKeptFrame);
         }
-        self.reconstruct(frame, motion, Matcher::Indexed, [0.0; 2], deadline);
+        self.reconstruct(frame, motion, Matcher::Indexed, Rounding::NONE, deadline);
         Ok(&self.output)
     }
 
@@ -275,15 +281,13 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     /// frame (kept with `keep`, else replaced by `frame` as
     /// [`Self::process_within`] does) with a motion composed from the
     /// kept frame's, which may be off the per-frame motions' exact
-    /// composition by its `f32` rounding, `rounding` (the translation by
-    /// at most `[0]`, the matrix by at most `[1]`: `|R_t v − R v| ≤ [1]
-    /// |v|`). The pair carries it: module docs, "The composition's
-    /// rounding".
+    /// composition by its `f32` rounding, `rounding`. The pair carries
+    /// it: module docs, "The composition's rounding".
     pub(crate) fn process_composed_within<D: Deadline>(
         &mut self,
         frame: &Frame<N, B>,
         motion: &Motion,
-        rounding: [f32; 2],
+        rounding: Rounding,
         keep: bool,
         deadline: &mut D,
     ) -> Result<&Structure<N, B>, ProcessError> {
@@ -295,21 +299,6 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             self.previous.assign(frame);
         }
         Ok(&self.output)
-    }
-
-    /// [`Self::process_composed_within`] without a deadline, for the
-    /// project's bench firmware (which replays the fusion's pairs). Not
-    /// part of the API.
-    #[cfg(feature = "firmware")]
-    #[doc(hidden)]
-    pub fn process_composed(
-        &mut self,
-        frame: &Frame<N, B>,
-        motion: &Motion,
-        rounding: [f32; 2],
-        keep: bool,
-    ) -> Result<&Structure<N, B>, ProcessError> {
-        self.process_composed_within(frame, motion, rounding, keep, &mut NoDeadline)
     }
 
     /// The output of the last successful reconstruction (empty before one).
@@ -334,7 +323,13 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         if !self.has_previous {
             return Err(ProcessError::NoKeptFrame);
         }
-        self.reconstruct(frame, motion, Matcher::Reference, [0.0; 2], &mut NoDeadline);
+        self.reconstruct(
+            frame,
+            motion,
+            Matcher::Reference,
+            Rounding::NONE,
+            &mut NoDeadline,
+        );
         Ok(&self.output)
     }
 
@@ -366,7 +361,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             Matcher::Indexed
         };
         self.fold_test = false;
-        self.reconstruct(frame, motion, matcher, [0.0; 2], &mut NoDeadline);
+        self.reconstruct(frame, motion, matcher, Rounding::NONE, &mut NoDeadline);
         self.fold_test = true;
         Ok(&self.output)
     }
@@ -395,7 +390,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         frame: &Frame<N, B>,
         motion: &Motion,
         matcher: Matcher,
-        rounding: [f32; 2],
+        rounding: Rounding,
         deadline: &mut D,
     ) {
         #[cfg(any(test, feature = "_reference"))]
@@ -415,8 +410,8 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         // error ([`composition_box`]; the flags of the configured box stay
         // the configured one's).
         let boxed;
-        let point_config: &Config = if rounding[1] > 0.0 {
-            boxed = composition_box(config, frame.camera(), rounding[1]);
+        let point_config: &Config = if rounding.matrix > 0.0 {
+            boxed = composition_box(config, frame.camera(), rounding.matrix);
             &boxed
         } else {
             config
@@ -594,7 +589,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
 /// [`crate::Structure::work_units`] counts every unit (until a review, a
 /// `Processor<512, 9>` at [`Config::MAX_WORK_PER_POINT`] saturated the
 /// count, and the units spent it gave fell with a boundary more). Only
-/// where `B N > 4 096` is this below [`Config::MAX_WORK_PER_POINT`].
+/// where `B N ≥ 4 096` is this below [`Config::MAX_WORK_PER_POINT`].
 /// (Applied where the processor takes its configuration, not per frame:
 /// a cap in the per-frame call measured 2.5 instructions a point on the
 /// representative pair, its inlining changed.)
@@ -667,7 +662,7 @@ impl<'c> Pair<'c> {
         cam1: &Camera,
         cam2: &Camera,
         motion: &Motion,
-        rounding: [f32; 2],
+        rounding: Rounding,
     ) -> Self {
         let geom = PairGeometry::new(cam1, cam2, motion);
         let [ex, ey, ez] = configured;
@@ -704,10 +699,18 @@ impl<'c> Pair<'c> {
         // module docs, "The composition's rounding"): the focus's error
         // and `W'`'s relative error from `T'`'s, and the rotation's as a
         // rotation error box.
-        let [mt, mr] = rounding;
-        let composed = mt > 0.0 || mr > 0.0;
+        let Rounding {
+            translation: mt,
+            matrix: mr,
+            in_config,
+        } = rounding;
+        // (With `in_config` the translation error of the configuration
+        // holds `T'`'s: the band path carries it, and nothing is added
+        // here for it.)
+        let composed = !in_config && (mt > 0.0 || mr > 0.0);
         let (foe_comp, scale_comp) = if composed {
-            geom.composition_error(mt, mr)
+            let (f, s) = geom.composition_error(mt, mr);
+            (f, s * 1.0001)
         } else {
             (0.0, 0.0)
         };
@@ -762,12 +765,12 @@ impl<'c> Pair<'c> {
                 // (Moving forwards, the wedge paths: the ends widened by
                 // the scale, `(1 + s)` outwards, before `q_z`'s.)
                 let [w, up, down] = crate::wedge::stick_w(geom.w());
-                let s = scale_comp * 1.0001;
+                let s = scale_comp;
                 [w, up * (1.0 + s), down * (1.0 - s)]
             } else {
                 crate::wedge::stick_w(geom.w())
             },
-            scale_motion: scale_comp * 1.0001,
+            scale_motion: scale_comp,
             geom,
         }
     }
@@ -810,6 +813,32 @@ impl<'c> Pair<'c> {
     fn exhaustive(&self) -> bool {
         self.geom.w() < 0.0 && self.translation > 0.0
     }
+}
+
+/// How far a composed motion may be from the exact composition of the
+/// per-frame motions by its `f32` rounding (module docs, "The
+/// composition's rounding"; the fusion's chain keeps it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct Rounding {
+    /// The translation's error, a length.
+    pub(crate) translation: f32,
+    /// The matrix's, `|R_t v − R v| ≤ matrix |v|`.
+    pub(crate) matrix: f32,
+    /// Whether the configuration's translation error already holds the
+    /// error of `T' = Rᵀ T` these give (the chain's choice where `W'` is
+    /// too small for the focus's error: [`crate::fusion`]); the matrix's
+    /// shift of the compensation is carried either way.
+    pub(crate) in_config: bool,
+}
+
+impl Rounding {
+    /// An exact motion.
+    pub(crate) const NONE: Rounding = Rounding {
+        translation: 0.0,
+        matrix: 0.0,
+        in_config: false,
+    };
 }
 
 /// `config` with its rotation error box widened by `m = 2.01 m_r
@@ -1151,7 +1180,14 @@ mod tests {
                 .with_translation_error(delta)
                 .and_then(|c| c.with_rotation_error(eps))
                 .expect("config");
-            let pair = Pair::new(&config, config.rotation_error, &cam, &cam, &m, [0.0; 2]);
+            let pair = Pair::new(
+                &config,
+                config.rotation_error,
+                &cam,
+                &cam,
+                &m,
+                Rounding::NONE,
+            );
             let r = m.rotation_matrix().map(|row| row.map(f64::from));
             let t = m.translation().map(f64::from);
             for k in 0..64 {

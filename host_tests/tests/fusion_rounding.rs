@@ -536,13 +536,13 @@ fn out_and_back(l: f32, angles: [f32; 3], target: V3) -> [Motion; 2] {
 /// projection (the longest run in view, monotone in rows): the fused
 /// intervals of key frame 0's points that are not inconsistent, checked
 /// against the truth while it is the key frame; `(checked, missed)`, and
-/// why key frame 0 retired, if it did.
+/// the new key frames the steps started, with their reasons.
 fn drive(
     c: &Cam,
     config: Config,
     key: (&[Pixel], &[V3]),
     motions: &[Motion],
-) -> (u64, Vec<String>, Option<KeyReason>) {
+) -> (u64, Vec<String>, Vec<KeyReason>) {
     let (pix, pts) = key;
     let mut fusion = Fusion::<32, 2, 64>::new(config, FusionConfig::DEFAULT);
     let mut f0 = Frame::<32, 2>::new(c.camera());
@@ -552,7 +552,7 @@ fn drive(
         [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
         [0.0; 3],
     );
-    let (mut checked, mut missed, mut retired) = (0u64, Vec::new(), None);
+    let (mut checked, mut missed, mut keys) = (0u64, Vec::new(), Vec::new());
     for (j, m) in motions.iter().enumerate() {
         let id = j as u32 + 1;
         t = add(t, mv(&r, m.translation().map(f64::from)));
@@ -581,9 +581,9 @@ fn drive(
                 }),
             )
             .expect("step");
+        keys.extend(step.new_key);
         let k = fusion.key().expect("a key frame");
         if k.id() != 0 {
-            retired = step.new_key;
             break;
         }
         for (i, p) in k.points(0).enumerate() {
@@ -601,7 +601,7 @@ fn drive(
             }
         }
     }
-    (checked, missed, retired)
+    (checked, missed, keys)
 }
 
 /// The review's reproducer: out by 10⁵ and back to 4 from the key frame
@@ -620,22 +620,22 @@ fn a_composed_translation_that_cancels_keeps_the_truth() {
     };
     let (pix, pts) = edge(&c);
     let ms = out_and_back(1.0e5, [0.3, 0.5, 0.2], [0.05, 0.0, 4.0]);
-    let (checked, missed, retired) = drive(&c, Config::DEFAULT, (&pix, &pts), &ms);
+    let (checked, missed, keys) = drive(&c, Config::DEFAULT, (&pix, &pts), &ms);
     println!(
-        "{checked} fused intervals checked, {} missed, retired {retired:?}",
+        "{checked} fused intervals checked, {} missed, new keys {keys:?}",
         missed.len()
     );
     assert!(missed.is_empty(), "{missed:#?}");
-    assert_eq!(checked, 0);
+    assert_eq!((checked, keys.len()), (0, 0));
     let ms = out_and_back(1.0e3, [0.3, 0.5, 0.2], [0.05, 0.0, 4.0]);
-    let (checked, missed, retired) = drive(&c, Config::DEFAULT, (&pix, &pts), &ms);
+    let (checked, missed, keys) = drive(&c, Config::DEFAULT, (&pix, &pts), &ms);
     println!(
-        "{checked} fused intervals checked, {} missed, retired {retired:?}",
+        "{checked} fused intervals checked, {} missed, new keys {keys:?}",
         missed.len()
     );
     assert!(
-        missed.is_empty() && checked > 0 && retired.is_none(),
-        "{checked} {retired:?} {missed:#?}"
+        missed.is_empty() && checked > 0 && keys.is_empty(),
+        "{checked} {keys:?} {missed:#?}"
     );
 }
 
@@ -655,8 +655,12 @@ fn out_and_back_keeps_the_truth_at_every_scale() {
             side,
         };
         let (pix, pts) = edge(&c);
-        for l in [10.0, 100.0, 1.0e3, 1.0e4, 1.0e5] {
-            let ms = out_and_back(l, [0.3, 0.5, 0.2], [0.05, 0.0, 4.0]);
+        // Back to 4 ahead, and to 4 behind (the band path).
+        for (l, back) in [10.0, 100.0, 1.0e3, 1.0e4, 1.0e5]
+            .into_iter()
+            .flat_map(|l| [(l, 4.0), (l, -4.0)])
+        {
+            let ms = out_and_back(l, [0.3, 0.5, 0.2], [0.05, 0.0, back]);
             let configs = [
                 Config::DEFAULT,
                 Config::DEFAULT
@@ -683,4 +687,34 @@ fn out_and_back_keeps_the_truth_at_every_scale() {
     println!("{checked} fused intervals checked, {} missed", missed.len());
     assert!(checked > 500, "{checked}");
     assert!(missed.is_empty(), "{:#?}", &missed[..missed.len().min(10)]);
+}
+
+/// Sideways and nearly sideways drives (`W' = 0` and `10⁻³` a frame, f =
+/// 5 000 px, 8 partners): the composed motion's rounding is carried as a
+/// translation error there (its focus error would bound nothing), so the
+/// pairs fuse, holding the truth. (A review found that with the rounding
+/// first carried every second pair was refused and a new key frame
+/// started, `ErrorLimit`, and the nearly sideways pairs gave no `ok`
+/// point.)
+#[test]
+fn sideways_drives_fuse_and_keep_the_truth() {
+    let c = Cam {
+        f: 5000.0,
+        c: 2047.5,
+        side: 4096,
+    };
+    let (pix, pts) = edge(&c);
+    for forward in [0.0, 1.0e-3] {
+        let ms: Vec<Motion> = (0..8)
+            .map(|_| Motion::new([0.3, 0.0, forward], [0.0; 3]).expect("motion"))
+            .collect();
+        let (checked, missed, keys) = drive(&c, Config::DEFAULT, (&pix, &pts), &ms);
+        println!(
+            "forward {forward}: {checked} fused intervals checked, {} missed, new keys {keys:?}",
+            missed.len()
+        );
+        assert!(missed.is_empty(), "{missed:#?}");
+        assert!(!keys.contains(&KeyReason::ErrorLimit), "{keys:?}");
+        assert!(checked > 8 * 15, "{checked}");
+    }
 }

@@ -57,12 +57,14 @@
 //! carries them (`crate::processor`, "The composition's rounding"; until
 //! an adversarial review it took the composed motion as exact, and a
 //! translation composed out by 10⁵ and back to 4 left every fused
-//! interval 0.7–2.4 % off the truth), and [`Chain::config`] starts a new
-//! key frame where they could move `W'` by a quarter of itself.
+//! interval 0.7–2.4 % off the truth); where the focus's error they give
+//! would bound little, [`Chain::config`] puts them into the pair's
+//! translation error instead.
 
 use crate::config::{Config, ConfigError};
 use crate::math::{mat3_mul, mat3_transpose, mat3_vec, sqrt, Mat3};
 use crate::motion::{Motion, MotionError};
+use crate::processor::Rounding;
 
 /// `√3`, rounded up: the length of a vector whose components are at most 1.
 const SQRT3: f32 = 1.732_051;
@@ -233,8 +235,12 @@ impl Chain {
     /// exact composition by its `f32` rounding, for the processor
     /// (`Processor::process_composed_within`): the translation by at most
     /// `[0]`, the matrix by at most `[1]` (`|R_t v − R v| ≤ [1] |v|`).
-    pub(crate) fn rounding(&self) -> [f32; 2] {
-        [self.pair_t, self.pair_r]
+    pub(crate) fn rounding(&self) -> Rounding {
+        Rounding {
+            translation: self.pair_t,
+            matrix: self.pair_r,
+            in_config: false,
+        }
     }
 
     /// The composed motion, for the processor.
@@ -243,32 +249,44 @@ impl Chain {
     }
 
     /// `base` with the composed error bounds in place of the per-frame
-    /// ones (`base` itself when there are none);
-    /// [`ConfigError::TranslationError`] also when the composition's
-    /// rounding ([`Chain::rounding`], which the processor carries) could
-    /// move `W'` by a quarter of itself or more (the processor could
-    /// certify little or nothing: the fusion starts a new key frame
-    /// instead).
-    pub(crate) fn config(&self, base: &Config) -> Result<Config, ConfigError> {
+    /// ones (`base` itself when there are none), and the composition's
+    /// rounding as the processor is to carry it ([`Chain::rounding`]).
+    /// Where it could move `W'` by a quarter of itself or more
+    /// (translations that cancel), or `W'` is under half of `|T|` (the
+    /// focus more than about `1.7 f` out: a nearly sideways motion, where
+    /// the focus's error, `|d|/|W'|` times `T'`'s, is looser than the
+    /// turn of the lines, `T'`'s over `|T'|`), the error of `T'` goes
+    /// into the configuration's translation error instead (on each
+    /// component, the box holding every vector that long), and the band
+    /// path carries it. (Until a review found sideways drives no longer fused, such a
+    /// pair was refused and a new key frame started.) A bound the
+    /// configuration does not accept is an error (a new key frame).
+    pub(crate) fn config(&self, base: &Config) -> Result<(Config, Rounding), ConfigError> {
         let with_bounds = if self.delta > 0.0 || self.omega > 0.0 {
             base.with_translation_error(self.delta)?
                 .with_rotation_error(self.eps)?
         } else {
             *base
         };
-        let (mt, mr) = (self.pair_t, self.pair_r);
-        if mt == 0.0 && mr == 0.0 {
-            return Ok(with_bounds);
+        let rounding = self.rounding();
+        if rounding == Rounding::NONE {
+            return Ok((with_bounds, rounding));
         }
-        // `W' = (Rᵀ T)_z`, against `T'`'s error from the rounding
-        // (`crate::epipolar::PairGeometry::composition_error`).
+        // `W' = (Rᵀ T)_z`, against `T'`'s error from the rounding.
         let w = self.r[0][2] * self.t[0] + self.r[1][2] * self.t[1] + self.r[2][2] * self.t[2];
-        let dt = (mr * (norm(self.t) + mt) + (1.0 + mr) * mt) * ROUND_UP;
+        let dt = crate::epipolar::composition_dt(norm(self.t), self.pair_t, self.pair_r);
         // (A NaN fails.)
-        if !(dt < 0.25 * w.abs()) {
-            return Err(ConfigError::TranslationError);
+        if dt < 0.25 * w.abs() && w.abs() >= 0.5 * norm(self.t) {
+            return Ok((with_bounds, rounding));
         }
-        Ok(with_bounds)
+        let config = with_bounds.with_translation_error(self.delta + dt * 1.01)?;
+        Ok((
+            config,
+            Rounding {
+                in_config: true,
+                ..rounding
+            },
+        ))
     }
 
     /// The current frame's pose of key-frame points, `P = A P_K + b`
@@ -405,7 +423,11 @@ mod tests {
         let m = Motion::new([0.0, 0.0, 0.4], [0.0, 0.05, 0.0]).unwrap();
         let c = Chain::IDENTITY.then(&m, &b).then(&m, &b);
         assert_eq!((c.delta, c.eps, c.omega), (0.0, [0.0; 3], 0.0));
-        assert_eq!(c.config(&Config::DEFAULT), Ok(Config::DEFAULT));
+        // (The base configuration, and the rounding the processor carries:
+        // forward, so not in the configuration.)
+        let (cfg, rounding) = c.config(&Config::DEFAULT).unwrap();
+        assert_eq!(cfg, Config::DEFAULT);
+        assert!(!rounding.in_config && rounding.translation > 0.0 && rounding.matrix > 0.0);
         // Only the composition's rounding (module docs): two steps' worth,
         // `2⁻¹⁸ (0 + 0.4) + 2⁻¹⁸ (0.4 + 0.4) + 2⁻¹⁹ · 0.4` in `T` (`S =
         // 2⁻¹⁹`: `2 S · 1.4`), and `(2⁻¹⁸ + 2 · 2⁻¹⁹) |T|₁ = 4 S |T|₁` more
@@ -441,7 +463,7 @@ mod tests {
         let m = Motion::new([0.0, 0.0, 0.4], [0.0, 0.02, 0.0]).unwrap();
         let mut c = Chain::IDENTITY.then(&m, &b);
         assert!((c.delta - 0.02).abs() < 1e-6 && (c.eps[0] - 0.004).abs() < 1e-6);
-        let cfg = c.config(&base).unwrap();
+        let (cfg, _) = c.config(&base).unwrap();
         assert!(cfg.translation_error() >= 0.02);
         let mut frames = 1;
         // The rotation bounds sum past what a Config accepts (0.1 rad)

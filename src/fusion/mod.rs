@@ -20,11 +20,13 @@
 //! composed too (`src/fusion/chain.rs` derives them) and the processor
 //! pairs with them, so the fused interval stays guaranteed: the translation
 //! bound grows with the travel since the key frame, the rotation bound with
-//! the number of frames. Without configured bounds the composed motion is
-//! taken as exact, and its `f32` rounding (about `5 u` of the rotation a
-//! frame, at worst about `0.015` px at f = 800 over 64 frames) is left to the localisation
-//! errors' slack: the pairs' sticks do not carry it (`docs/FUSION.md`,
-//! "Limits"); the road map's radius does (`crate::map`, "The radius").
+//! the number of frames. The composed motion's `f32` rounding is carried
+//! too, bounds or not: the chain bounds it (`src/fusion/chain.rs`,
+//! "Rounding") and the processor adds it to the pair's errors
+//! (`crate::processor`, "The composition's rounding"; until a review it
+//! was left out, and a translation composed out and back left fused
+//! intervals 0.7–2.4 % off the truth); the road map's radius carries its
+//! own (`crate::map`, "The radius").
 //!
 //! # Longer baselines, informative pairs
 //! Pairing with the key frame rather than with the previous frame makes the
@@ -94,7 +96,7 @@ use crate::deadline::{Deadline, NoDeadline};
 use crate::map::{Retired, RoadMap};
 use crate::math::{fmax, sin_cos, sqrt};
 use crate::motion::Motion;
-use crate::processor::Processor;
+use crate::processor::{Processor, Rounding};
 use crate::structure::Structure;
 use code::DepthScale;
 use key::Added;
@@ -337,8 +339,8 @@ pub struct Fusion<const N: usize, const B: usize, const M: usize> {
     /// `key` still shows the one that just retired (its id, its lengths).
     pending: Option<(u32, [u16; B])>,
     map: RoadMap<B, M>,
-    /// The rounding of the last pair's composed motion (`Chain::rounding`).
-    pair_rounding: [f32; 2],
+    /// The rounding of the last pair's composed motion (`Chain::config`).
+    pair_rounding: Rounding,
 }
 
 impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
@@ -357,7 +359,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             due: false,
             pending: None,
             map: RoadMap::new(config.tilt_sc, scale),
-            pair_rounding: [0.0; 2],
+            pair_rounding: Rounding::NONE,
         }
     }
 
@@ -494,8 +496,9 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         };
         // (The composed bounds and the composition's rounding, for this
         // pair: `Chain::config`.)
-        self.processor.set_config(*cfg);
-        let fused = self.fuse_pair(frame, motion, last_partner, deadline);
+        let (cfg, rounding) = *cfg;
+        self.processor.set_config(cfg);
+        let fused = self.fuse_pair(frame, motion, rounding, last_partner, deadline);
         let cut = self.processor.deadline_expired();
         // 4. The pair fused; a last partner retires the key frame.
         out.paired = Some(fused);
@@ -534,11 +537,11 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         &mut self,
         frame: &Frame<N, B>,
         motion: &Motion,
+        rounding: Rounding,
         last_partner: bool,
         deadline: &mut D,
     ) -> PairFused {
         // (The composition's rounding, which the processor carries.)
-        let rounding = self.chain.rounding();
         self.pair_rounding = rounding;
         match self.processor.process_composed_within(
             frame,
@@ -553,14 +556,27 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         }
     }
 
-    /// The rounding of the last pair's composed motion, as the processor
-    /// took it (`Processor::process_composed`): for the project's bench
-    /// firmware, which replays the pair on a copy of the processor. Not
-    /// part of the API.
+    /// The last step's pair again on `copy` (a copy of [`Fusion::processor`]
+    /// from before the step), with its configuration and composed
+    /// motion's rounding: for the project's bench firmware, which times
+    /// the matching apart from the fusion's own work. Not part of the API.
     #[cfg(feature = "firmware")]
     #[doc(hidden)]
-    pub fn pair_rounding(&self) -> [f32; 2] {
-        self.pair_rounding
+    pub fn replay_pair<'p>(
+        &self,
+        copy: &'p mut Processor<N, B>,
+        frame: &Frame<N, B>,
+        motion: &Motion,
+        last_partner: bool,
+    ) -> Result<&'p Structure<N, B>, crate::ProcessError> {
+        copy.set_config(*self.processor.config());
+        copy.process_composed_within(
+            frame,
+            motion,
+            self.pair_rounding,
+            !last_partner,
+            &mut NoDeadline,
+        )
     }
 
     /// Whether the deadline of the last [`Fusion::step_within`] cut its

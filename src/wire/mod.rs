@@ -50,6 +50,8 @@ pub const VERSION: u8 = 1;
 pub const MAGIC: [u8; 2] = *b"RS";
 /// Bytes before the payload. (The layout lengths are the format's,
 /// `docs/wire.md`; a caller sizes its buffers with [`frame_packet_max`],
+/// [`input_packet_max`] (what a receiver takes, every packet type: at a
+/// small capacity a motion packet is larger than a frame packet),
 /// [`result_packet_max`] and [`cobs_max`].)
 pub(crate) const HEADER_LEN: usize = 10;
 /// Bytes of the CRC after the payload.

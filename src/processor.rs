@@ -270,11 +270,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         motion: &Motion,
         deadline: &mut D,
     ) -> Result<&Structure<N, B>, ProcessError> {
-        if !self.has_previous {
-            return Err(ProcessError::NoKeptFrame);
-        }
-        self.reconstruct(frame, motion, Matcher::Indexed, Rounding::NONE, deadline);
-        Ok(&self.output)
+        self.process_composed_within(frame, motion, Rounding::NONE, true, deadline)
     }
 
     /// The fusion's pair ([`crate::fusion`]): `frame` against the kept
@@ -382,7 +378,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
 
     /// Steps 1–4 of the module docs for every boundary of the kept frame,
     /// the motion within `rounding` of the true one
-    /// ([`Self::process_composed_within`]; `[0, 0]`: exact); whether
+    /// ([`Self::process_composed_within`]; [`Rounding::NONE`]: exact); whether
     /// `deadline` expired before they were done goes into the output
     /// ([`Structure::deadline_expired`]).
     fn reconstruct<D: Deadline>(
@@ -697,8 +693,8 @@ impl<'c> Pair<'c> {
         let slack = scale * 9.54e-7;
         // The composition's rounding (a composed motion, `crate::fusion`;
         // module docs, "The composition's rounding"): the focus's error
-        // and `W'`'s relative error from `T'`'s, and the rotation's as a
-        // rotation error box.
+        // and `W'`'s relative error from `T'`'s here, the matrix's shift
+        // below (and point by point in `config`, `composition_box`).
         let Rounding {
             translation: mt,
             matrix: mr,
@@ -761,14 +757,12 @@ impl<'c> Pair<'c> {
             translation,
             spread_w,
             csc_twice: crate::math::sqrt_pos(4.0 + config.cot_twice * config.cot_twice),
-            w_stick: if composed {
-                // (Moving forwards, the wedge paths: the ends widened by
-                // the scale, `(1 + s)` outwards, before `q_z`'s.)
+            // (Moving forwards, the wedge paths: the ends widened by the
+            // composition's scale, `1 ± s` outwards, before `q_z`'s; `s = 0`
+            // keeps them, the products exact.)
+            w_stick: {
                 let [w, up, down] = crate::wedge::stick_w(geom.w());
-                let s = scale_comp;
-                [w, up * (1.0 + s), down * (1.0 - s)]
-            } else {
-                crate::wedge::stick_w(geom.w())
+                [w, up * (1.0 + scale_comp), down * (1.0 - scale_comp)]
             },
             scale_motion: scale_comp,
             geom,

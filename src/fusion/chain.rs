@@ -233,8 +233,8 @@ impl Chain {
 
     /// How far the composed motion may be from the per-frame matrices'
     /// exact composition by its `f32` rounding, for the processor
-    /// (`Processor::process_composed_within`): the translation by at most
-    /// `[0]`, the matrix by at most `[1]` (`|R_t v − R v| ≤ [1] |v|`).
+    /// (`Processor::process_composed_within`), not yet in any
+    /// configuration ([`Chain::config`] decides where it goes).
     pub(crate) fn rounding(&self) -> Rounding {
         Rounding {
             translation: self.pair_t,

@@ -138,6 +138,9 @@ pub struct Processor<const N: usize, const B: usize> {
     /// [`Self::set_checking_forms`] (padding too).
     #[cfg(any(test, feature = "_reference"))]
     checking: bool,
+    /// Whether the counting rule for folded points is on
+    /// ([`Self::set_fold_counting`]; padding too).
+    fold_counting: bool,
     index: Index<N>,
     output: Structure<N, B>,
 }
@@ -156,6 +159,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             fold_test: true,
             #[cfg(any(test, feature = "_reference"))]
             checking: false,
+            fold_counting: false,
             index: Index::new(),
             output: Structure::EMPTY,
         }
@@ -181,6 +185,42 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     /// ```
     pub fn set_config(&mut self, config: Config) {
         self.config = capped::<N, B>(config);
+    }
+
+    /// The **counting rule** for folded points on (`true`) or off
+    /// (`false`, the default), from the next call on. Off, a point whose
+    /// epipolar ray meets the frame-1 boundary again is
+    /// [`Status::Folded`]: a frame-2 crossing on that ray may be the other
+    /// place's image, which two views cannot tell. On, moving forwards
+    /// without a translation error (half-plane keys, the usual case), such
+    /// a point is searched after all when the boundary meets its ray
+    /// exactly once more, nearer the FOE than the point's band, and the
+    /// frame-2 boundary crosses the ray between that place and the band:
+    /// the other place's image is then there, so what the point's band
+    /// holds is its own (`src/fold/count.rs`). It gives back most of the
+    /// points on curves that fold across the rays (the certification's
+    /// S-bends: about 30 % of their two-view ideal points, none wrong), at
+    /// a cost in time where points fold (README, "What the tests show";
+    /// `docs/TESTS.md`, "The counting rule"). The stick's guarantee is the
+    /// same either way: the rule decides only which points are searched,
+    /// and what it assumes is the fold test's own assumption (a frame-2
+    /// crossing has a frame-1 source the detector saw).
+    ///
+    /// ```
+    /// use roadstereo::{Config, Processor};
+    /// let mut p = Processor::<16, 2>::new(Config::DEFAULT);
+    /// assert!(!p.fold_counting());
+    /// p.set_fold_counting(true);
+    /// assert!(p.fold_counting());
+    /// ```
+    pub fn set_fold_counting(&mut self, on: bool) {
+        self.fold_counting = on;
+    }
+
+    /// Whether the counting rule for folded points is on
+    /// ([`Self::set_fold_counting`]).
+    pub fn fold_counting(&self) -> bool {
+        self.fold_counting
     }
 
     /// The kept previous frame, if any.
@@ -400,6 +440,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             previous,
             index,
             output,
+            fold_counting,
             ..
         } = self;
         // A composed motion: the points' rotation box holds the matrix's
@@ -571,13 +612,174 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 (slots, b2),
                 index,
                 (&mut work, &mut guard),
-                matcher,
+                (matcher, *fold_counting, checking),
             );
+        }
+        if *fold_counting && guard.has_expired() {
+            // A frame cut short: a point that folds might have been
+            // searched, had the clock not stopped the rule's part first.
+            let n = usize::from(output.count).min(B);
+            crate::fold::cut_short(output.slots.get_mut(..n).unwrap_or(&mut []));
         }
         guard.settle(&mut work);
         output.work = work.usage();
         output.cut = guard.has_expired();
     }
+}
+
+/// Step 1's values of the frame-1 point `p1`, as step 1 computed them
+/// ([`compensate_all_certified`] on a certified pair, [`compensate_point`]
+/// otherwise) with its key's margin: `None` where step 1 would have
+/// flagged it.
+fn recompensate(pair: &Pair, keying: &Keying, p1: Pixel) -> Option<(PointResult, f32)> {
+    match (pair.certified_r1, keying.pencil) {
+        (Some(r1), Pencil::Half { foe, side, min_t }) => {
+            let stretch = pair.geom.frame_stretch().unwrap_or(0.0);
+            let c = pair.geom.compensate_certified(p1, stretch);
+            let (k, e) = half_key(c.pixel, (foe, side, min_t), keying.key_scale);
+            let r = PointResult {
+                pixel1: p1,
+                pixel2: Pixel::new(c.pixel[0], c.pixel[1]),
+                z: c.inv_depth_scale,
+                z_near: r1,
+                z_far: k,
+                status: Status::NoIntersection,
+            };
+            Some((r, e))
+        }
+        _ => {
+            let mut r1_max = 0.0;
+            compensate_point(pair, keying, p1, &mut r1_max)
+                .ok()
+                .map(|(r, (_, e))| (r, e))
+        }
+    }
+}
+
+/// The counting rule ([`Processor::set_fold_counting`]) for one boundary,
+/// after its search, where it applies (the lean wedge path: half-plane
+/// keys, moving forwards without a translation error) and a point was
+/// flagged [`Status::Folded`]: step 1's values again ([`recompensate`]:
+/// the same arithmetic) for the fold test's index of the boundary and for
+/// each point that folds, their partners ([`crate::fold::partners`]), the
+/// frame-2 index again, the points the rule gives back
+/// ([`crate::fold::images`]) searched as every other point was, and every
+/// point that folds given its flag ([`crate::fold::settle`]). (Out of
+/// line, after the usual steps, which stay as they were; it asks the
+/// clock and spends units as they do.)
+#[cold]
+#[inline(never)]
+fn counted_search<const N: usize, D: Deadline>(
+    (pair, keying): (&Pair, &Keying),
+    (slots, b2): (&mut [PointResult], &[Pixel]),
+    index: &mut Index<N>,
+    (work, guard): (&mut Work, &mut Guard<'_, D>),
+    (matcher, checking): (Matcher, bool),
+) {
+    let Pencil::Half { foe, side, min_t } = keying.pencil else {
+        return;
+    };
+    if !step4::wedge_path(pair) || !slots.iter().any(|r| r.status == Status::Folded) {
+        return;
+    }
+    // What the usual steps had: the keys' orientation, the largest `r₁`.
+    let orient = orientation(keying, b2.first(), b2.last());
+    let mut r1_max = 0.0f32;
+    // Each pass over the boundary in parts of `CHUNK` items, the clock
+    // asked before each part (as every such pass of the usual steps);
+    // once it says yes the rule stops, its points `over_budget`.
+    // Step 1's margins, and its values for the points that fold.
+    let margins = index.margins_mut();
+    for i in 0..slots.len() {
+        if i % CHUNK == 0 && guard.check() {
+            crate::fold::settle(slots, true);
+            return;
+        }
+        let (Some(r), Some(m)) = (slots.get_mut(i), margins.get_mut(i)) else {
+            break;
+        };
+        let c = recompensate(pair, keying, r.pixel1);
+        *m = c.map_or(0.0, |(_, e)| e);
+        if let Some((c, _)) = c {
+            r1_max = crate::math::fmax(r1_max, c.z_near);
+        }
+        if r.status == Status::Folded {
+            // (Step 1 kept every point the fold test looked at; one it
+            // would not keep now, which cannot happen, stays `folded`.)
+            *r = match c {
+                Some((c, _)) => PointResult {
+                    status: Status::Folded,
+                    ..c
+                },
+                None => PointResult {
+                    z_far: f32::NAN,
+                    ..*r
+                },
+            };
+        }
+    }
+    // The fold test's index again, from step 1's keys.
+    let key = |r: &PointResult| match r.status {
+        Status::Folded if r.z_far.is_finite() => r.z_far,
+        Status::Folded => NO_KEY,
+        _ => recompensate(pair, keying, r.pixel1).map_or(NO_KEY, |(c, _)| c.z_far),
+    };
+    let mut builder = index.builder((keying.period, orient), Unkeyed::MeetNone);
+    let mut stopped = false;
+    for (c, part) in slots.chunks(CHUNK).enumerate() {
+        if c > 0 && guard.check() {
+            stopped = true;
+            break;
+        }
+        builder.push_all_stored(part.iter().map(key));
+    }
+    let mut ask = || guard.check();
+    let mut tick: Tick = if crate::deadline::never::<D>() {
+        None
+    } else {
+        Some(&mut ask)
+    };
+    if stopped || !builder.finish(None, &mut tick) {
+        crate::fold::settle(slots, true);
+        return;
+    }
+    let at = |p: Pixel| recompensate(pair, keying, p).map(|(c, _)| c.pixel2.arr());
+    let e2 = pair.e2();
+    crate::fold::partners(index, slots, at, (foe, e2), work, guard);
+    // The frame-2 index again (its block tree built at once: the tree the
+    // walks would build), and the points given back searched.
+    let ks = keying.key_scale;
+    let mut builder = index.builder((keying.period, orient), Unkeyed::MeetAll);
+    for (c, part) in b2.chunks(CHUNK).enumerate() {
+        if c > 0 && guard.check() {
+            stopped = true;
+            break;
+        }
+        let keys = part
+            .iter()
+            .map(|p| half_key(p.arr(), (foe, side, min_t), ks));
+        if checking {
+            builder.push_all(keys);
+        } else {
+            builder.push_all_bounded(keys);
+        }
+    }
+    let mut ask = || guard.check();
+    let mut tick: Tick = if crate::deadline::never::<D>() {
+        None
+    } else {
+        Some(&mut ask)
+    };
+    if stopped || !builder.finish(None, &mut tick) {
+        crate::fold::settle(slots, true);
+        return;
+    }
+    if crate::fold::images(index, slots, b2, (keying, foe, e2), work, guard) {
+        let near_foe = pair.near_foe(r1_max);
+        let m = (matcher, false, checking);
+        match_boundary(pair, keying, near_foe, (slots, b2), index, (work, guard), m);
+    }
+    crate::fold::settle(slots, guard.has_expired());
 }
 
 /// `config` with its work budget at most `⌊(2³² − 1)/(B N)⌋` units a

@@ -699,6 +699,9 @@ pub enum Fold {
     /// folded point searched, for the check that the search alone holds
     /// the containment guarantee.
     Untested,
+    /// With the counting rule on (`Processor::set_fold_counting`): the
+    /// points that fold searched where the rule allows.
+    Counted,
     /// As shipped, within a deadline (`Processor::process_within`) whose
     /// clock says the time is up from its `k`-th question on: the points
     /// not done by then `over_budget`, the rest complete results.
@@ -733,6 +736,13 @@ fn run_frames(
             Ok(Step::Structure(s)) => s,
             other => return Err(format!("second frame: {other:?}")),
         },
+        Fold::Counted => {
+            p.set_fold_counting(true);
+            match p.process(f2, Some(motion)) {
+                Ok(Step::Structure(s)) => s,
+                other => return Err(format!("second frame: {other:?}")),
+            }
+        }
         Fold::Untested => match p.without_fold_test_against_kept(f2, motion, false) {
             Ok(s) => s,
             other => return Err(format!("second frame: {other:?}")),

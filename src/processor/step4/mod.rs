@@ -32,9 +32,44 @@ use reference::{match_wedge_angular_reference, match_wedge_reference};
 
 /// Step 4 for every point of a boundary left by steps 1–2. (Out of line,
 /// with the loop inside: the frame's constants stay in registers.)
+/// With `counting` (the counting rule, [`super::Processor::set_fold_counting`];
+/// `checking` the tests' switch of the loops' forms) the points the rule
+/// gives back are searched afterwards ([`super::counted_search`]).
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 pub(super) fn match_boundary<const N: usize, D: Deadline>(
+    pair: &Pair,
+    keying: &Keying,
+    near_foe: f32,
+    (slots, b2): (&mut [PointResult], &[Pixel]),
+    index: &mut Index<N>,
+    (work, guard): (&mut Work, &mut Guard<'_, D>),
+    (matcher, counting, checking): (Matcher, bool, bool),
+) {
+    match_points(
+        pair,
+        keying,
+        near_foe,
+        (&mut *slots, b2),
+        index,
+        (&mut *work, &mut *guard),
+        matcher,
+    );
+    if counting {
+        super::counted_search(
+            (pair, keying),
+            (slots, b2),
+            index,
+            (work, guard),
+            (matcher, checking),
+        );
+    }
+}
+
+/// [`match_boundary`]'s search of every point still to be matched.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(super) fn match_points<const N: usize, D: Deadline>(
     pair: &Pair,
     keying: &Keying,
     near_foe: f32,

@@ -28,6 +28,10 @@
 //!    is queried, each segment looked at paid from the frame's work budget
 //!    ([`Status::OverBudget`] when it runs out).
 
+mod count;
+
+pub(crate) use count::{cut_short, images, partners, settle};
+
 use crate::deadline::{Deadline, Guard};
 use crate::math::{fmax, fmin};
 use crate::pencil::NO_KEY;

@@ -1,0 +1,371 @@
+//! The **counting rule**: which points the fold test flagged are searched
+//! after all (issue 11 §4, the yield on curves that do fold).
+//!
+//! A point `p₁` folds ([`super`]) when its ray from the FOE `F` meets the
+//! compensated frame-1 polyline again at some `q`: a frame-2 crossing in
+//! `p₁`'s band could then be `q`'s image, which two views cannot tell from
+//! `p₁`'s own. Moving forwards (`W' > 0`) an image lies on its point's ray
+//! **beyond** the point: `q`'s image is at `q` or farther from `F`. So
+//! where the polyline meets the ray exactly once more, at `q` **nearer**
+//! `F` than `p₁`'s band (the near side of an S-bend, whose far side folds
+//! back across the rays), and the frame-2 polyline crosses the ray between
+//! `q` and `p₁`'s band, that crossing can be `q`'s image and nothing on the
+//! ray is left to be the source of a crossing in `p₁`'s band but `p₁`
+//! itself: the point is searched as if it did not fold.
+//!
+//! Like the fold test this is a rule about the points whose correspondent
+//! is *not* in frame 2, not part of the stick's guarantee (which holds for
+//! every point whose correspondent is there, folded or not: "What the fold
+//! test buys", `docs/TESTS.md`). What it assumes is the fold test's own
+//! assumption: a frame-2 crossing comes from a frame-1 point the detector
+//! saw. A crossing between `q` and the band from a stretch frame 1 did not
+//! see, with `p₁`'s correspondent missing from frame 2 and `q`'s image
+//! beyond `p₁`, would let a wrong match through; over the certification's
+//! scenarios none did (`docs/TESTS.md`, "The counting rule").
+//!
+//! Precisely, for a point the fold test flagged, on a pair that takes the
+//! lean wedge path (moving forwards without a translation error,
+//! half-plane keys), with `d = p₁' − F`, `R = |d|²`, `X = d·(x − F)` the
+//! place of `x` along the ray and `n = ρ₁ (r₁ + e₂)` (the band's reach
+//! towards `F` in `X`, [`crate::wedge`]):
+//!
+//! 1. **Partners** ([`partners`], step 2, while the slots hold the
+//!    compensated points): the frame-1 segments the fold test's index
+//!    offers for the point's widened key, outside its window, each tested
+//!    against the exact line through `F` and `p₁'`. The point stays
+//!    `folded` unless exactly one crosses it, on `F`'s side of the band
+//!    (`0 < X_q < R − n`); a segment along the line, a second crossing or
+//!    one in or beyond the band keeps the fold.
+//! 2. **Images** ([`images`], after step 4): the frame-2 segments the
+//!    index offers for the point's key widened by its margin, the same
+//!    test: the point is searched (step 4 again, the same search as every
+//!    other point's) when one crosses the line at `X_q − n ≤ X < R − n`,
+//!    and stays `folded` otherwise.
+//!
+//! Each segment looked at is a unit of the frame's work budget, each one
+//! tested one more, and each point asks the caller's deadline first
+//! ([`Guard::proceed`]): a point the budget or the deadline stops is
+//! `over_budget`, so a cut frame gives each point its result or
+//! `over_budget`, as everywhere. Between the steps a point the fold test
+//! flagged keeps its step-1 values and its status [`Status::Folded`], its
+//! `z_far` saying where it stands ([`Standing`]); [`settle`] gives every one
+//! left its flag.
+
+use crate::camera::Pixel;
+use crate::deadline::{Deadline, Guard};
+use crate::math::sqrt;
+use crate::pencil::{Keying, NO_KEY};
+use crate::search::{Flow, Index, OutOfWork, Query, Visitor, Work};
+use crate::structure::{PointResult, Status, FOLD_WINDOW};
+
+/// Where a point the fold test flagged stands between the steps, kept in
+/// its `z_far` (its key until [`partners`]; the key is a function of
+/// `p₁'`, [`Keying::key`], and [`images`] computes it again).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Standing {
+    /// It stays `folded`.
+    Folded,
+    /// The budget or the deadline stopped the rule: `over_budget`.
+    OverBudget,
+    /// One partner, at `X_q − R` (negative).
+    Partner(f32),
+}
+
+impl Standing {
+    fn of(z_far: f32) -> Self {
+        if z_far < 0.0 {
+            // (Finite: partners stores `X_q − R > −R`, and `R` is finite.)
+            Self::Partner(z_far)
+        } else if z_far == f32::INFINITY {
+            Self::OverBudget
+        } else {
+            Self::Folded
+        }
+    }
+
+    fn z_far(self) -> f32 {
+        match self {
+            Self::Folded => f32::NAN,
+            Self::OverBudget => f32::INFINITY,
+            Self::Partner(x) => x,
+        }
+    }
+}
+
+/// The exact line through `F` and `p₁'` ([`Self::crossing`]).
+#[derive(Debug, Clone, Copy)]
+struct Ray {
+    p: [f32; 2],
+    d: [f32; 2],
+    /// `R = |d|²`.
+    r: f32,
+    /// `n = ρ₁ (r₁ + e₂)`.
+    n: f32,
+}
+
+/// Where a segment meets a [`Ray`]'s line.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Meets {
+    /// Not at all (both ends strictly on one side).
+    No,
+    /// At `X − R` (the place along the ray less `p₁'`'s).
+    At(f32),
+    /// Along it (both ends on it), or the arithmetic cannot say (a NaN).
+    Unknown,
+}
+
+impl Ray {
+    /// The line of the point `p` (`p₁'`) with error `r1` about the FOE
+    /// `foe`, frame-2 error `e2`; `None` where the numbers are not finite
+    /// and positive.
+    fn of(p: [f32; 2], foe: [f32; 2], r1: f32, e2: f32) -> Option<Self> {
+        let d = [p[0] - foe[0], p[1] - foe[1]];
+        let r = d[0] * d[0] + d[1] * d[1];
+        let n = sqrt(r) * (r1 + e2);
+        // (A NaN fails.)
+        (r > 0.0 && r < f32::INFINITY && n < f32::INFINITY).then_some(Self { p, d, r, n })
+    }
+
+    /// Where segment `a → b` meets the line, from the ends' sides of it
+    /// (`d × (x − p₁')`) and, between them, the crossing's place `d·(x −
+    /// p₁')`: differences from `p₁'`, not products of large coordinates.
+    fn crossing(&self, a: [f32; 2], b: [f32; 2]) -> Meets {
+        let (a, b) = (
+            [a[0] - self.p[0], a[1] - self.p[1]],
+            [b[0] - self.p[0], b[1] - self.p[1]],
+        );
+        let sa = self.d[0] * a[1] - self.d[1] * a[0];
+        let sb = self.d[0] * b[1] - self.d[1] * b[0];
+        if (sa > 0.0 && sb > 0.0) || (sa < 0.0 && sb < 0.0) {
+            return Meets::No;
+        }
+        let den = sa - sb;
+        // (Both on the line, or a NaN: `den` is 0 or NaN.)
+        if !(den != 0.0 && den.is_finite()) {
+            return Meets::Unknown;
+        }
+        // (`sa` and `sb` on opposite sides or one 0: `u` in [0, 1].)
+        let u = sa / den;
+        let x = [a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])];
+        let at = self.d[0] * x[0] + self.d[1] * x[1];
+        if at.is_finite() {
+            Meets::At(at)
+        } else {
+            Meets::Unknown
+        }
+    }
+}
+
+/// The frame-1 visitor of [`partners`]: the compensated vertex `j` is
+/// `at(slots[j].pixel1)` (step 1's arithmetic again; `None` where step 1
+/// flagged the point).
+#[derive(Clone, Copy)]
+struct Partners<'a, C> {
+    ray: Ray,
+    slots: &'a [PointResult],
+    at: C,
+    /// The one partner so far (`X_q − R`), if any.
+    partner: Option<f32>,
+    /// The fold stays.
+    keep: bool,
+}
+
+impl<C: Fn(Pixel) -> Option<[f32; 2]> + Copy> Visitor<'_> for Partners<'_, C> {
+    fn segment(&mut self, j: usize, _: (f32, f32)) -> (Flow, u32) {
+        let vertex = |j: usize| self.slots.get(j).and_then(|r| (self.at)(r.pixel1));
+        let (Some(a), Some(b)) = (vertex(j), vertex(j + 1)) else {
+            // (Not offered: a segment with an unkeyed end meets no key in
+            // the fold test's index.)
+            return (Flow::Continue, 1);
+        };
+        match self.ray.crossing(a, b) {
+            Meets::No => (Flow::Continue, 1),
+            // Behind `F`: the other half of the line.
+            Meets::At(x) if x <= -self.ray.r => (Flow::Continue, 1),
+            Meets::At(x) if x < -self.ray.n && self.partner.is_none() => {
+                self.partner = Some(x);
+                (Flow::Continue, 1)
+            }
+            // A second partner, one in or beyond the band, or one that
+            // cannot be placed.
+            _ => {
+                self.keep = true;
+                (Flow::Stop, 1)
+            }
+        }
+    }
+}
+
+/// The frame-2 visitor of [`images`].
+#[derive(Clone, Copy)]
+struct Images<'a> {
+    ray: Ray,
+    b2: &'a [Pixel],
+    /// `X_q − n − R`: the nearest place a partner's image can be.
+    from: f32,
+    found: bool,
+}
+
+impl Visitor<'_> for Images<'_> {
+    fn segment(&mut self, j: usize, _: (f32, f32)) -> (Flow, u32) {
+        let (Some(a), Some(b)) = (self.b2.get(j), self.b2.get(j + 1)) else {
+            return (Flow::Continue, 1);
+        };
+        match self.ray.crossing(a.arr(), b.arr()) {
+            Meets::At(x) if x >= self.from && x < -self.ray.n => {
+                self.found = true;
+                (Flow::Stop, 1)
+            }
+            _ => (Flow::Continue, 1),
+        }
+    }
+}
+
+/// The rule's first part for one boundary's `slots`, after its search:
+/// each point flagged [`Status::Folded`] (holding step 1's values again)
+/// gets its partner on its ray, or its standing ([`Standing`]), in its
+/// `z_far`. `index` is the fold test's index of the boundary (step 1's
+/// keys and margins), `at` step 1's compensation of a frame-1 pixel. The
+/// points take their units from `work`, each asking `guard` first. The FOE
+/// `foe`, the frame-2 error `e2`.
+#[cold]
+#[inline(never)]
+pub(crate) fn partners<const N: usize, D: Deadline>(
+    index: &mut Index<N>,
+    slots: &mut [PointResult],
+    at: impl Fn(Pixel) -> Option<[f32; 2]> + Copy,
+    (foe, e2): ([f32; 2], f32),
+    work: &mut Work,
+    guard: &mut Guard<'_, D>,
+) {
+    for i in 0..slots.len() {
+        let Some(r) = slots.get(i).filter(|r| r.status == Status::Folded) else {
+            continue;
+        };
+        let key = r.z_far;
+        let standing = match Ray::of(r.pixel2.arr(), foe, r.z_near, e2) {
+            // (Without step 1's values: no key.)
+            _ if !key.is_finite() => Standing::Folded,
+            _ if !guard.proceed(work) => Standing::OverBudget,
+            None => Standing::Folded,
+            Some(ray) => {
+                let e = index.margin(i);
+                let skip = (
+                    i.saturating_sub(FOLD_WINDOW),
+                    i.saturating_add(FOLD_WINDOW).saturating_sub(1),
+                );
+                let mut v = Partners {
+                    ray,
+                    slots,
+                    at,
+                    partner: None,
+                    keep: false,
+                };
+                match index.visit(
+                    Query::Keys(key - e, key + e),
+                    false,
+                    Some(skip),
+                    work,
+                    &mut v,
+                ) {
+                    Err(OutOfWork) => Standing::OverBudget,
+                    Ok(()) => match (v.keep, v.partner) {
+                        (false, Some(x)) => Standing::Partner(x),
+                        _ => Standing::Folded,
+                    },
+                }
+            }
+        };
+        if let Some(r) = slots.get_mut(i) {
+            r.z_far = standing.z_far();
+        }
+    }
+}
+
+/// Step 4's part of the rule for one boundary (after its search): each
+/// point with a partner ([`partners`]) whose ray the frame-2 polyline `b2`
+/// crosses between the partner and the band (through the frame-2 `index`)
+/// is made a point still to be matched again, its key back in `z_far`.
+/// Returns whether any was. Units and deadline as [`partners`].
+#[cold]
+#[inline(never)]
+pub(crate) fn images<const N: usize, D: Deadline>(
+    index: &mut Index<N>,
+    slots: &mut [PointResult],
+    b2: &[Pixel],
+    (keying, foe, e2): (&Keying, [f32; 2], f32),
+    work: &mut Work,
+    guard: &mut Guard<'_, D>,
+) -> bool {
+    let mut any = false;
+    for r in slots.iter_mut().filter(|r| r.status == Status::Folded) {
+        let Standing::Partner(xq) = Standing::of(r.z_far) else {
+            continue;
+        };
+        let p = r.pixel2.arr();
+        let (key, e) = keying.key(p);
+        let found = match Ray::of(p, foe, r.z_near, e2) {
+            _ if !guard.proceed(work) => Err(OutOfWork),
+            // (Not reached: step 1 keyed the point, `partners` placed it.)
+            None => Ok(false),
+            Some(_) if key == NO_KEY => Ok(false),
+            Some(ray) => {
+                let mut v = Images {
+                    ray,
+                    b2,
+                    from: xq - ray.n,
+                    found: false,
+                };
+                index
+                    .visit(Query::Keys(key - e, key + e), false, None, work, &mut v)
+                    .map(|()| v.found)
+            }
+        };
+        match found {
+            Ok(true) => {
+                r.z_far = key;
+                r.status = Status::NoIntersection;
+                any = true;
+            }
+            Ok(false) => r.z_far = Standing::Folded.z_far(),
+            Err(OutOfWork) => r.z_far = Standing::OverBudget.z_far(),
+        }
+    }
+    any
+}
+
+/// Every point flagged [`Status::Folded`] on a frame the deadline cut
+/// (its `boundaries`): `over_budget`, as the rule might have searched it
+/// had the clock not stopped the frame first (on a cut frame
+/// `over_budget` may stand for any result; the boundaries done before the
+/// cut lose their `folded` flags to it too, which is simpler than telling
+/// them apart and costs only a cut frame).
+#[cold]
+#[inline(never)]
+pub(crate) fn cut_short<const N: usize>(boundaries: &mut [crate::structure::BoundaryStructure<N>]) {
+    for r in boundaries
+        .iter_mut()
+        .flat_map(|b| b.points.as_mut_slice().iter_mut())
+        .filter(|r| r.status == Status::Folded)
+    {
+        *r = PointResult::flagged(r.pixel1, Status::OverBudget);
+    }
+}
+
+/// Every point the fold test flagged and the rule left given its flag: a
+/// clean [`Status::Folded`], or [`Status::OverBudget`] where the budget or
+/// the deadline stopped the rule, or where `cut` (the boundary's steps
+/// were cut short by the deadline) left a point with a partner that might
+/// have been searched.
+#[cold]
+#[inline(never)]
+pub(crate) fn settle(slots: &mut [PointResult], cut: bool) {
+    for r in slots.iter_mut().filter(|r| r.status == Status::Folded) {
+        let status = match Standing::of(r.z_far) {
+            Standing::Folded => Status::Folded,
+            Standing::Partner(_) if !cut => Status::Folded,
+            _ => Status::OverBudget,
+        };
+        *r = PointResult::flagged(r.pixel1, status);
+    }
+}

@@ -774,11 +774,16 @@ fn counted_search<const N: usize, D: Deadline>(
         crate::fold::settle(slots, true);
         return;
     }
-    if crate::fold::images(index, slots, b2, (keying, foe, e2), work, guard) {
-        let near_foe = pair.near_foe(r1_max);
-        let m = (matcher, false, checking);
-        match_boundary(pair, keying, near_foe, (slots, b2), index, (work, guard), m);
-    }
+    let near_foe = pair.near_foe(r1_max);
+    let m = (matcher, false, checking);
+    let search = |one: &mut [PointResult],
+                  index: &mut Index<N>,
+                  work: &mut Work,
+                  guard: &mut Guard<'_, D>| {
+        match_boundary(pair, keying, near_foe, (one, b2), index, (work, guard), m);
+    };
+    let e = (keying, foe, e2);
+    crate::fold::images(index, slots, b2, e, (&mut *work, &mut *guard), search);
     crate::fold::settle(slots, guard.has_expired());
 }
 

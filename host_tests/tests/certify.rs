@@ -378,6 +378,61 @@ fn containment_within_a_deadline() {
     }
 }
 
+/// The indexed search equals its reference with the counting rule for
+/// folded points on (`Processor::set_fold_counting`): the points the rule
+/// gives back are searched by each matcher, and every result is the same.
+/// Every family, 12 seeds each, every variant, with a budget that never
+/// binds; the rule must act (fewer points `folded` than without it).
+#[test]
+fn indexed_equals_reference_with_the_counting_rule() {
+    let (mut points, mut given_back) = (0usize, 0usize);
+    for f in Family::ALL {
+        for seed in 0..12 {
+            let Some(case) = Case::new(f, seed) else {
+                continue;
+            };
+            let k = &case.scenario.intrinsics;
+            let m = case.rendered.motion();
+            for v in Variant::ALL {
+                let input = case.input(v);
+                let (f1, f2) = input.frames(k).expect("frames");
+                let config = input
+                    .config()
+                    .with_work_budget(Config::MAX_WORK_PER_POINT)
+                    .expect("budget");
+                let mut p = Box::new(Processor::new(config));
+                let _ = p.process(&f1, None);
+                let folded = |s: &roadstereo::Structure<{ host_tests::N }, { host_tests::B }>| {
+                    s.boundaries()
+                        .iter()
+                        .flat_map(|b| b.points())
+                        .filter(|r| r.status() == Status::Folded)
+                        .count()
+                };
+                let without = folded(p.process_against_kept(&f2, &m).expect("indexed"));
+                p.set_fold_counting(true);
+                let fast = Box::new(p.process_against_kept(&f2, &m).expect("indexed").clone());
+                let slow = p.reference_against_kept(&f2, &m).expect("reference");
+                given_back += without - folded(&fast);
+                for (bk, (x, y)) in fast.boundaries().iter().zip(slow.boundaries()).enumerate() {
+                    assert_eq!(x.points().len(), y.points().len());
+                    for (i, (a, b)) in x.points().iter().zip(y.points()).enumerate() {
+                        assert!(
+                            a == b,
+                            "{} {seed} {}: boundary {bk} point {i}: indexed {a:?}, reference {b:?}",
+                            f.name(),
+                            v.name()
+                        );
+                        points += 1;
+                    }
+                }
+            }
+        }
+    }
+    eprintln!("{points} points, {given_back} given back by the counting rule");
+    assert!(given_back > 1_000, "{given_back} points given back");
+}
+
 /// The indexed search equals its reference with the fold test switched
 /// off as well, where every point on a fold reaches the search (issue 11:
 /// the reference follows the rule and equals the fast path on every

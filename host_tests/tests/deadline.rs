@@ -126,10 +126,22 @@ fn compare(got: &Structure<N, B>, full: &Structure<N, B>, what: &str, c: &mut Co
 /// The pair `(f1, f2)` within clocks that say yes from their `k`-th
 /// question on, for every `k` from 0 to past the frame's last question.
 fn sweep(config: Config, (f1, f2, m): (&Frame<N, B>, &Frame<N, B>, &Motion), what: &str) -> Counts {
+    sweep_with(config, (f1, f2, m), what, false)
+}
+
+/// [`sweep`] with the counting rule for folded points on or off
+/// (`Processor::set_fold_counting`).
+fn sweep_with(
+    config: Config,
+    (f1, f2, m): (&Frame<N, B>, &Frame<N, B>, &Motion),
+    what: &str,
+    counting: bool,
+) -> Counts {
     let largest = config
         .with_work_budget(Config::MAX_WORK_PER_POINT)
         .expect("the largest budget");
     let mut p = Box::new(Processor::<N, B>::new(largest));
+    p.set_fold_counting(counting);
     assert!(matches!(p.process(f1, None), Ok(Step::First)));
     let Ok(full) = p.process_against_kept(f2, m) else {
         panic!("{what}: no structure");
@@ -142,7 +154,9 @@ fn sweep(config: Config, (f1, f2, m): (&Frame<N, B>, &Frame<N, B>, &Motion), wha
     // The questions a frame asks without expiring: at most one a point
     // in step 1, the fold queries and step 4, a few a boundary, and one
     // before every 32 items of each pass of a boundary's steps (fewer
-    // than 24 passes: step 1, the fold test, the two index builds).
+    // than 24 passes: step 1, the fold test, the two index builds); with
+    // the counting rule two more a point that folds (its partners, its
+    // images), one more for its search, and three more passes.
     let mut never = Clock {
         k: usize::MAX,
         asked: 0,
@@ -154,8 +168,9 @@ fn sweep(config: Config, (f1, f2, m): (&Frame<N, B>, &Frame<N, B>, &Motion), wha
     );
     assert!(!p.deadline_expired(), "{what}: a clock that never says yes");
     let asked = never.asked;
+    let (per_point, passes) = if counting { (6, 30) } else { (3, 24) };
     assert!(
-        asked <= 3 * points + 24 * points.div_ceil(32) + 32 * B,
+        asked <= per_point * points + passes * points.div_ceil(32) + 32 * B,
         "{what}: {asked} questions for {points} points"
     );
     // With no cap and a clock that never says yes: `process` exactly.
@@ -257,6 +272,54 @@ fn every_cut_of_the_adversarial_family_is_complete_or_flagged() {
         total.cut_frames
     );
     assert!(total.over_budget > 0 && total.equal > 0);
+}
+
+/// The same with the counting rule for folded points on
+/// (`Processor::set_fold_counting`), on the pairs where it acts: the
+/// certification's S-bends, rounded to the pixel grid and with disc
+/// noise, each at its own errors. Every cut is complete or flagged, a
+/// clock that never says yes and caps nothing is `process` exactly, and
+/// the rule gives points back on these pairs (fewer `folded` than without
+/// it).
+#[test]
+fn every_cut_with_the_counting_rule_is_complete_or_flagged() {
+    use host_tests::certify::{Case, Variant};
+    use host_tests::scenarios::Family;
+    let mut total = Counts::default();
+    let (mut folded_off, mut folded_on) = (0usize, 0usize);
+    for seed in 0..8 {
+        let Some(case) = Case::new(Family::SBend, seed) else {
+            continue;
+        };
+        let k = &case.scenario.intrinsics;
+        let m = case.rendered.motion();
+        for v in [Variant::Rounded, Variant::Disc] {
+            let input = case.input(v);
+            let (f1, f2) = input.frames(k).expect("frames");
+            let what = format!("s_bend {seed} {}", v.name());
+            let c = sweep_with(input.config(), (&f1, &f2, &m), &what, true);
+            total.add(&c);
+            let count = |on: bool| {
+                let mut p = Box::new(Processor::<N, B>::new(input.config()));
+                p.set_fold_counting(on);
+                assert!(matches!(p.process(&f1, None), Ok(Step::First)));
+                let s = p.process_against_kept(&f2, &m).expect("kept");
+                s.boundaries()
+                    .iter()
+                    .flat_map(|b| b.points())
+                    .filter(|r| r.status() == Status::Folded)
+                    .count()
+            };
+            folded_off += count(false);
+            folded_on += count(true);
+        }
+    }
+    eprintln!("{total:?}; folded {folded_off} without the rule, {folded_on} with it");
+    assert!(total.equal > 0 && total.over_budget > 0 && total.cut_frames > 0);
+    assert!(
+        folded_on * 2 < folded_off,
+        "the rule gave back too few: folded {folded_off} without it, {folded_on} with it"
+    );
 }
 
 /// The named synthetic scenarios and 20 random ones, exact and rounded to

@@ -285,8 +285,11 @@ pub(crate) fn partners<const N: usize, D: Deadline>(
 /// Step 4's part of the rule for one boundary (after its search): each
 /// point with a partner ([`partners`]) whose ray the frame-2 polyline `b2`
 /// crosses between the partner and the band (through the frame-2 `index`)
-/// is made a point still to be matched again, its key back in `z_far`.
-/// Returns whether any was. Units and deadline as [`partners`].
+/// is made a point still to be matched again, its key back in `z_far`, and
+/// searched at once by `search` on its own slot (the other slots hold
+/// results, some of them [`Status::NoIntersection`], which a search of the
+/// whole boundary would take for points still to be matched). Units and
+/// deadline as [`partners`].
 #[cold]
 #[inline(never)]
 pub(crate) fn images<const N: usize, D: Deadline>(
@@ -294,11 +297,13 @@ pub(crate) fn images<const N: usize, D: Deadline>(
     slots: &mut [PointResult],
     b2: &[Pixel],
     (keying, foe, e2): (&Keying, [f32; 2], f32),
-    work: &mut Work,
-    guard: &mut Guard<'_, D>,
-) -> bool {
-    let mut any = false;
-    for r in slots.iter_mut().filter(|r| r.status == Status::Folded) {
+    (work, guard): (&mut Work, &mut Guard<'_, D>),
+    mut search: impl FnMut(&mut [PointResult], &mut Index<N>, &mut Work, &mut Guard<'_, D>),
+) {
+    for i in 0..slots.len() {
+        let Some(r) = slots.get_mut(i).filter(|r| r.status == Status::Folded) else {
+            continue;
+        };
         let Standing::Partner(xq) = Standing::of(r.z_far) else {
             continue;
         };
@@ -325,13 +330,14 @@ pub(crate) fn images<const N: usize, D: Deadline>(
             Ok(true) => {
                 r.z_far = key;
                 r.status = Status::NoIntersection;
-                any = true;
+                if let Some(one) = slots.get_mut(i..=i) {
+                    search(one, index, work, guard);
+                }
             }
             Ok(false) => r.z_far = Standing::Folded.z_far(),
             Err(OutOfWork) => r.z_far = Standing::OverBudget.z_far(),
         }
     }
-    any
 }
 
 /// Every point flagged [`Status::Folded`] on a frame the deadline cut

@@ -612,7 +612,8 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 (slots, b2),
                 index,
                 (&mut work, &mut guard),
-                (matcher, *fold_counting, checking),
+                matcher,
+                (*fold_counting, checking),
             );
         }
         if *fold_counting && guard.has_expired() {
@@ -775,12 +776,23 @@ fn counted_search<const N: usize, D: Deadline>(
         return;
     }
     let near_foe = pair.near_foe(r1_max);
-    let m = (matcher, false, checking);
+    // (The search of `match_boundary` without its tail, this function: no
+    // recursion, so the matcher the per-frame call passes stays a constant
+    // the compiler can see, and the reference walks stay out of the
+    // firmware.)
     let search = |one: &mut [PointResult],
                   index: &mut Index<N>,
                   work: &mut Work,
                   guard: &mut Guard<'_, D>| {
-        match_boundary(pair, keying, near_foe, (one, b2), index, (work, guard), m);
+        step4::match_points(
+            pair,
+            keying,
+            near_foe,
+            (one, b2),
+            index,
+            (work, guard),
+            matcher,
+        );
     };
     let e = (keying, foe, e2);
     crate::fold::images(index, slots, b2, e, (&mut *work, &mut *guard), search);

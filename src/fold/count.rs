@@ -289,9 +289,9 @@ pub(crate) fn partners<const N: usize, D: Deadline>(
 /// searched at once by `search` on its own slot (the other slots hold
 /// results, some of them [`Status::NoIntersection`], which a search of the
 /// whole boundary would take for points still to be matched). Units and
-/// deadline as [`partners`].
-#[cold]
-#[inline(never)]
+/// deadline as [`partners`]. (Inlined into its one caller, so that the
+/// matcher `search` captures stays a constant there.)
+#[inline(always)]
 pub(crate) fn images<const N: usize, D: Deadline>(
     index: &mut Index<N>,
     slots: &mut [PointResult],

@@ -44,7 +44,8 @@ pub(super) fn match_boundary<const N: usize, D: Deadline>(
     (slots, b2): (&mut [PointResult], &[Pixel]),
     index: &mut Index<N>,
     (work, guard): (&mut Work, &mut Guard<'_, D>),
-    (matcher, counting, checking): (Matcher, bool, bool),
+    matcher: Matcher,
+    (counting, checking): (bool, bool),
 ) {
     match_points(
         pair,

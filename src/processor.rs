@@ -746,7 +746,11 @@ fn counted_search<const N: usize, D: Deadline>(
     }
     let at = |p: Pixel| recompensate(pair, keying, p).map(|(c, _)| c.pixel2.arr());
     let e2 = pair.e2();
-    crate::fold::partners(index, slots, at, (foe, e2), work, guard);
+    if !crate::fold::partners(index, slots, at, (foe, e2), work, guard) {
+        // No point has a partner: nothing to look for in frame 2.
+        crate::fold::settle(slots, guard.has_expired());
+        return;
+    }
     // The frame-2 index again (its block tree built at once: the tree the
     // walks would build), and the points given back searched.
     let ks = keying.key_scale;

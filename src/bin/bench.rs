@@ -192,7 +192,7 @@ fn fusion_bench() -> bool {
             step.paired.is_none() || copy.structure().digest() == fusion.structure().digest();
         let own = step_instr.saturating_sub(matching);
         defmt::info!(
-            "fusion frame={=u32} points={=u32} step_instr={=u32} matching_instr={=u32} fusion_instr={=u32} per_point={=u32} paired={=bool} retired={=bool} same_structure={=bool} map={=u32} ok={=u32}",
+            "fusion frame={=u32} points={=u32} step_instr={=u32} matching_instr={=u32} fusion_instr={=u32} per_point={=u32} paired={=bool} retired={=bool} same_structure={=bool} map={=u32} ok={=u32} folded={=u32}",
             i,
             points as u32,
             step_instr,
@@ -203,11 +203,55 @@ fn fusion_bench() -> bool {
             step.retired.is_some(),
             same,
             (fusion.map().len(0) + fusion.map().len(1)) as u32,
-            fusion.structure().status_counts().get(Status::Ok) as u32
+            fusion.structure().status_counts().get(Status::Ok) as u32,
+            fusion.structure().status_counts().get(Status::Folded) as u32
         );
     }
     fusion.reset();
-    fusion_within(fusion)
+    if !fusion_within(fusion) {
+        return false;
+    }
+    fusion.reset();
+    fusion.set_fold_counting(true);
+    let counted = fusion_counted(fusion);
+    fusion.set_fold_counting(false);
+    fusion.reset();
+    counted
+}
+
+/// The demo drive again through `Fusion::step` with the counting rule for
+/// folded points on (`Fusion::set_fold_counting`): per frame the step's
+/// instructions and the pair's `ok` and `folded` points (against the
+/// rows of [`fusion_bench`], where the rule is off).
+fn fusion_counted(fusion: &mut Fusion<256, 2, 512>) -> bool {
+    let Ok(mut drive) = fw::Drive::new(DRIVE) else {
+        return false;
+    };
+    let mut frame = Frame::<256, 2>::new(drive.camera);
+    for i in 0..drive.frames {
+        let Ok(motion) = drive.next_frame(&mut frame) else {
+            return false;
+        };
+        let chained = motion.map(|m| ChainedMotion {
+            from: i.wrapping_sub(1),
+            motion: m,
+        });
+        let (result, instr) = fw::measure(|| fusion.step(black_box(i), &frame, chained.as_ref()));
+        let Ok(step) = result else {
+            return false;
+        };
+        let counts = fusion.structure().status_counts();
+        defmt::info!(
+            "fusion_counted frame={=u32} step_instr={=u32} paired={=bool} ok={=u32} folded={=u32} over_budget={=u32}",
+            i,
+            instr,
+            step.paired.is_some(),
+            counts.get(Status::Ok) as u32,
+            counts.get(Status::Folded) as u32,
+            counts.get(Status::OverBudget) as u32
+        );
+    }
+    true
 }
 
 /// The limit of the demo drive's steps within a deadline, instructions:

@@ -227,7 +227,7 @@ impl Visitor<'_> for Images<'_> {
 /// `z_far`. `index` is the fold test's index of the boundary (step 1's
 /// keys and margins), `at` step 1's compensation of a frame-1 pixel. The
 /// points take their units from `work`, each asking `guard` first. The FOE
-/// `foe`, the frame-2 error `e2`.
+/// `foe`, the frame-2 error `e2`. Returns whether any point has a partner.
 #[cold]
 #[inline(never)]
 pub(crate) fn partners<const N: usize, D: Deadline>(
@@ -237,7 +237,8 @@ pub(crate) fn partners<const N: usize, D: Deadline>(
     (foe, e2): ([f32; 2], f32),
     work: &mut Work,
     guard: &mut Guard<'_, D>,
-) {
+) -> bool {
+    let mut any = false;
     for i in 0..slots.len() {
         let Some(r) = slots.get(i).filter(|r| r.status == Status::Folded) else {
             continue;
@@ -276,10 +277,12 @@ pub(crate) fn partners<const N: usize, D: Deadline>(
                 }
             }
         };
+        any |= matches!(standing, Standing::Partner(_));
         if let Some(r) = slots.get_mut(i) {
             r.z_far = standing.z_far();
         }
     }
+    any
 }
 
 /// Step 4's part of the rule for one boundary (after its search): each

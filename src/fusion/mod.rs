@@ -739,6 +739,14 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         &self.processor
     }
 
+    /// The counting rule for folded points in the pairs' search on or off
+    /// from the next step on ([`Processor::set_fold_counting`]; off by
+    /// default). A pair's points are then searched where the rule allows,
+    /// and their sticks fuse as every other point's.
+    pub fn set_fold_counting(&mut self, on: bool) {
+        self.processor.set_fold_counting(on);
+    }
+
     /// The policy.
     pub fn config(&self) -> &FusionConfig {
         &self.config

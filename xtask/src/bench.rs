@@ -139,6 +139,7 @@ pub fn bench(b: &Budget) -> Result<(), String> {
     crate::worst::worst_case(&log, b.deadline(), OPEN, &mut misses);
     deadline_table(&log, b.deadline(), &mut misses);
     drive_within(&log, b.deadline(), &mut misses);
+    drive_counted(&log, b.deadline(), &mut misses);
     fusion_table(&log, &per, b, &mut misses);
     memory_table(&log, &demo_elf, b, &mut misses)?;
     wire_table(&log, &mut misses);
@@ -546,6 +547,59 @@ the demo drive's fusion steps within a deadline (`Fusion::step_within`, SysTick 
             "the demo drive within a deadline: a step of {worst} instructions > the deadline {deadline}"
         ));
     }
+}
+
+/// The demo drive's fusion steps with the counting rule for folded points
+/// on (firmware `fusion_counted`: `Fusion::set_fold_counting`), against
+/// the same steps without it: per paired frame the step's instructions and
+/// the pair's `ok` and `folded` points. Reported, not budgeted (the rule
+/// is off by default; the deadline's budgets are without it); hard check:
+/// the rows are there.
+fn drive_counted(log: &str, deadline: u64, misses: &mut Vec<String>) {
+    let rows = records(log, "fusion_counted frame=");
+    if rows.is_empty() {
+        misses.push("no fusion_counted rows in the bench log".into());
+        return;
+    }
+    let plain: BTreeMap<u64, (u64, u64, u64)> = records(log, "fusion frame=")
+        .iter()
+        .map(|r| {
+            let f = num(r, "frame");
+            (f, (num(r, "step_instr"), num(r, "ok"), num(r, "folded")))
+        })
+        .collect();
+    println!(
+        "
+the demo drive's fusion steps with the counting rule for folded points (`Fusion::set_fold_counting`; off in every other figure):"
+    );
+    println!("| frame | step (without the rule) | share of the deadline | ok (without) | folded (without) |");
+    println!("|---:|---:|---:|---:|---:|");
+    let (mut worst, mut over) = (0u64, 0usize);
+    let (mut ok, mut ok0, mut folded, mut folded0) = (0u64, 0u64, 0u64, 0u64);
+    for r in &rows {
+        if field(r, "paired") != Some("true") {
+            continue;
+        }
+        let f = num(r, "frame");
+        let step = num(r, "step_instr");
+        let (s0, k0, f0) = plain.get(&f).copied().unwrap_or((0, 0, 0));
+        worst = worst.max(step);
+        over += usize::from(step > deadline);
+        ok += num(r, "ok");
+        ok0 += k0;
+        folded += num(r, "folded");
+        folded0 += f0;
+        println!(
+            "| {f} | {step} ({s0}) | {:.1} % | {} ({k0}) | {} ({f0}) |",
+            100.0 * step as f64 / deadline as f64,
+            num(r, "ok"),
+            num(r, "folded")
+        );
+    }
+    println!(
+        "with the counting rule: every step within {worst} instructions ({:.1} % of the deadline {deadline}), {over} over it; ok points over the drive's pairs {ok} ({ok0} without the rule), folded {folded} ({folded0})",
+        100.0 * worst as f64 / deadline as f64
+    );
 }
 
 /// The adversarial family from the log, by member in log order.

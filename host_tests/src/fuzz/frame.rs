@@ -70,6 +70,22 @@ pub struct ConfigIn {
     pub work_budget: Option<u32>,
 }
 
+impl ConfigIn {
+    /// Whether the case's processors take the counting rule for folded
+    /// points (`Processor::set_fold_counting`): the parity of the set bits
+    /// of the configuration's first four arguments, so about half the
+    /// cases, without a draw of its own (the corpus's cases stay what
+    /// they were).
+    pub fn fold_counting(&self) -> bool {
+        self.new
+            .iter()
+            .map(|x| x.to_bits().count_ones())
+            .sum::<u32>()
+            % 2
+            == 1
+    }
+}
+
 /// One call of the frame path.
 #[derive(Debug, Clone)]
 pub enum Call {
@@ -1006,12 +1022,13 @@ fn matchers<const N: usize, const B: usize>(
     kept: &Frame<N, B>,
     frame: &Frame<N, B>,
     m: &Motion,
-    config: &Config,
+    (config, counting): (&Config, bool),
 ) -> Box<Structure<N, B>> {
     let unlimited = config
         .with_work_budget(Config::MAX_WORK_PER_POINT)
         .expect("the largest budget is valid");
     let mut r = Box::new(Processor::<N, B>::new(unlimited));
+    r.set_fold_counting(counting);
     assert!(matches!(r.process(kept, None), Ok(Step::First)));
     let fast = Box::new(r.process_against_kept(frame, m).expect("kept").clone());
     let slow = Box::new(r.reference_against_kept(frame, m).expect("kept").clone());
@@ -1114,11 +1131,12 @@ fn against_reference<const N: usize, const B: usize>(
 fn within_deadlines<const N: usize, const B: usize>(
     kept: &Frame<N, B>,
     (frame, m): (&Frame<N, B>, &Motion),
-    config: &Config,
+    (config, counting): (&Config, bool),
     reference: &Structure<N, B>,
     features: &mut u128,
 ) {
     let mut p = Box::new(Processor::<N, B>::new(*config));
+    p.set_fold_counting(counting);
     assert!(matches!(p.process(kept, None), Ok(Step::First)));
     let mut questions = 0usize;
     let mut count = || {
@@ -1223,8 +1241,11 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
     }
     let config = build_config(&case.config, &mut features);
     // `a` gets every call; `shadow` only those that succeed.
+    let counting = case.config.fold_counting();
     let mut a = Box::new(Processor::<N, B>::new(config));
     let mut shadow = Box::new(Processor::<N, B>::new(config));
+    a.set_fold_counting(counting);
+    shadow.set_fold_counting(counting);
     // (The shadow takes the checking forms of the loops that have a
     // bounded one: every call compares the two bit for bit.)
     shadow.set_checking_forms(true);
@@ -1260,7 +1281,7 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
                 let motion = m.as_ref().and_then(|m| build_motion(m, &mut features));
                 let kept = a.previous().cloned().map(Box::new);
                 let reference = match (&kept, &motion) {
-                    (Some(k), Some(m)) => Some(matchers(k, &frame, m, &config)),
+                    (Some(k), Some(m)) => Some(matchers(k, &frame, m, (&config, counting))),
                     _ => None,
                 };
                 let got = match a.process(&frame, motion.as_ref()) {
@@ -1318,7 +1339,9 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
                     continue;
                 };
                 let kept = a.previous().cloned().map(Box::new);
-                let reference = kept.as_ref().map(|k| matchers(k, &frame, &motion, &config));
+                let reference = kept
+                    .as_ref()
+                    .map(|k| matchers(k, &frame, &motion, (&config, counting)));
                 let got = a
                     .process_against_kept(&frame, &motion)
                     .map(|s| Box::new(s.clone()));
@@ -1335,7 +1358,13 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
                         check_structure(&s, k, &config, &mut features);
                         check_on_polyline(&s, k, (&frame, &motion));
                         against_reference(&s, r, &config, &mut features);
-                        within_deadlines(k, (&frame, &motion), &config, r, &mut features);
+                        within_deadlines(
+                            k,
+                            (&frame, &motion),
+                            (&config, counting),
+                            r,
+                            &mut features,
+                        );
                         assert!(
                             a.previous() == Some(&**k),
                             "{what}: the kept frame was replaced"

@@ -489,14 +489,18 @@ fn indexed_equals_reference_without_the_fold_test() {
 }
 
 /// Issue 11's yield targets: actual >= 90 % of the ideal yield over all
-/// families and >= 80 % in each, in every variant. Not met today (`docs/TESTS.md`
-/// gives the figures and where the points go):
-/// `cargo test --profile checked --test certify -- --ignored` checks them.
+/// families and >= 80 % in each, in every variant, with the library at its
+/// best (the counting rule for folded points on, `Processor::set_fold_counting`;
+/// without it the S-bend misses too). Not met: the far-small-disparity
+/// family in the three inexact variants, whose ideal points no guaranteed
+/// stick can mostly bound (`docs/TESTS.md` gives the figures and where the
+/// points go): `cargo test --profile checked --test certify -- --ignored`
+/// checks them.
 #[test]
 #[ignore = "issue 11's yield targets are not met yet (docs/TESTS.md gives the figures)"]
 fn certify_yield_targets() {
     let (families, per, full) = families_from_env();
-    let rep = certify(&families, 0..per);
+    let rep = certify_with(&families, 0..per, Fold::Counted);
     let (guarantee, yields) = requirements(&rep, full);
     let all: Vec<String> = guarantee.into_iter().chain(yields).collect();
     assert!(

@@ -15,6 +15,12 @@
 
 use std::time::Duration;
 
+/// The usage `--help` prints (the module docs say more).
+const USAGE: &str = "usage: fuzz [--seconds S] [--threads T] [--seed X] \
+[--targets frame:6,calibration:1,geometry:1,replay:1,fusion:2] [--cases N] \
+[--case-limit S] [--save DIR]; fuzz --describe TARGET SEED prints a case \
+(cargo xtask fuzz passes these on; the libFuzzer targets are in fuzz/, on nightly)";
+
 use host_tests::fuzz::{pass, Pass, Target};
 
 fn main() -> std::process::ExitCode {
@@ -126,6 +132,10 @@ fn main() -> std::process::ExitCode {
                 Ok(s) if s > 0.0 => p.case_limit = Duration::from_secs_f64(s),
                 _ => return bad("--case-limit"),
             },
+            "--help" | "-h" => {
+                println!("{USAGE}");
+                return std::process::ExitCode::SUCCESS;
+            }
             "--save" => p.save = Some(value().into()),
             "--targets" => {
                 let mut t = Vec::new();
@@ -139,7 +149,7 @@ fn main() -> std::process::ExitCode {
                 p.targets = t;
             }
             _ => {
-                eprintln!("fuzz: unknown argument {a}; see the doc comment of src/bin/fuzz.rs");
+                eprintln!("fuzz: unknown argument {a}\n{USAGE}");
                 return std::process::ExitCode::from(2);
             }
         }

@@ -27,20 +27,27 @@
 //! lean wedge path (moving forwards without a translation error,
 //! half-plane keys), with `d = p₁' − F`, `R = |d|²`, `X = d·(x − F)` the
 //! place of `x` along the ray and `n = ρ₁ (r₁ + e₂)` (the band's reach
-//! towards `F` in `X`, [`crate::wedge`]):
+//! towards `F` in `X`, [`crate::wedge`]), after the boundary's search
+//! (`counted_search` in [`crate::processor`], which computes step 1's
+//! values of the boundary again, the same arithmetic, and builds the fold
+//! test's index and then frame 2's again):
 //!
-//! 1. **Partners** ([`partners`], step 2, while the slots hold the
-//!    compensated points): the frame-1 segments the fold test's index
-//!    offers for the point's widened key, outside its window, each tested
-//!    against the exact line through `F` and `p₁'`. The point stays
+//! 1. **Partners** ([`partners`]): the frame-1 segments the fold test's
+//!    index offers for the point's widened key, outside its window, each
+//!    tested against the exact line through `F` and `p₁'`. The point stays
 //!    `folded` unless exactly one crosses it, on `F`'s side of the band
 //!    (`0 < X_q < R − n`); a segment along the line, a second crossing or
 //!    one in or beyond the band keeps the fold.
-//! 2. **Images** ([`images`], after step 4): the frame-2 segments the
-//!    index offers for the point's key widened by its margin, the same
-//!    test: the point is searched (step 4 again, the same search as every
-//!    other point's) when one crosses the line at `X_q − n ≤ X < R − n`,
-//!    and stays `folded` otherwise.
+//! 2. **Images** ([`images`]): the frame-2 segments the index offers for
+//!    the point's key widened by its margin, the same test: the point is
+//!    searched (on its own slot, the same search as every other point's)
+//!    when one crosses the line at `X_q − n ≤ X < R − n`, and stays
+//!    `folded` otherwise.
+//!
+//! Both count crossings of the exact ray on the *detected* polylines, as
+//! the fold test does: a place the detection moves off the ray is no
+//! partner to them (a limit the rule shares with the fold test, pinned by
+//! `tests/fold_counting.rs`).
 //!
 //! Each segment looked at is a unit of the frame's work budget, each one
 //! tested one more, and each point asks the caller's deadline first
@@ -59,8 +66,9 @@ use crate::search::{Flow, Index, OutOfWork, Query, Visitor, Work};
 use crate::structure::{PointResult, Status, FOLD_WINDOW};
 
 /// Where a point the fold test flagged stands between the steps, kept in
-/// its `z_far` (its key until [`partners`]; the key is a function of
-/// `p₁'`, [`Keying::key`], and [`images`] computes it again).
+/// its `z_far` (its key until [`partners`], NaN if step 1's values could
+/// not be had again; the key is a function of `p₁'`, [`Keying::key`], and
+/// [`images`] computes it again).
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Standing {
     /// It stays `folded`.

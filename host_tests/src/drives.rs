@@ -666,6 +666,17 @@ pub fn run(
     run_within(d, input, policy, None, each)
 }
 
+/// [`run`] with the counting rule for folded points on
+/// (`Fusion::set_fold_counting`).
+pub fn run_counted(
+    d: &Drive,
+    input: &Input,
+    policy: FusionConfig,
+    each: impl FnMut(usize, &FusionStep, &HostFusion),
+) -> Run {
+    run_with(d, input, (policy, true), None, each)
+}
+
 /// [`run`] with every frame's step within a deadline
 /// (`Fusion::step_within`) whose clock says the time is up from its
 /// `k`-th question on, when `cut` is `Some(k)`.
@@ -674,10 +685,22 @@ pub fn run_within(
     input: &Input,
     policy: FusionConfig,
     cut: Option<usize>,
+    each: impl FnMut(usize, &FusionStep, &HostFusion),
+) -> Run {
+    run_with(d, input, (policy, false), cut, each)
+}
+
+/// [`run_within`], the counting rule on or off.
+fn run_with(
+    d: &Drive,
+    input: &Input,
+    (policy, counting): (FusionConfig, bool),
+    cut: Option<usize>,
     mut each: impl FnMut(usize, &FusionStep, &HostFusion),
 ) -> Run {
     let k = d.spec.intrinsics;
     let mut fusion = Box::new(HostFusion::new(input.config(), policy));
+    fusion.set_fold_counting(counting);
     let mut keys: Vec<KeyRecord> = Vec::new();
     let mut steps = Vec::new();
     for j in 0..d.frames.len() {

@@ -49,6 +49,16 @@ fn pct(a: usize, b: usize) -> String {
 /// agreeing pairs) holds the truth, every wrong two-view stick is caught
 /// or harmless, and no two-view stick whose correspondent exists misses.
 fn containment(noise: Noise, motion: Option<MotionNoise>, per_family: usize) -> Tally {
+    containment_with(noise, motion, per_family, false)
+}
+
+/// [`containment`] with the counting rule for folded points on or off.
+fn containment_with(
+    noise: Noise,
+    motion: Option<MotionNoise>,
+    per_family: usize,
+    counting: bool,
+) -> Tally {
     use std::fmt::Write as _;
     let policy = FusionConfig::DEFAULT;
     let mut all = Tally::default();
@@ -73,7 +83,11 @@ fn containment(noise: Noise, motion: Option<MotionNoise>, per_family: usize) -> 
         let mut t = Tally::default();
         for (seed, d) in &ds {
             let input = d.input(noise, motion, *seed);
-            let r = run(d, &input, policy, |_, _, _| {});
+            let r = if counting {
+                host_tests::drives::run_counted(d, &input, policy, |_, _, _| {})
+            } else {
+                run(d, &input, policy, |_, _, _| {})
+            };
             t.add(&tally(d, &r));
         }
         let _ = writeln!(
@@ -333,6 +347,30 @@ fn containment_rounded() {
 #[test]
 fn containment_disc_noise() {
     containment(Noise::Disc, None, PER_FAMILY);
+}
+
+/// The same with the counting rule for folded points on
+/// (`Fusion::set_fold_counting`): the pairs' points it gives back fuse as
+/// every other, and the fused intervals still hold the truth, no wrong
+/// match unflagged (rounded boundaries).
+#[test]
+fn containment_with_the_counting_rule() {
+    let t = containment_with(Noise::Rounded, None, PER_FAMILY, true);
+    assert!(t.consistent > 0);
+    // The drive built for wrong matches on disjoint stretches: every
+    // wrong two-view stick still flagged or harmless.
+    let d = disjoint_stretch_drive();
+    let policy = FusionConfig::new(8, 0).expect("policy");
+    let mut all = Tally::default();
+    for (v, noise) in [Noise::Rounded, Noise::Disc].into_iter().enumerate() {
+        let input = d.input(noise, None, v as u64);
+        let r = host_tests::drives::run_counted(&d, &input, policy, |_, _, _| {});
+        all.add(&tally(&d, &r));
+    }
+    wrong_match_report("built on purpose, with the counting rule", &all);
+    assert!(all.wrong_pairs >= 10, "{all:?}");
+    assert_eq!(all.wrong_pairs, all.caught + all.harmless, "{all:?}");
+    assert_eq!(all.consistent, all.consistent_contained);
 }
 
 #[test]

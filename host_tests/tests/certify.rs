@@ -378,14 +378,17 @@ fn containment_within_a_deadline() {
     }
 }
 
-/// The indexed search equals its reference with the counting rule for
-/// folded points on (`Processor::set_fold_counting`): the points the rule
-/// gives back are searched by each matcher, and every result is the same.
-/// Every family, 12 seeds each, every variant, with a budget that never
-/// binds; the rule must act (fewer points `folded` than without it).
-#[test]
-fn indexed_equals_reference_with_the_counting_rule() {
-    let (mut points, mut given_back) = (0usize, 0usize);
+/// Every family, 12 seeds each, every variant: `each` gets a processor
+/// with the largest budget (a budget that never binds) that has kept the
+/// pair's first frame, the second frame, the motion and the case's name.
+fn each_pair(
+    mut each: impl FnMut(
+        &mut Processor<{ host_tests::N }, { host_tests::B }>,
+        &Frame<{ host_tests::N }, { host_tests::B }>,
+        &Motion,
+        &str,
+    ),
+) {
     for f in Family::ALL {
         for seed in 0..12 {
             let Some(case) = Case::new(f, seed) else {
@@ -402,33 +405,62 @@ fn indexed_equals_reference_with_the_counting_rule() {
                     .expect("budget");
                 let mut p = Box::new(Processor::new(config));
                 let _ = p.process(&f1, None);
-                let folded = |s: &roadstereo::Structure<{ host_tests::N }, { host_tests::B }>| {
-                    s.boundaries()
-                        .iter()
-                        .flat_map(|b| b.points())
-                        .filter(|r| r.status() == Status::Folded)
-                        .count()
-                };
-                let without = folded(p.process_against_kept(&f2, &m).expect("indexed"));
-                p.set_fold_counting(true);
-                let fast = Box::new(p.process_against_kept(&f2, &m).expect("indexed").clone());
-                let slow = p.reference_against_kept(&f2, &m).expect("reference");
-                given_back += without - folded(&fast);
-                for (bk, (x, y)) in fast.boundaries().iter().zip(slow.boundaries()).enumerate() {
-                    assert_eq!(x.points().len(), y.points().len());
-                    for (i, (a, b)) in x.points().iter().zip(y.points()).enumerate() {
-                        assert!(
-                            a == b,
-                            "{} {seed} {}: boundary {bk} point {i}: indexed {a:?}, reference {b:?}",
-                            f.name(),
-                            v.name()
-                        );
-                        points += 1;
-                    }
-                }
+                each(
+                    &mut p,
+                    &f2,
+                    &m,
+                    &format!("{} {seed} {}", f.name(), v.name()),
+                );
             }
         }
     }
+}
+
+/// Every point of the indexed structure `fast` equals the reference's
+/// `slow`; returns the points compared and the `ok` ones among them.
+fn assert_indexed_is_reference(
+    fast: &roadstereo::Structure<{ host_tests::N }, { host_tests::B }>,
+    slow: &roadstereo::Structure<{ host_tests::N }, { host_tests::B }>,
+    what: &str,
+) -> (usize, usize) {
+    let (mut points, mut ok) = (0usize, 0usize);
+    for (bk, (x, y)) in fast.boundaries().iter().zip(slow.boundaries()).enumerate() {
+        assert_eq!(x.points().len(), y.points().len());
+        for (i, (a, b)) in x.points().iter().zip(y.points()).enumerate() {
+            assert!(
+                a == b,
+                "{what}: boundary {bk} point {i}: indexed {a:?}, reference {b:?}"
+            );
+            points += 1;
+            ok += usize::from(a.status() == Status::Ok);
+        }
+    }
+    (points, ok)
+}
+
+/// The indexed search equals its reference with the counting rule for
+/// folded points on (`Processor::set_fold_counting`): the points the rule
+/// gives back are searched by each matcher, and every result is the same.
+/// Every family, 12 seeds each, every variant, with a budget that never
+/// binds; the rule must act (fewer points `folded` than without it).
+#[test]
+fn indexed_equals_reference_with_the_counting_rule() {
+    let (mut points, mut given_back) = (0usize, 0usize);
+    let folded = |s: &roadstereo::Structure<{ host_tests::N }, { host_tests::B }>| {
+        s.boundaries()
+            .iter()
+            .flat_map(|b| b.points())
+            .filter(|r| r.status() == Status::Folded)
+            .count()
+    };
+    each_pair(|p, f2, m, what| {
+        let without = folded(p.process_against_kept(f2, m).expect("indexed"));
+        p.set_fold_counting(true);
+        let fast = Box::new(p.process_against_kept(f2, m).expect("indexed").clone());
+        let slow = p.reference_against_kept(f2, m).expect("reference");
+        given_back += without - folded(&fast);
+        points += assert_indexed_is_reference(&fast, slow, what).0;
+    });
     eprintln!("{points} points, {given_back} given back by the counting rule");
     assert!(given_back > 1_000, "{given_back} points given back");
 }
@@ -441,46 +473,19 @@ fn indexed_equals_reference_with_the_counting_rule() {
 #[test]
 fn indexed_equals_reference_without_the_fold_test() {
     let (mut points, mut ok) = (0usize, 0usize);
-    for f in Family::ALL {
-        for seed in 0..12 {
-            let Some(case) = Case::new(f, seed) else {
-                continue;
-            };
-            let k = &case.scenario.intrinsics;
-            let m = case.rendered.motion();
-            for v in Variant::ALL {
-                let input = case.input(v);
-                let (f1, f2) = input.frames(k).expect("frames");
-                let config = input
-                    .config()
-                    .with_work_budget(Config::MAX_WORK_PER_POINT)
-                    .expect("budget");
-                let mut p = Box::new(Processor::new(config));
-                let _ = p.process(&f1, None);
-                let fast = Box::new(
-                    p.without_fold_test_against_kept(&f2, &m, false)
-                        .expect("indexed")
-                        .clone(),
-                );
-                let slow = p
-                    .without_fold_test_against_kept(&f2, &m, true)
-                    .expect("reference");
-                for (bk, (x, y)) in fast.boundaries().iter().zip(slow.boundaries()).enumerate() {
-                    assert_eq!(x.points().len(), y.points().len());
-                    for (i, (a, b)) in x.points().iter().zip(y.points()).enumerate() {
-                        assert!(
-                            a == b,
-                            "{} {seed} {}: boundary {bk} point {i}: indexed {a:?}, reference {b:?}",
-                            f.name(),
-                            v.name()
-                        );
-                        points += 1;
-                        ok += usize::from(a.status() == Status::Ok);
-                    }
-                }
-            }
-        }
-    }
+    each_pair(|p, f2, m, what| {
+        let fast = Box::new(
+            p.without_fold_test_against_kept(f2, m, false)
+                .expect("indexed")
+                .clone(),
+        );
+        let slow = p
+            .without_fold_test_against_kept(f2, m, true)
+            .expect("reference");
+        let (n, k) = assert_indexed_is_reference(&fast, slow, what);
+        points += n;
+        ok += k;
+    });
     println!("{points} points equal, {ok} of them ok");
     assert!(
         points > 100_000 && ok > points / 3,

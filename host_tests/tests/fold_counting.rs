@@ -24,19 +24,6 @@ fn statuses(s: &Structure<N, B>) -> Vec<Status> {
         .collect()
 }
 
-/// A clock that says yes from its `k`-th question on.
-struct Clock {
-    k: usize,
-    asked: usize,
-}
-
-impl roadstereo::Deadline for Clock {
-    fn expired(&mut self) -> bool {
-        self.asked += 1;
-        self.asked > self.k
-    }
-}
-
 /// The points the rule gives back are searched on their own: the rest of
 /// the boundary keeps its results. (The rule's first form searched the
 /// whole boundary again, which took the finished `no_intersection`
@@ -73,16 +60,22 @@ fn the_points_given_back_are_searched_alone() {
             assert_eq!(a, b, "point {i}: {a:?} without the rule, {b:?} with it");
         }
     }
-    let mut never = Clock {
-        k: usize::MAX,
-        asked: 0,
+    // Clocks that count their questions and say yes from the `k`-th on.
+    let mut asked = 0usize;
+    let mut never = || {
+        asked += 1;
+        false
     };
     let uncut = statuses(
         p.process_against_kept_within(&f2, &motion, &mut never)
             .expect("kept"),
     );
-    for k in 0..=never.asked {
-        let mut clock = Clock { k, asked: 0 };
+    for k in 0..=asked {
+        let mut n = 0usize;
+        let mut clock = || {
+            n += 1;
+            n > k
+        };
         let cut = statuses(
             p.process_against_kept_within(&f2, &motion, &mut clock)
                 .expect("kept"),

@@ -256,7 +256,7 @@ fn fusion_counted(fusion: &mut Fusion<256, 2, 512>) -> bool {
 
 /// The limit of the demo drive's steps within a deadline, instructions:
 /// the deadline (277 200) less the lateness README quotes (40 000, the
-/// bench's hard budget for it: 34 566 measured where it is worst, at
+/// bench's hard budget for it: 34 570 measured where it is worst, at
 /// 2 × 512) and the fusion's own work after the matching, which the
 /// deadline does not cut (at most 24 516 on this drive, in a frame where
 /// a key frame retires), rounded down.

@@ -117,6 +117,17 @@ impl<const N: usize> Index<N> {
     #[inline(never)]
     fn rebuild(&mut self, orient: f32, wide: f32, tick: &mut Tick<'_>, defer: bool) -> bool {
         let s = self.segments;
+        // Periodic keys: a turn lost across a spike, taken back (the
+        // orientation then from the keys as they are after it).
+        let (orient, turned) = if self.period > 0.0 {
+            match self.turns_back(tick) {
+                None => return false,
+                Some(Some(falls)) => (if falls { -self.orient } else { self.orient }, true),
+                Some(None) => (orient, false),
+            }
+        } else {
+            (orient, false)
+        };
         let Some(seg) = self.seg.get_mut(..s) else {
             return true;
         };
@@ -147,7 +158,7 @@ impl<const N: usize> Index<N> {
         // Over `enumerate().skip(from)` instead of the slice from `from`
         // the bench firmware measured dearer, `worst_found` +2.7 %.)
         let from = match aside.first() {
-            _ if flip => 0,
+            _ if flip || turned => 0,
             Some(&(j, _, _)) => usize::from(j),
             None => s,
         };
@@ -183,6 +194,127 @@ impl<const N: usize> Index<N> {
             return true;
         }
         !loose || self.build_tree(tick)
+    }
+
+    /// Periodic keys (pseudo-angles, period 4): take back a turn lost
+    /// across a spike. The pushes unwrap each key within half a turn of
+    /// the one before ([`Builder::push_stored`]); a spurious detector point
+    /// out past the FOE and back makes two segments of about half a turn
+    /// each, and where the two go the same way round the keys after them
+    /// lie a whole turn off those before, folded over them: the index is
+    /// loose, its orientation, from a first and a last key a turn apart,
+    /// often the wrong one, and every query's run the whole boundary (the
+    /// `fwd_spiral` member's fold queries, about 33 units each at
+    /// N = 512). Here a segment after a stretch of wide ones (a quarter
+    /// turn or more, or without keys) whose middle lies more than three
+    /// quarters of a turn from the middle of the last narrow segment before
+    /// the stretch moves, with every segment after it, by the whole turn
+    /// that brings it nearer that one. A boundary that passes the FOE
+    /// turns by about half a turn there and is left as it is; one whose
+    /// first and last narrow segments lie within three quarters of a turn
+    /// is left without the pass.
+    ///
+    /// Any turns are as good for a segment (a query meets every copy of
+    /// its key within the keys' range, [`Index::copies`]); each end moved
+    /// is widened by more than its rounding (`2⁻²⁴` of the result), so the
+    /// interval still holds the one it was moved from. `Some(Some(falls))`
+    /// when segments moved, `falls` whether the keys then fall overall
+    /// (from the first narrow segment's middle to the last's); `Some(None)`
+    /// when none did; `None` when `tick`'s clock stopped the pass (the
+    /// index is then unfit for queries).
+    #[inline(never)]
+    fn turns_back(&mut self, tick: &mut Tick<'_>) -> Option<Option<bool>> {
+        let s = self.segments;
+        let seg = self.seg.get_mut(..s).unwrap_or_default();
+        // The middles of the first and the last narrow segment (moved),
+        // whether wide ones followed the last; the turn to add from `at`.
+        let (mut first, mut last, mut gap) = (f32::NAN, f32::NAN, false);
+        let (mut shift, mut at) = (0.0f32, s);
+        // (A middle is NaN where a segment has no keys, `(−∞, ∞)`, or is
+        // empty, `(∞, −∞)`: not narrow.)
+        let narrow = |g: &Seg| {
+            let mid = 0.5 * (g.lo + g.hi);
+            (g.hi - g.lo < 1.0 && mid.is_finite()).then_some(mid)
+        };
+        // Where the first and the last narrow segment (among the first and
+        // the last `CHUNK`) are within three quarters of a turn, no turn is
+        // taken back: a lost one shows there (unless another made up for
+        // it), and a boundary passing the FOE does not.
+        let head = seg.get(..CHUNK).unwrap_or(seg);
+        let tail = seg.get(s.saturating_sub(CHUNK)..).unwrap_or(seg);
+        if let (Some(a), Some(b)) = (
+            head.iter().find_map(narrow),
+            tail.iter().rev().find_map(narrow),
+        ) {
+            if (b - a).abs() <= 3.0 {
+                return Some(None);
+            }
+        }
+        // Then, only where a turn is lost (most boundaries: nowhere), and
+        // the stretch of wide segments before it (from `from`).
+        let mut from = s;
+        for (j, g) in seg.iter().enumerate() {
+            if j % CHUNK == CHUNK - 1 && expired(tick) {
+                return None;
+            }
+            let mid = narrow(g);
+            if let Some(mid) = mid {
+                let d = mid - last;
+                if gap && d.abs() > 3.0 {
+                    (shift, at) = (if d > 0.0 { -4.0 } else { 4.0 }, j);
+                    break;
+                }
+                (last, from) = (mid, j + 1);
+                if first.is_nan() {
+                    first = mid;
+                }
+            }
+            gap = mid.is_none() && !last.is_nan();
+        }
+        // The stretch's wide segments each the way round whose middle is
+        // nearer the middle between the narrow ones about it.
+        let about = seg
+            .get(at)
+            .and_then(narrow)
+            .map_or(f32::NAN, |m| 0.5 * (last + m + shift));
+        let stretch = seg.get_mut(from.min(at)..at).unwrap_or_default();
+        for (j, g) in (from..).zip(stretch.iter_mut()) {
+            if j % CHUNK == CHUNK - 1 && expired(tick) {
+                return None;
+            }
+            let mid = 0.5 * (g.lo + g.hi);
+            if g.lo.is_finite()
+                && g.hi.is_finite()
+                && (mid + shift - about).abs() < (mid - about).abs()
+            {
+                let (lo, hi) = (g.lo + shift, g.hi + shift);
+                (g.lo, g.hi) = (lo - lo.abs() * 2.4e-7, hi + hi.abs() * 2.4e-7);
+            }
+        }
+        // And every segment from there moved, a turn more after each
+        // stretch where another is lost.
+        let rest = seg.get_mut(at..).unwrap_or_default();
+        for (j, g) in (at..).zip(rest.iter_mut()) {
+            if j % CHUNK == CHUNK - 1 && expired(tick) {
+                return None;
+            }
+            let mid = narrow(g);
+            if let Some(mid) = mid {
+                let d = mid + shift - last;
+                if gap && d.abs() > 3.0 {
+                    shift -= if d > 0.0 { 4.0 } else { -4.0 };
+                }
+            }
+            if shift != 0.0 && g.lo.is_finite() && g.hi.is_finite() {
+                let (lo, hi) = (g.lo + shift, g.hi + shift);
+                (g.lo, g.hi) = (lo - lo.abs() * 2.4e-7, hi + hi.abs() * 2.4e-7);
+            }
+            if mid.is_some() {
+                last = 0.5 * (g.lo + g.hi);
+            }
+            gap = mid.is_none() && !last.is_nan();
+        }
+        Some((at < s).then_some(last < first))
     }
 
     /// The block tree over the current intervals (module docs): the key

@@ -28,7 +28,7 @@
 //! half-plane keys), with `d = p₁' − F`, `R = |d|²`, `X = d·(x − F)` the
 //! place of `x` along the ray and `n = ρ₁ (r₁ + e₂)` (the band's reach
 //! towards `F` in `X`, [`crate::wedge`]), after the boundary's search
-//! (`counted_search` in [`crate::processor`], which computes step 1's
+//! (`counted_search` in `src/processor/counted.rs`, which computes step 1's
 //! values of the boundary again, the same arithmetic, and builds the fold
 //! test's index and then frame 2's again):
 //!

@@ -34,7 +34,7 @@ use reference::{match_wedge_angular_reference, match_wedge_reference};
 /// with the loop inside: the frame's constants stay in registers.)
 /// With `counting` (the counting rule, [`super::Processor::set_fold_counting`];
 /// `checking` the tests' switch of the loops' forms) the points the rule
-/// gives back are searched afterwards ([`super::counted_search`]).
+/// gives back are searched afterwards ([`super::counted::counted_search`]).
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 pub(super) fn match_boundary<const N: usize, D: Deadline>(
@@ -57,7 +57,7 @@ pub(super) fn match_boundary<const N: usize, D: Deadline>(
         matcher,
     );
     if counting {
-        super::counted_search(
+        super::counted::counted_search(
             (pair, keying),
             (slots, b2),
             index,

@@ -879,3 +879,96 @@ fn half_turn_spikes_keep_every_query_and_fold() {
     // The pass moved segments in most builds (4 869 of 6 000).
     assert!(moved > 3000, "{moved}");
 }
+
+/// Two findings of a review of [`Index::turns_back`], whose first form
+/// moved a turn at every stretch that looked like a lost one. Keys whose
+/// stretches each did (down about 3.1 turns' quarters, then up 2.9) piled
+/// the turns up, a turn more a cycle, past the copies a query handles:
+/// the fold test answered "folds" for every vertex (here `folds(0, …)`
+/// where the brute force says no). Now at most one turn moves, and only
+/// within the keys' range the copies handle: the fold test is the brute
+/// force again.
+#[test]
+fn turns_taken_back_do_not_pile_up() {
+    let raw = [
+        0.30, 0.31, NO_KEY, 2.76, NO_KEY, 1.21, 1.22, NO_KEY, 2.67, NO_KEY, 0.12, 0.13, NO_KEY,
+        2.58, NO_KEY, 1.03, 1.04, NO_KEY, 2.49, NO_KEY, 3.94, 3.95, NO_KEY, 2.40, NO_KEY, 0.85,
+        0.86, NO_KEY, 2.31, NO_KEY, 3.76, 3.77, NO_KEY, 2.22, NO_KEY, 0.67, 0.68,
+    ];
+    let ks: Vec<(f32, f32)> = raw
+        .iter()
+        .map(|&k| (k, if k.is_finite() { 1.0e-4 } else { 0.0 }))
+        .collect();
+    let ivs = intervals(&ks, true);
+    let mut index = Index::<CAP>::new();
+    for guess in [1.0, -1.0] {
+        let mut b = index.builder((4.0, guess), Unkeyed::MeetNone);
+        b.push_all(ks.iter().copied());
+        assert!(b.finish(None, &mut None));
+        assert!(
+            index.kmax - index.kmin < 8.0,
+            "{guess}: {} {}",
+            index.kmin,
+            index.kmax
+        );
+        for (i, &(k, e)) in ks.iter().enumerate() {
+            if !k.is_finite() {
+                continue;
+            }
+            let brute = ivs.iter().enumerate().any(|(j, iv)| {
+                let outside = j + 4 < i || j > i + 3;
+                outside && iv.is_some_and(|iv| meets(iv, (k - e, k + e), true))
+            });
+            let mut work = Work::new();
+            work.grant(u32::MAX);
+            assert_eq!(
+                index.folds(i, k, 4, &mut work),
+                Ok(brute),
+                "{guess}: vertex {i}"
+            );
+        }
+    }
+}
+
+/// The review's second finding: a boundary that really winds 0.8 turn
+/// past the FOE (radial keys from 0.5 to 0.6, one vertex 1.55 on, radial
+/// keys from 3.65 to 3.75) is monotone as the pushes leave it; the first
+/// form moved its tail a turn under its head, and every query then ran
+/// the tail (32.6 units a vertex at 61 vertices, 122.6 at 241, against 2).
+/// It is left as it is.
+#[test]
+fn a_real_winding_past_the_foe_is_left_as_it_is() {
+    let n = 40;
+    let mut ks: Vec<(f32, f32)> = (0..n)
+        .map(|i| (0.5 + 0.1 * i as f32 / n as f32, 1.0e-4))
+        .collect();
+    ks.push((0.6 + 1.55, 1.0e-4));
+    ks.extend((0..n).map(|i| (3.65 + 0.1 * i as f32 / n as f32, 1.0e-4)));
+    let mut index = Index::<CAP>::new();
+    for unkeyed in [Unkeyed::MeetAll, Unkeyed::MeetNone] {
+        let mut b = index.builder((4.0, 1.0), unkeyed);
+        b.push_all(ks.iter().copied());
+        assert!(b.finish(None, &mut None));
+        let mut units = 0u64;
+        for (i, &(k, e)) in ks.iter().enumerate() {
+            let mut rec = Record {
+                seen: [false; CAP],
+                last: None,
+                ordered: true,
+            };
+            let mut work = Work::new();
+            work.grant(u32::MAX);
+            assert!(index
+                .visit(Query::Keys(k - e, k + e), false, None, &mut work, &mut rec)
+                .is_ok());
+            units += u64::from(u32::MAX - work.credit);
+            if unkeyed == Unkeyed::MeetNone {
+                let mut work = Work::new();
+                work.grant(u32::MAX);
+                assert_eq!(index.folds(i, k, 4, &mut work), Ok(false), "vertex {i}");
+            }
+        }
+        let per = units as f64 / ks.len() as f64;
+        assert!(per <= 6.0, "{unkeyed:?}: {per:.1} units a vertex");
+    }
+}

@@ -4,6 +4,7 @@
 use super::*;
 use crate::test_rng::Rng;
 extern crate std;
+use std::format;
 use std::vec::Vec;
 
 pub(crate) const CAP: usize = 96;
@@ -115,6 +116,23 @@ impl Visitor<'_> for Record {
     }
 }
 
+/// The segments a query of keys `q` is offered (with every unit granted),
+/// checked to come in increasing order, and the units it spent.
+fn offered(index: &mut Index<CAP>, q: (f32, f32), what: &str) -> (Record, u32) {
+    let mut rec = Record {
+        seen: [false; CAP],
+        last: None,
+        ordered: true,
+    };
+    let mut work = Work::new();
+    work.grant(u32::MAX);
+    assert!(index
+        .visit(Query::Keys(q.0, q.1), false, None, &mut work, &mut rec)
+        .is_ok());
+    assert!(rec.ordered, "{what}: out of order");
+    (rec, u32::MAX - work.credit)
+}
+
 #[derive(Clone, Copy)]
 struct Count(usize, usize);
 impl Visitor<'_> for Count {
@@ -172,17 +190,7 @@ fn visit_offers_every_segment_that_meets_the_query() {
             };
             let w = 0.2 * rng.next() * rng.next();
             let q = (c - w, c + w);
-            let mut rec = Record {
-                seen: [false; CAP],
-                last: None,
-                ordered: true,
-            };
-            let mut work = Work::new();
-            work.grant(u32::MAX);
-            assert!(index
-                .visit(Query::Keys(q.0, q.1), false, None, &mut work, &mut rec)
-                .is_ok());
-            assert!(rec.ordered, "case {case}: out of order");
+            let (rec, _) = offered(&mut index, q, &format!("case {case}"));
             for (j, iv) in ivs.iter().enumerate() {
                 let must = iv.is_none_or(|iv| meets(iv, q, period));
                 assert!(
@@ -753,17 +761,7 @@ fn half_turn_spikes_keep_every_query_and_fold() {
                 let c = 4.0 * rng.next();
                 let w = 0.2 * rng.next() * rng.next();
                 let q = (c - w, c + w);
-                let mut rec = Record {
-                    seen: [false; CAP],
-                    last: None,
-                    ordered: true,
-                };
-                let mut work = Work::new();
-                work.grant(u32::MAX);
-                assert!(index
-                    .visit(Query::Keys(q.0, q.1), false, None, &mut work, &mut rec)
-                    .is_ok());
-                assert!(rec.ordered, "case {case}: out of order");
+                let (rec, _) = offered(&mut index, q, &format!("case {case}"));
                 for (j, iv) in ivs.iter().enumerate() {
                     let must =
                         unkeyed == Unkeyed::MeetAll && iv.is_none_or(|iv| meets(iv, q, true));
@@ -774,22 +772,7 @@ fn half_turn_spikes_keep_every_query_and_fold() {
                 }
             }
             if unkeyed == Unkeyed::MeetNone {
-                for (i, &(k, e)) in ks.iter().enumerate() {
-                    if !k.is_finite() {
-                        continue;
-                    }
-                    let brute = ivs.iter().enumerate().any(|(j, iv)| {
-                        let outside = j + 4 < i || j > i + 3;
-                        outside && iv.is_some_and(|iv| meets(iv, (k - e, k + e), true))
-                    });
-                    let mut work = Work::new();
-                    work.grant(u32::MAX);
-                    assert_eq!(
-                        index.folds(i, k, 4, &mut work),
-                        Ok(brute),
-                        "case {case} vertex {i}"
-                    );
-                }
+                assert_folds_are_brute(&mut index, &ks, &ivs, &format!("case {case}"));
             }
         }
     }
@@ -827,22 +810,33 @@ fn turns_taken_back_do_not_pile_up() {
             index.kmin,
             index.kmax
         );
-        for (i, &(k, e)) in ks.iter().enumerate() {
-            if !k.is_finite() {
-                continue;
-            }
-            let brute = ivs.iter().enumerate().any(|(j, iv)| {
-                let outside = j + 4 < i || j > i + 3;
-                outside && iv.is_some_and(|iv| meets(iv, (k - e, k + e), true))
-            });
-            let mut work = Work::new();
-            work.grant(u32::MAX);
-            assert_eq!(
-                index.folds(i, k, 4, &mut work),
-                Ok(brute),
-                "{guess}: vertex {i}"
-            );
+        assert_folds_are_brute(&mut index, &ks, &ivs, &format!("guess {guess}"));
+    }
+}
+
+/// Every keyed vertex's fold test (window 4) against the brute force over
+/// the pushes' intervals `ivs` of periodic keys `ks`.
+fn assert_folds_are_brute(
+    index: &mut Index<CAP>,
+    ks: &[(f32, f32)],
+    ivs: &[Option<(f32, f32)>],
+    what: &str,
+) {
+    for (i, &(k, e)) in ks.iter().enumerate() {
+        if !k.is_finite() {
+            continue;
         }
+        let brute = ivs.iter().enumerate().any(|(j, iv)| {
+            let outside = j + 4 < i || j > i + 3;
+            outside && iv.is_some_and(|iv| meets(iv, (k - e, k + e), true))
+        });
+        let mut work = Work::new();
+        work.grant(u32::MAX);
+        assert_eq!(
+            index.folds(i, k, 4, &mut work),
+            Ok(brute),
+            "{what}: vertex {i}"
+        );
     }
 }
 
@@ -866,17 +860,7 @@ fn a_real_winding_past_the_foe_is_left_as_it_is() {
         assert!(b.finish(None, &mut None));
         let mut units = 0u64;
         for (i, &(k, e)) in ks.iter().enumerate() {
-            let mut rec = Record {
-                seen: [false; CAP],
-                last: None,
-                ordered: true,
-            };
-            let mut work = Work::new();
-            work.grant(u32::MAX);
-            assert!(index
-                .visit(Query::Keys(k - e, k + e), false, None, &mut work, &mut rec)
-                .is_ok());
-            units += u64::from(u32::MAX - work.credit);
+            units += u64::from(offered(&mut index, (k - e, k + e), "winding").1);
             if unkeyed == Unkeyed::MeetNone {
                 let mut work = Work::new();
                 work.grant(u32::MAX);

@@ -365,7 +365,8 @@ fn radius(rho: f32, phi: f32, lat: f32, e: &Entry, zf: f32) -> f32 {
 }
 
 /// The fixed-capacity road map: up to `M` points on each of `B`
-/// boundaries (module docs).
+/// boundaries (module docs). `0 < M < 65535` (16-bit slots): another `M`
+/// fails to compile (`evaluation panicked: 0 < M < 65535`).
 #[derive(Debug, Clone)]
 pub struct RoadMap<const B: usize, const M: usize> {
     entries: [[Entry; M]; B],

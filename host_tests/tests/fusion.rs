@@ -1093,6 +1093,80 @@ fn the_map_radius_covers_the_key_frames_localisation_error() {
     assert!(checked >= 6, "{checked} map points");
 }
 
+/// `Fusion::key_point` (an integrator's review: the fused intervals had
+/// no pixel or ray to put them in 3-D): over random drives of every
+/// family, after every step, each key-frame point's pixel is the one the
+/// key frame was given, its fusion is `key().point`'s, and for every
+/// consistent point the true 3-D point (the generator's, `f64`) lies
+/// between the stick's depths and within `e₁` of its ray (the true
+/// pixel is within `e₁` of the detected one); right after a step that
+/// retired a key frame there is none (the retired frame is no longer
+/// kept), and after the next step there is again.
+#[test]
+fn key_points_put_the_fused_intervals_in_3d() {
+    let (mut checked, mut after_retire) = (0usize, 0usize);
+    for family in DriveFamily::ALL {
+        let (ds, _) = drives(family, 3, FRAMES);
+        for (seed, d) in &ds {
+            let input = d.input(Noise::Disc, None, *seed);
+            let k = d.spec.intrinsics;
+            let mut retired_before = false;
+            run(d, &input, FusionConfig::DEFAULT, |j, step, f| {
+                let Some(key) = f.key() else {
+                    assert!(f.key_point(0, 0).is_none());
+                    return;
+                };
+                let kid = key.id() as usize;
+                if step.retired.is_some() {
+                    assert!(f.key_point(0, 0).is_none(), "frame {j}: a retired key frame's point");
+                    after_retire += 1;
+                    retired_before = true;
+                    return;
+                }
+                if retired_before && key.len(0) > 0 {
+                    assert!(f.key_point(0, 0).is_some(), "frame {j}: the new key frame's point");
+                }
+                retired_before = false;
+                for b in 0..B {
+                    assert!(f.key_point(b, key.len(b)).is_none());
+                    for i in 0..key.len(b) {
+                        let p = f.key_point(b, i).expect("a key-frame point");
+                        assert_eq!(p.pixel, input.frames[kid][b][i], "frame {j} ({b}, {i})");
+                        assert_eq!(Some(p.fused), key.point(b, i));
+                        if p.fused.status != FusedStatus::Consistent {
+                            continue;
+                        }
+                        let (near, far) = p.stick().expect("a consistent point's stick");
+                        let t = d.frames[kid].boundaries[b][i].camera;
+                        let z = t[2];
+                        assert!(
+                            f64::from(near[2]) <= z && z <= f64::from(far[2]),
+                            "frame {j} ({b}, {i}): depth {z} outside [{}, {}]",
+                            near[2],
+                            far[2]
+                        );
+                        // The truth's normalised position against the ray's:
+                        // within e₁ pixels (and f32 rounding).
+                        let (du, dv) = (
+                            (t[0] / z - f64::from(p.ray[0])) * k.fx,
+                            (t[1] / z - f64::from(p.ray[1])) * k.fy,
+                        );
+                        assert!(
+                            du.hypot(dv) <= input.e1 + 1e-3,
+                            "frame {j} ({b}, {i}): the truth {du}, {dv} px off the ray"
+                        );
+                        assert!((f64::from(p.ray[2]) - 1.0).abs() == 0.0);
+                        checked += 1;
+                    }
+                }
+            });
+        }
+    }
+    println!("key_point: {checked} consistent points checked in 3-D, {after_retire} steps right after a retirement");
+    assert!(checked > 10_000, "{checked}");
+    assert!(after_retire > 20, "{after_retire}");
+}
+
 /// The limit of the consistency check, pinned (`docs/FUSION.md`, "Limits"; found by
 /// an adversarial review, reduced from its crest family): every pair's
 /// stick is guaranteed only where the point's true correspondent is in

@@ -205,6 +205,8 @@ fn main() -> ! {
                 black_box(p);
             }
         }
+        let kp = fusion.key_point(black_box(1), black_box(7));
+        black_box((kp, kp.and_then(|p| p.stick())));
         let map = fusion.map();
         for p in map.points(black_box(0)) {
             black_box(p);

@@ -51,6 +51,7 @@ use crate::structure::{PointResult, Status, Structure};
 /// What the fusion knows about a key-frame point.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum FusedStatus {
     /// No pair has given the point an interval yet.
     Unmatched,
@@ -87,6 +88,12 @@ impl FusedStatus {
     }
 }
 
+impl core::fmt::Display for FusedStatus {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// One key-frame point's fusion.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -103,6 +110,38 @@ pub struct FusedPoint {
     pub pairs: u8,
     /// Of those, the ones whose interval misses the one given.
     pub disagreeing: u8,
+}
+
+/// A key-frame point in 3-D ([`crate::fusion::Fusion::key_point`]): its
+/// detected pixel, its ray and its fusion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct KeyPoint {
+    /// The detected pixel in the key frame.
+    pub pixel: crate::camera::Pixel,
+    /// The detected pixel's ray `(x, y, 1)` in key-frame camera
+    /// coordinates (normalised: [`crate::Camera::normalise`]): depth `z` is
+    /// the point `z · ray`, as [`crate::Structure::point`] makes a pair's.
+    /// The true point lies on a ray through a pixel within `e₁` of the
+    /// detected one ([`crate::Config::e1`]).
+    pub ray: [f32; 3],
+    /// The point's fusion.
+    pub fused: FusedPoint,
+}
+
+impl KeyPoint {
+    /// The fused interval's ends (near, far) on the ray, in key-frame
+    /// camera coordinates, if the point has an interval (an inconsistent
+    /// point's is the majority's, whose far end may be infinite:
+    /// [`FusedPoint::interval`]).
+    pub fn stick(&self) -> Option<([f32; 3], [f32; 3])> {
+        let i = self.fused.interval?;
+        let [x, y, _] = self.ray;
+        Some((
+            [x * i.z_near, y * i.z_near, i.z_near],
+            [x * i.z_far, y * i.z_far, i.z_far],
+        ))
+    }
 }
 
 /// What one interval did to a point.

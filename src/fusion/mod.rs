@@ -88,7 +88,7 @@ mod key;
 use core::fmt;
 
 pub(crate) use chain::{norm1, Chain, StepBounds, STEP_ROUNDING};
-pub use key::{FusedCounts, FusedPoint, FusedStatus, KeyFrame, PairFused};
+pub use key::{FusedCounts, FusedPoint, FusedStatus, KeyFrame, KeyPoint, PairFused};
 
 use crate::boundary::Frame;
 use crate::config::Config;
@@ -163,7 +163,10 @@ impl FusionConfig {
     /// frame) is its `max_partners`-th (1 to [`MAX_PARTNERS`]), or the
     /// frame after a pair that matched fewer than `keep_permille` ‰ of the
     /// most points a pair of it matched (0 switches the share rule off),
-    /// whichever comes first. A frame without points cannot become a key
+    /// whichever comes first. The map then admits points with 2 agreeing
+    /// pairs or more ([`FusionConfig::with_map_min_pairs`]: with
+    /// `max_partners` 1, set it to 1 or add range constraints, or the map
+    /// stays empty). A frame without points cannot become a key
     /// frame: while the last partner is due, such frames are paired too
     /// and the switch waits for the next frame with points (module docs,
     /// "Key-frame policy"), so a key frame has more than `max_partners`
@@ -207,7 +210,14 @@ impl FusionConfig {
 
     /// The same policy with points entering the map only with at least
     /// `pairs` agreeing pairs, 1 to 64 (1 admits [`FusedStatus::Single`]
-    /// points, which nothing has checked).
+    /// points, which nothing has checked; 2 is [`FusionConfig::new`]'s).
+    /// Partners and range constraints ([`Fusion::constrain`]) count, and a
+    /// key frame has at most `max_partners` partners with points: with
+    /// `pairs` above `max_partners` (`new(1, …)` keeps 2) only constraints
+    /// can bring a point in, and without them the map stays empty (every
+    /// retirement counts its points in [`crate::map::Retired::unverified`]).
+    /// Not an error, as constraints may be part of the plan; check
+    /// `map_min_pairs() <= max_partners()` if they are not.
     pub const fn with_map_min_pairs(mut self, pairs: u8) -> Result<Self, FusionConfigError> {
         if pairs == 0 || pairs > 64 {
             return Err(FusionConfigError::MinPairs);
@@ -292,6 +302,7 @@ impl fmt::Display for FusionError {
 /// Why a key frame started.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum KeyReason {
     /// There was no key frame (the first frame with points).
     First,
@@ -322,7 +333,7 @@ pub struct FusionStep {
 
 /// The key-frame fusion and its road map, around the per-frame processor
 /// (module docs). `N`, `B` as for [`Processor`]; `M` points per boundary in
-/// the map.
+/// the map, `0 < M < 65535` (checked at compile time: [`RoadMap`]).
 #[derive(Debug, Clone)]
 pub struct Fusion<const N: usize, const B: usize, const M: usize> {
     processor: Processor<N, B>,
@@ -721,6 +732,60 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// made of every point.
     pub fn key(&self) -> Option<&KeyFrame<N, B>> {
         self.has_key.then_some(&self.key)
+    }
+
+    /// Point `index` of key-frame boundary `boundary` with its pixel and
+    /// ray, so its fused interval can be put in 3-D ([`KeyPoint::stick`]:
+    /// key-frame camera coordinates). The key frame's pixels are the
+    /// processor's kept frame, so this is `None` right after a step that
+    /// retired a key frame and until the next step or
+    /// [`Fusion::constrain`]: [`Fusion::key`] then shows the retired key
+    /// frame, whose frame the processor no longer keeps (its admitted
+    /// points are in the map, in 3-D: [`RoadMap::points`]). `None` also
+    /// without a key frame or such a point.
+    ///
+    /// ```
+    /// use roadstereo::fusion::{ChainedMotion, Fusion, FusionConfig};
+    /// use roadstereo::{Camera, Config, Frame, Motion, Pixel};
+    /// let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).unwrap();
+    /// let mut fusion = Fusion::<64, 1, 128>::new(Config::DEFAULT, FusionConfig::DEFAULT);
+    /// // A straight edge 1 below and 1 left of the camera, depths 5 to 16,
+    /// // after `n` steps of 0.25 forward and 0.05 right.
+    /// let edge = |n: f32| {
+    ///     let mut f = Frame::new(cam);
+    ///     let mut pts = [Pixel::default(); 12];
+    ///     for (i, p) in pts.iter_mut().enumerate() {
+    ///         let (x, z) = (-1.0 - 0.05 * n, 5.0 + i as f32 - 0.25 * n);
+    ///         *p = Pixel::new(255.5 + 800.0 * x / z, 239.5 + 800.0 / z);
+    ///     }
+    ///     f.push_boundary(&pts).unwrap();
+    ///     f
+    /// };
+    /// fusion.step(0, &edge(0.0), None).unwrap();
+    /// let step = Motion::new([0.05, 0.0, 0.25], [0.0; 3]).unwrap();
+    /// for id in 1..=3 {
+    ///     let m = ChainedMotion { from: id - 1, motion: step };
+    ///     fusion.step(id, &edge(id as f32), Some(&m)).unwrap();
+    /// }
+    /// // Point 4 is at (-1, 1, 9) in the key frame's camera coordinates.
+    /// let p = fusion.key_point(0, 4).unwrap();
+    /// let (near, far) = p.stick().unwrap();
+    /// assert!(near[2] <= 9.0 && 9.0 <= far[2]);
+    /// assert!((near[0] / near[2] + 1.0 / 9.0).abs() < 1e-3);
+    /// ```
+    pub fn key_point(&self, boundary: usize, index: usize) -> Option<KeyPoint> {
+        if !self.has_key || self.pending.is_some() {
+            return None;
+        }
+        let frame = self.processor.previous()?;
+        let pixel = *frame.boundaries().get(boundary)?.points().get(index)?;
+        let fused = self.key.point(boundary, index)?;
+        let [x, y] = frame.camera().normalise(pixel);
+        Some(KeyPoint {
+            pixel,
+            ray: [x, y, 1.0],
+            fused,
+        })
     }
 
     /// The road map.

@@ -29,6 +29,7 @@ pub const SPI_HEADER_LEN: usize = 4;
 pub const SPI_CHUNK: usize = 64;
 
 /// The SPI link driver.
+#[derive(Debug)]
 pub struct SpiLink<SPI, DR> {
     spi: SPI,
     ready: DR,

@@ -11,6 +11,7 @@ use crate::wire::{Event, Receiver};
 pub const UART_CHUNK: usize = 64;
 
 /// The UART link driver.
+#[derive(Debug)]
 pub struct UartLink<IO> {
     io: IO,
     chunk: [u8; UART_CHUNK],

@@ -377,6 +377,22 @@ pub struct Decoder<const N: usize, const B: usize> {
     step: i32,
 }
 
+/// A summary (the frame buffer being filled is kilobytes): the data ids,
+/// where the decoder is in a packet, the camera and the motion it holds.
+impl<const N: usize, const B: usize> core::fmt::Debug for Decoder<N, B> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Decoder")
+            .field("ids", &self.ids)
+            .field("state", &self.state)
+            .field("packet_type", &self.ptype)
+            .field("bytes_in_packet", &self.pos)
+            .field("camera", &self.camera)
+            .field("motion", &self.motion)
+            .field("boundaries_done", &self.boundary)
+            .finish_non_exhaustive()
+    }
+}
+
 impl<const N: usize, const B: usize> Decoder<N, B> {
     /// A decoder that takes packets with the data ids `ids`, with no camera
     /// yet (frames need a camera packet first).

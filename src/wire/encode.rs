@@ -133,6 +133,16 @@ pub struct FramePacket<'a> {
     count: u8,
 }
 
+impl core::fmt::Debug for FramePacket<'_> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("FramePacket")
+            .field("written", &self.w.at)
+            .field("capacity", &self.w.buf.len())
+            .field("boundaries", &self.count)
+            .finish()
+    }
+}
+
 impl<'a> FramePacket<'a> {
     /// Start a frame packet in `out`.
     pub fn begin(

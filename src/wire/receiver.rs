@@ -157,6 +157,20 @@ pub struct Receiver<const N: usize, const B: usize> {
     counters: Counters,
 }
 
+/// A summary (the decoder's frame buffer is kilobytes): the decoder's,
+/// the configuration, whether a motion and a frame are kept, the counters.
+impl<const N: usize, const B: usize> core::fmt::Debug for Receiver<N, B> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Receiver")
+            .field("decoder", &self.decoder)
+            .field("base", &self.base)
+            .field("motion", &self.motion)
+            .field("kept_frame", &self.kept.is_some())
+            .field("counters", &self.counters)
+            .finish()
+    }
+}
+
 impl<const N: usize, const B: usize> Receiver<N, B> {
     /// A receiver for packets with the data ids `ids`, building each
     /// pair's configuration from `base`.

@@ -24,6 +24,7 @@ fn le32(b: &[u8], at: usize) -> u32 {
 
 /// A checked packet: its type, data id, counter and payload.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Checked<'a> {
     /// Type.
     pub ptype: PacketType,
@@ -99,6 +100,7 @@ pub fn report(payload: &[u8]) -> Option<Report> {
 
 /// One point of a result.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PointView {
     /// Its status.
     pub status: Status,
@@ -108,6 +110,7 @@ pub struct PointView {
 
 /// One boundary of a result.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct ResultBoundary<'a> {
     /// Points.
     pub len: u16,
@@ -139,6 +142,7 @@ impl ResultBoundary<'_> {
 
 /// A parsed result packet.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct ResultView<'a> {
     /// The frame (frame 2 of the pair).
     pub frame_id: u32,

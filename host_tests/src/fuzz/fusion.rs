@@ -695,6 +695,9 @@ fn check_point(p: &roadstereo::fusion::FusedPoint, at: &str) {
         FusedStatus::Inconsistent => {
             assert!(p.interval.is_some() && p.disagreeing >= 1, "{at}: {p:?}");
         }
+        // (`FusedStatus` is `#[non_exhaustive]`: a status added later must
+        // be given its check here.)
+        other => panic!("{at}: a status this check does not know: {other:?}"),
     }
     if let Some(iv) = p.interval {
         // An inconsistent point's majority may be a coded interval whose

@@ -43,7 +43,9 @@
 use core::fmt;
 
 use super::code::DepthScale;
+use super::sight::Sight;
 use crate::boundary::Frame;
+use crate::camera::Pixel;
 use crate::depth::DepthInterval;
 use crate::math::{fmax, fmin};
 use crate::structure::{PointResult, Status, Structure};
@@ -69,12 +71,20 @@ pub enum FusedStatus {
     /// interval given is the one most pairs agree on (module docs), not a
     /// guarantee.
     Inconsistent,
+    /// The pairs agree, but some partner was not shown to see the point's
+    /// ray over every depth the pairs allow (it left that partner's image,
+    /// or its boundary's rows): that partner's match may be of another
+    /// stretch, inside a wider right stick, and their intersection wrong
+    /// (`src/fusion/sight.rs`). The interval given is the intersection,
+    /// not a guarantee; the point stays out of the map.
+    PartlyUnseen,
 }
 
 impl FusedStatus {
-    /// Whether the point is flagged ([`FusedStatus::Inconsistent`]).
+    /// Whether the point is flagged ([`FusedStatus::Inconsistent`],
+    /// [`FusedStatus::PartlyUnseen`]).
     pub fn is_flagged(self) -> bool {
-        self == FusedStatus::Inconsistent
+        matches!(self, FusedStatus::Inconsistent | FusedStatus::PartlyUnseen)
     }
 
     /// Short lower-case name.
@@ -84,6 +94,7 @@ impl FusedStatus {
             FusedStatus::Single => "single",
             FusedStatus::Consistent => "consistent",
             FusedStatus::Inconsistent => "inconsistent",
+            FusedStatus::PartlyUnseen => "partly_unseen",
         }
     }
 }
@@ -149,10 +160,23 @@ impl KeyPoint {
 pub(crate) enum Added {
     /// It agreed with the fused interval (or was the first).
     Agreed,
-    /// It missed it: the point is inconsistent now (or was already). Before
-    /// it, whether the point was consistent and with how many pairs.
-    Conflict { was_clean: bool, was_major: u8 },
+    /// It agreed, but the pairs' hull reaches below what some partner was
+    /// shown to see: the point is `PartlyUnseen` now ([`super::sight`]).
+    /// The packed counts before it.
+    Unseen { was_counts: u32 },
+    /// It missed it: the point is inconsistent now (or was already). The
+    /// packed counts before it.
+    Conflict { was_counts: u32 },
 }
+
+/// `Cell::counts`' flag of a `PartlyUnseen` point (bit 24).
+const UNSEEN: u32 = 1 << 24;
+
+/// The depth code from which a partner sees a point's ray, for an
+/// interval from no partner (a range constraint): no partner to see.
+pub(crate) const SEEN_ANY: u16 = 0;
+/// The same for a partner shown to see none of the ray worth having.
+pub(crate) const SEEN_NONE: u16 = u16::MAX;
 
 /// The state of one point (16 bytes).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -160,13 +184,17 @@ pub(crate) enum Added {
 pub(crate) struct Cell {
     near: f32,
     far: f32,
-    /// Rival interval, codes.
+    /// Rival interval, codes. While no interval has missed the majority
+    /// (no rival yet), the sight's state instead ([`super::sight`]): the
+    /// code of `H`, the lowest near end of the point's intervals (rounded
+    /// down), and of `U`, a depth from which every partner so far was
+    /// shown to see the ray (rounded up; [`SEEN_NONE`]: one was not).
     rival: [u16; 2],
     /// The pair counts, a byte each: bits 0–7 the pairs in the majority
     /// (0: no interval yet), 8–15 the pairs in the rival (0: none), 16–23
-    /// the pairs that missed both; bits 24–31 zero. Packed so that one
-    /// comparison tells a clean point with a given majority
-    /// ([`Cell::is_clean_with`]).
+    /// the pairs that missed both; bit 24 [`UNSEEN`], bits 25–31 zero.
+    /// Packed so that one comparison tells a clean point with a given
+    /// majority ([`Cell::is_clean_with`]).
     counts: u32,
 }
 
@@ -222,18 +250,57 @@ impl Cell {
             }
             return Added::Agreed;
         }
-        let was_clean = self.clean();
+        let was_counts = self.counts;
         self.conflict(near, far, scale);
-        Added::Conflict {
-            was_clean,
-            was_major: major,
-        }
+        Added::Conflict { was_counts }
     }
 
-    /// No interval has missed the majority.
+    /// [`Self::add`] with the sight check ([`super::sight`]): the interval's
+    /// sight `(h, u)` (codes) is the lowest depth the truth can have if
+    /// this pair is right (its near end, or the depth from which its
+    /// partner sees the ray if that is above) and the depth from which its
+    /// partner sees the ray (for a range constraint: its near end and
+    /// [`SEEN_ANY`]). While no interval has missed the point, `H` and `U`
+    /// take them in, and `H < U` flags it.
     #[inline(always)]
-    fn clean(&self) -> bool {
+    pub(crate) fn add_sighted(
+        &mut self,
+        near: f32,
+        far: f32,
+        scale: &DepthScale,
+        (h, u): (u16, u16),
+    ) -> Added {
+        let was_counts = self.counts;
+        let added = self.add(near, far, scale);
+        if was_counts == 0 {
+            self.rival = [h, u];
+            return added;
+        }
+        if let (Added::Agreed, 0) = (added, was_counts >> 8) {
+            let h = self.rival[0].min(h);
+            let u = self.rival[1].max(u);
+            self.rival = [h, u];
+            if h < u {
+                self.counts |= UNSEEN;
+                return Added::Unseen { was_counts };
+            }
+        }
+        added
+    }
+
+    /// Whether the sight's state is kept (the point has an interval, no
+    /// interval missed it, and it is not `PartlyUnseen`), or it has no
+    /// interval yet: the two cases where a pair's sight counts.
+    #[inline(always)]
+    pub(crate) fn watches(&self) -> bool {
         self.counts >> 8 == 0
+    }
+
+    /// `H`, the lowest near end of the point's intervals (rounded down to
+    /// its code), while [`Self::watches`] and it has an interval.
+    #[inline(always)]
+    pub(crate) fn hull_near(&self, scale: &DepthScale) -> Option<f32> {
+        (self.major() > 0).then(|| scale.depth(self.rival[0]))
     }
 
     /// No interval has missed the majority, and `major` pairs are in it.
@@ -273,6 +340,7 @@ impl Cell {
     pub(crate) fn status(&self) -> FusedStatus {
         match (self.major(), self.rival_n(), self.others()) {
             (0, _, _) => FusedStatus::Unmatched,
+            (_, 0, 0) if self.counts & UNSEEN != 0 => FusedStatus::PartlyUnseen,
             (1, 0, 0) => FusedStatus::Single,
             (_, 0, 0) => FusedStatus::Consistent,
             _ => FusedStatus::Inconsistent,
@@ -280,10 +348,10 @@ impl Cell {
     }
 
     /// Whether the point goes into the map with at least `min_pairs`
-    /// agreeing pairs (no disagreeing one, a bounded interval), in one
-    /// range test on the packed counts: clean (nothing above the majority
-    /// byte) with at least `min_pairs`, and at least one, pairs in the
-    /// majority. (Every interval fused is finite, so a fused interval is
+    /// agreeing pairs (no disagreeing one, seen by every partner, a
+    /// bounded interval), in one range test on the packed counts: clean
+    /// (nothing above the majority byte, [`UNSEEN`] included) with at
+    /// least `min_pairs`, and at least one, pairs in the majority. (Every interval fused is finite, so a fused interval is
     /// bounded.)
     #[inline(always)]
     pub(crate) fn admitted(&self, min_pairs: u8) -> bool {
@@ -319,7 +387,7 @@ impl Cell {
             self.near.to_bits(),
             self.far.to_bits(),
             u32::from(self.rival[0]) | u32::from(self.rival[1]) << 16,
-            pack(self.major(), self.rival_n(), self.others()),
+            self.counts,
         ]
     }
 }
@@ -331,23 +399,65 @@ impl Cell {
 /// joins the inconsistent at its first conflict.
 #[inline(always)]
 fn count(added: Added, c: &Cell, min: u8, admitted: &mut u16, inconsistent: &mut u16) {
+    // (Admitted before: clean with at least `min` pairs, `Cell::admitted`.)
+    let was_admitted = |was: u32| (u32::from(min.max(1))..=0xFF).contains(&was);
     match added {
         Added::Agreed => {
             if c.is_clean_with(min) {
                 *admitted = admitted.saturating_add(1);
             }
         }
-        Added::Conflict {
-            was_clean: true,
-            was_major,
-        } => {
-            *inconsistent = inconsistent.saturating_add(1);
-            if was_major >= min {
+        Added::Unseen { was_counts } => {
+            if was_admitted(was_counts) {
                 *admitted = admitted.saturating_sub(1);
             }
         }
-        Added::Conflict { .. } => {}
+        Added::Conflict { was_counts } => {
+            // (Consistent or `PartlyUnseen` before: no interval had missed.)
+            if was_counts & 0x00FF_FF00 == 0 {
+                *inconsistent = inconsistent.saturating_add(1);
+            }
+            if was_admitted(was_counts) {
+                *admitted = admitted.saturating_sub(1);
+            }
+        }
     }
+}
+
+/// The sight of the pair's interval for `r`'s point, for its cell `c`
+/// ([`Cell::add`], [`super::sight`]): the partner is probed from half the
+/// pairs' lowest depth `H` (this pair's near end counted); seen there, the
+/// sight is `(near, H/2)`; if not, the depth `e` from which it sees the ray
+/// is worked out, and the sight is `(max(near, e), e)`. A cell whose sight
+/// is no longer watched gets `(0, SEEN_ANY)` (not looked at); a partner
+/// that sees nothing of the boundary (`sight` `None`), `(near, SEEN_NONE)`.
+#[inline(always)]
+fn sight_of(c: &Cell, r: &PointResult, sight: Option<&Sight>, scale: &DepthScale) -> (u16, u16) {
+    if !c.watches() {
+        return (0, SEEN_ANY);
+    }
+    let near = scale.down(r.z_near);
+    let Some(sight) = sight else {
+        return (near, SEEN_NONE);
+    };
+    let h = c.hull_near(scale).map_or(r.z_near, |h| fmin(h, r.z_near));
+    let half = 0.5 * h;
+    if sight.sees_from(r.pixel1, half) {
+        return (near, scale.up(half));
+    }
+    sight_exact(r.pixel1, near, sight, scale)
+}
+
+/// [`sight_of`] where the probe failed (out of line: rare).
+#[inline(never)]
+fn sight_exact(p: Pixel, near: u16, sight: &Sight, scale: &DepthScale) -> (u16, u16) {
+    let e = sight.seen_from(p);
+    if e == f32::INFINITY {
+        return (near, SEEN_NONE);
+    }
+    let u = scale.up(e);
+    // (Codes compare as depths: at `e`'s, when it is above the near end.)
+    (near.max(u), u)
 }
 
 /// The first pair of a fresh key frame on one boundary ([`KeyFrame::fuse`]):
@@ -409,6 +519,8 @@ pub struct FusedCounts {
     pub consistent: u32,
     /// [`FusedStatus::Inconsistent`] points.
     pub inconsistent: u32,
+    /// [`FusedStatus::PartlyUnseen`] points.
+    pub partly_unseen: u32,
 }
 
 /// The fusion state of one key frame: a `Cell` per boundary point.
@@ -439,6 +551,8 @@ pub struct KeyFrame<const N: usize, const B: usize> {
     /// Since [`KeyFrame::start`], no pair and no range constraint: every
     /// point is unmatched, whatever its cell holds.
     fresh: bool,
+    /// The sight check is on ([`super::FusionConfig::with_sight_check`]).
+    sighted: bool,
 }
 
 /// The live cells of a key frame, boundary by boundary ([`KeyFrame`]'s
@@ -471,7 +585,7 @@ impl<const N: usize, const B: usize> fmt::Debug for KeyFrame<N, B> {
 }
 
 impl<const N: usize, const B: usize> KeyFrame<N, B> {
-    pub(crate) const fn new(scale: DepthScale, min_pairs: u8) -> Self {
+    pub(crate) const fn new(scale: DepthScale, min_pairs: u8, sighted: bool) -> Self {
         Self {
             cells: [[Cell::EMPTY; N]; B],
             lens: [0; B],
@@ -483,6 +597,7 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
             best_matched: 0,
             scale,
             fresh: false,
+            sighted,
         }
     }
 
@@ -531,6 +646,7 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
     ///
     /// Work: one pass over the structure's points (at most `B·N`), `O(1)`
     /// each.
+    /// With the sight check on, [`Self::fuse_sighted`] instead.
     pub(crate) fn fuse(&mut self, s: &Structure<N, B>) -> PairFused {
         let mut out = PairFused::default();
         let scale = self.scale;
@@ -585,6 +701,60 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
         out
     }
 
+    /// [`Self::fuse`] with the sight check on
+    /// ([`super::FusionConfig::with_sight_check`]): `sights` says what the
+    /// partner sees of each boundary's rays ([`super::sight`]; `None`:
+    /// nothing). One pass over the points, `O(1)` each (a probe of the
+    /// partner's sight, and where it fails the depth it sees from).
+    pub(crate) fn fuse_sighted(
+        &mut self,
+        s: &Structure<N, B>,
+        sights: &[Option<Sight>; B],
+    ) -> PairFused {
+        let mut out = PairFused::default();
+        let scale = self.scale;
+        let min = self.min_pairs;
+        let fresh = core::mem::replace(&mut self.fresh, false);
+        for (k, ((((cells, len), adm), inc), sight)) in self
+            .cells
+            .iter_mut()
+            .zip(self.lens.iter())
+            .zip(self.admitted.iter_mut())
+            .zip(self.inconsistent.iter_mut())
+            .zip(sights.iter())
+            .enumerate()
+        {
+            let cells = cells.get_mut(..usize::from(*len)).unwrap_or(&mut []);
+            let results = s.boundaries().get(k).map_or(&[][..], |b| b.points());
+            let mut results = results.iter();
+            for c in cells.iter_mut() {
+                if fresh {
+                    *c = Cell::EMPTY;
+                }
+                let Some(r) = results.next().filter(|r| r.status == Status::Ok) else {
+                    continue;
+                };
+                out.matched += 1;
+                let sight = sight_of(c, r, sight.as_ref(), &scale);
+                let added = c.add_sighted(r.z_near, r.z_far, &scale, sight);
+                if let Added::Conflict { .. } = added {
+                    out.conflicts += 1;
+                }
+                count(added, c, min, adm, inc);
+            }
+        }
+        self.partners = self.partners.saturating_add(1);
+        if out.matched > self.best_matched {
+            self.best_matched = out.matched;
+        }
+        out
+    }
+
+    /// Whether the sight check is on.
+    pub(crate) fn sighted(&self) -> bool {
+        self.sighted
+    }
+
     /// Fuse an outside interval into point `index` of `boundary`.
     pub(crate) fn constrain(
         &mut self,
@@ -600,7 +770,11 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
         self.unfresh();
         let (scale, min) = (self.scale, self.min_pairs);
         let c = self.cells.get_mut(boundary)?.get_mut(index)?;
-        let added = c.add(near, far, &scale);
+        let added = if self.sighted {
+            c.add_sighted(near, far, &scale, (scale.down(near), SEEN_ANY))
+        } else {
+            c.add(near, far, &scale)
+        };
         if let (Some(adm), Some(inc)) = (
             self.admitted.get_mut(boundary),
             self.inconsistent.get_mut(boundary),
@@ -701,6 +875,7 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
                     FusedStatus::Single => c.single += 1,
                     FusedStatus::Consistent => c.consistent += 1,
                     FusedStatus::Inconsistent => c.inconsistent += 1,
+                    FusedStatus::PartlyUnseen => c.partly_unseen += 1,
                 }
             }
         }

@@ -84,6 +84,7 @@
 mod chain;
 pub(crate) mod code;
 mod key;
+mod sight;
 
 use core::fmt;
 
@@ -112,6 +113,7 @@ pub struct FusionConfig {
     max_partners: u16,
     keep_permille: u16,
     map_min_pairs: u8,
+    sight_check: bool,
     tilt: f32,
     tilt_sc: (f32, f32),
 }
@@ -190,6 +192,7 @@ impl FusionConfig {
             max_partners,
             keep_permille,
             map_min_pairs: 2,
+            sight_check: false,
             tilt: 0.0,
             tilt_sc: (0.0, 1.0),
         })
@@ -224,6 +227,24 @@ impl FusionConfig {
         }
         self.map_min_pairs = pairs;
         Ok(self)
+    }
+
+    /// The same policy with the **sight check** on or off (off by
+    /// default): a point whose pairs' sticks reach depths some contributing
+    /// partner was not shown to see along its ray (it left that partner's
+    /// image, or its boundary's rows) is flagged
+    /// [`FusedStatus::PartlyUnseen`] and kept out of the map, as that
+    /// partner's match may be of another stretch that happens to lie
+    /// inside a wider right stick (`src/fusion/sight.rs`; `docs/FUSION.md`,
+    /// "Limits"). It costs points and narrowing: measured there.
+    pub const fn with_sight_check(mut self, on: bool) -> Self {
+        self.sight_check = on;
+        self
+    }
+
+    /// Whether the sight check is on.
+    pub const fn sight_check(&self) -> bool {
+        self.sight_check
     }
 
     /// Most partners per key frame.
@@ -363,7 +384,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             processor: Processor::new(base),
             base,
             config,
-            key: KeyFrame::new(scale, config.map_min_pairs),
+            key: KeyFrame::new(scale, config.map_min_pairs, config.sight_check),
             has_key: false,
             chain: Chain::IDENTITY,
             last: None,
@@ -554,6 +575,8 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     ) -> PairFused {
         // (The composition's rounding, which the processor carries.)
         self.pair_rounding = rounding;
+        // (The pair's configuration, for the sight check's margins.)
+        let cfg = self.key.sighted().then(|| *self.processor.config());
         match self.processor.process_composed_within(
             frame,
             motion,
@@ -561,7 +584,18 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             !last_partner,
             deadline,
         ) {
-            Ok(s) => self.key.fuse(s),
+            Ok(s) => {
+                // What the partner sees of each boundary's rays.
+                let key_cam = s.camera1();
+                let Some(cfg) = cfg else {
+                    return self.key.fuse(s);
+                };
+                let sights: [Option<sight::Sight>; B] = core::array::from_fn(|k| {
+                    let points = frame.boundaries().get(k).map_or(&[][..], |b| b.points());
+                    sight::Sight::new(key_cam, frame.camera(), points, motion, &cfg)
+                });
+                self.key.fuse_sighted(s, &sights)
+            }
             // (A kept frame exists: not reached.)
             Err(_) => PairFused::default(),
         }
@@ -717,7 +751,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         }
         self.settle();
         match self.key.constrain(boundary, index, zn, zf) {
-            Some(Added::Agreed | Added::Conflict { .. }) => {}
+            Some(Added::Agreed | Added::Unseen { .. } | Added::Conflict { .. }) => {}
             None => return Err(FusionError::NoSuchPoint),
         }
         self.key

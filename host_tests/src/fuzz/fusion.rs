@@ -695,6 +695,12 @@ fn check_point(p: &roadstereo::fusion::FusedPoint, at: &str) {
         FusedStatus::Inconsistent => {
             assert!(p.interval.is_some() && p.disagreeing >= 1, "{at}: {p:?}");
         }
+        FusedStatus::PartlyUnseen => {
+            assert!(
+                p.interval.is_some() && p.pairs >= 2 && p.disagreeing == 0,
+                "{at}: {p:?}"
+            );
+        }
         // (`FusedStatus` is `#[non_exhaustive]`: a status added later must
         // be given its check here.)
         other => panic!("{at}: a status this check does not know: {other:?}"),

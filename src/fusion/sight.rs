@@ -1,0 +1,236 @@
+//! What a partner frame can see of the key frame's rays: the check that a
+//! pair's match could be the true correspondent's.
+//!
+//! # Why
+//! A pair's stick is guaranteed only where the point's true correspondent
+//! is in the partner's data. When it is not (the point's ray has left the
+//! partner's image, or its boundary's rows there), the band may still meet
+//! the partner's boundary elsewhere, and that match's stick can fall inside
+//! a correct but wide stick of another pair: the two "agree" and the
+//! intersection is the wrong one's (an adversarial review: a correct first
+//! partner's stick `[9.21, 371]`, a later partner's wrong `[14.7, 16.9]`
+//! for a truth of 11.7 whose image was 28 px off the partner's left edge;
+//! `Consistent`, and into the map 3.08 from its stick with a radius of
+//! 0.011). Interval logic alone cannot tell: the wrong stick is inside the
+//! right one.
+//!
+//! # The rule
+//! Say a pair `c` is *right* when the point's true correspondent is in
+//! its partner's data: its stick `S_c` holds the truth. Suppose one pair is
+//! right. If every pair's stick lies in what every *other* partner `j`
+//! sees along the ray (`S_i ⊂ V_j`), then the truth (in `S_c`) is seen by
+//! every partner, every partner's match is the correspondent's, and every
+//! stick holds the truth: so does their intersection. With `H` the lowest
+//! near end of the point's sticks (their hull's) and `U` a depth from
+//! which every partner so far was shown to see the ray (`V_j ⊃ [U, ∞)`),
+//! `H ≥ U` gives `S_i ⊂ [H, ∞) ⊂ V_j` for all of them. Both are running
+//! extremes, so the test does not depend on the pairs' order: a point
+//! whose pairs break it is flagged `PartlyUnseen` for good (out of the
+//! map), whichever pair came first. (A pair's own stick need not lie in
+//! what its own partner sees: if it is the right one, the truth is seen by
+//! definition. A first pair therefore never flags.) If no pair is right,
+//! nothing in the views can tell: `docs/FUSION.md`, "Limits".
+//!
+//! # Seen from a depth on
+//! The ray's points at depths `[d, ∞)` map into the partner (motion
+//! `R, T`: frame-2 coordinates `Rᵀ (P − T)`) to `P(z) = z a − b`, `a = Rᵀ r`
+//! for the detected pixel's ray `r = (x, y, 1)`, `b = Rᵀ T`; with `a_z > 0`
+//! and `P_z(d) > 0` their images are the segment from the image of depth
+//! `d` to the image at infinity, inside the convex window (the partner's
+//! columns and its boundary's rows, shrunk by a margin) when both ends are.
+//! The tests are linear in `P`: `P_x ≥ ū₀ P_z` and so on, no division.
+//! The margin covers what moves the true ray's image from the detected
+//! one's: `e₁ + e₂ + 1` pixels and the rotation error's `f ε` (in the
+//! window), the translation error `δ` (in the tests: `T` off by `δ` moves
+//! `P_x − ū P_z` by at most `δ (1 + |ū|)`). A margin, not a derived bound:
+//! the zero wrong unflagged fused points is what the tests show
+//! (`docs/FUSION.md`).
+//!
+//! A point's `U` is set by probing: each pair `j` asks whether its partner
+//! sees the ray from `H/2` (`H` counting this pair's stick), then from
+//! just below `H`; the first yes is partner `j`'s depth (rounded up to a
+//! code), two noes mean it has none (`U` unbounded: the next pair flags).
+//! Assumes the partner's polyline covers its boundary wherever that is in
+//! the image (rows from its first point's to its last's).
+
+use crate::camera::{Camera, Pixel};
+use crate::config::Config;
+use crate::math::{fmax, fmin};
+use crate::motion::Motion;
+
+/// What one partner sees of the key frame's rays on one boundary.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Sight {
+    /// `Rᵀ`, by rows: a key-frame direction in partner coordinates.
+    rt: [[f32; 3]; 3],
+    /// `Rᵀ T`.
+    b: [f32; 3],
+    /// The key camera's normalisation, `x = u·kx + ox`, `y = v·ky + oy`.
+    key: [f32; 4],
+    /// The window, normalised: `ū₀ ≤ x ≤ ū₁`, `v̄₀ ≤ y ≤ v̄₁`.
+    win: [f32; 4],
+    /// `1 + |ū|` for each of the window's four sides, in the order of
+    /// `win`: a change of `P` by at most `ε` in each coordinate moves the
+    /// side's value `P_x − ū P_z` (and so on) by at most `ε (1 + |ū|)`.
+    side: [f32; 4],
+    /// The translation error `δ` and the key pixel's, `ε₁ = e₁/min(f)`
+    /// (normalised): the slack of a side at depth `d` is `(1 + |ū|)(δ + ε₁ d)`.
+    err: [f32; 2],
+}
+
+impl Sight {
+    /// The sight of a partner whose camera is `cam` and whose boundary has
+    /// the points `points` (the motion `m` from the key frame, the pair's
+    /// configuration `cfg`); `None` when the window is empty (nothing is
+    /// seen: fewer than two points, or rows narrower than the margin).
+    pub(crate) fn new(
+        key_cam: &Camera,
+        cam: &Camera,
+        points: &[Pixel],
+        m: &Motion,
+        cfg: &Config,
+    ) -> Option<Self> {
+        let (Some(first), Some(last)) = (points.first(), points.last()) else {
+            return None;
+        };
+        let r = m.rotation_matrix();
+        let t = m.translation();
+        let mut rt = [[0.0f32; 3]; 3];
+        for (i, row) in rt.iter_mut().enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                // (Indices below 3.)
+                *v = r.get(j).and_then(|c| c.get(i)).copied().unwrap_or(0.0);
+            }
+        }
+        let b = [
+            rt[0][0] * t[0] + rt[0][1] * t[1] + rt[0][2] * t[2],
+            rt[1][0] * t[0] + rt[1][1] * t[1] + rt[1][2] * t[2],
+            rt[2][0] * t[0] + rt[2][1] * t[1] + rt[2][2] * t[2],
+        ];
+        let eps = cfg.rotation_error();
+        let margin = cfg.e2() + fmax(cam.fx(), cam.fy()) * (eps[0] + eps[1] + eps[2]);
+        let (v_lo, v_hi) = if first.v <= last.v {
+            (first.v, last.v)
+        } else {
+            (last.v, first.v)
+        };
+        let (u0, u1) = (margin, f32::from(cam.width()) - 1.0 - margin);
+        let (v0, v1) = (v_lo + margin, v_hi - margin);
+        // (A NaN fails.)
+        if !(u0 < u1 && v0 < v1) {
+            return None;
+        }
+        let win = [
+            (u0 - cam.cx()) / cam.fx(),
+            (u1 - cam.cx()) / cam.fx(),
+            (v0 - cam.cy()) / cam.fy(),
+            (v1 - cam.cy()) / cam.fy(),
+        ];
+        let side = win.map(|w| 1.0 + w.abs());
+        let err = [
+            cfg.translation_error(),
+            cfg.e1() / fmin(key_cam.fx(), key_cam.fy()),
+        ];
+        Some(Self {
+            rt,
+            b,
+            key: [
+                1.0 / key_cam.fx(),
+                -key_cam.cx() / key_cam.fx(),
+                1.0 / key_cam.fy(),
+                -key_cam.cy() / key_cam.fy(),
+            ],
+            win,
+            side,
+            err,
+        })
+    }
+
+    /// Whether the partner sees the ray of the key-frame pixel `p` at every
+    /// depth from `d` on (module docs).
+    #[inline(always)]
+    pub(crate) fn sees_from(&self, p: Pixel, d: f32) -> bool {
+        let x = p.u * self.key[0] + self.key[1];
+        let y = p.v * self.key[2] + self.key[3];
+        let [r0, r1, r2] = self.rt;
+        let a = [
+            r0[0] * x + r0[1] * y + r0[2],
+            r1[0] * x + r1[1] * y + r1[2],
+            r2[0] * x + r2[1] * y + r2[2],
+        ];
+        let p = [d * a[0] - self.b[0], d * a[1] - self.b[1], d * a[2] - self.b[2]];
+        // At infinity the direction `a` (the key pixel's error alone), at
+        // `d` the point `P` (the translation's too). (A NaN fails.)
+        let [delta, e1] = self.err;
+        inside(a, &self.win, &self.side, e1) && inside(p, &self.win, &self.side, delta + e1 * d)
+    }
+}
+
+impl Sight {
+    /// The depth from which the partner sees the ray of the key-frame
+    /// pixel `p` ([`Self::sees_from`] holds from it on, up to rounding),
+    /// rounded up; `f32::INFINITY` when it does not see the ray's far end
+    /// (nor any depth, then). Each of the window's sides is a linear
+    /// bound on the depth, `d (c·a) ≥ s + c·b` with `c·a > 0` when the far
+    /// end is seen: the largest of them, and `P_z > 0`'s.
+    pub(crate) fn seen_from(&self, p: Pixel) -> f32 {
+        let x = p.u * self.key[0] + self.key[1];
+        let y = p.v * self.key[2] + self.key[3];
+        let [r0, r1, r2] = self.rt;
+        let a = [
+            r0[0] * x + r0[1] * y + r0[2],
+            r1[0] * x + r1[1] * y + r1[2],
+            r2[0] * x + r2[1] * y + r2[2],
+        ];
+        let b = self.b;
+        let (w, k) = (self.win, self.side);
+        let [delta, e1] = self.err;
+        // (Side: the coefficient of the depth and the bound's right-hand
+        // side, `d (c·a − k ε₁) ≥ c·b + k δ`.)
+        let sides = [
+            (a[2], b[2]),
+            (
+                a[0] - w[0] * a[2] - k[0] * e1,
+                b[0] - w[0] * b[2] + k[0] * delta,
+            ),
+            (
+                w[1] * a[2] - a[0] - k[1] * e1,
+                w[1] * b[2] - b[0] + k[1] * delta,
+            ),
+            (
+                a[1] - w[2] * a[2] - k[2] * e1,
+                b[1] - w[2] * b[2] + k[2] * delta,
+            ),
+            (
+                w[3] * a[2] - a[1] - k[3] * e1,
+                w[3] * b[2] - b[1] + k[3] * delta,
+            ),
+        ];
+        let mut e = 0.0f32;
+        for (c, rhs) in sides {
+            // (A NaN fails: not seen.)
+            if !(c > 0.0) {
+                return f32::INFINITY;
+            }
+            e = fmax(e, rhs / c);
+        }
+        // (The bounds' rounding, a few ulps of their terms: 1e-5 over.)
+        let e = e * (1.0 + 1.0e-5) + 1.0e-30;
+        if e.is_finite() {
+            e
+        } else {
+            f32::INFINITY
+        }
+    }
+}
+
+/// `q` in front of the camera and inside the window's cone, each side by
+/// `side · e` (`q` off by at most `e` in each coordinate stays inside).
+#[inline(always)]
+fn inside(q: [f32; 3], win: &[f32; 4], side: &[f32; 4], e: f32) -> bool {
+    q[2] > 0.0
+        && q[0] - win[0] * q[2] >= side[0] * e
+        && win[1] * q[2] - q[0] >= side[1] * e
+        && q[1] - win[2] * q[2] >= side[2] * e
+        && win[3] * q[2] - q[1] >= side[3] * e
+}

@@ -410,6 +410,13 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
     }
 
     /// Forget every point (the counters too).
+    /// [`Self::clear`] for a camera tilted by the angle whose sine and
+    /// cosine are `tilt`.
+    pub(crate) fn clear_tilted(&mut self, tilt: (f32, f32)) {
+        self.clear();
+        self.tilt = tilt;
+    }
+
     pub(crate) fn clear(&mut self) {
         self.tail = [0; B];
         self.used = [0; B];

@@ -793,6 +793,10 @@ pub struct Tally {
     pub single_contained: usize,
     /// Points inconsistent when their key frame retired (or at the end).
     pub inconsistent: usize,
+    /// Snapshots of points the sight check flagged (`PartlyUnseen`), and of
+    /// those the ones whose interval holds the truth.
+    pub unseen: usize,
+    pub unseen_contained: usize,
     /// Two-view sticks (`Ok`) that miss the truth: all, and those whose
     /// correspondent was in the partner frame (a broken guarantee).
     pub wrong_pairs: usize,
@@ -817,6 +821,8 @@ impl Tally {
         self.single += o.single;
         self.single_contained += o.single_contained;
         self.inconsistent += o.inconsistent;
+        self.unseen += o.unseen;
+        self.unseen_contained += o.unseen_contained;
         self.wrong_pairs += o.wrong_pairs;
         self.wrong_pairs_observed += o.wrong_pairs_observed;
         self.caught += o.caught;
@@ -853,6 +859,10 @@ pub fn tally(d: &Drive, run: &Run) -> Tally {
                             t.single += 1;
                             t.single_contained += usize::from(holds(p.interval, z));
                         }
+                        FusedStatus::PartlyUnseen => {
+                            t.unseen += 1;
+                            t.unseen_contained += usize::from(holds(p.interval, z));
+                        }
                         _ => {}
                     }
                 }
@@ -879,7 +889,7 @@ pub fn tally(d: &Drive, run: &Run) -> Tally {
                     }
                     let f = last[b][i];
                     match f.status {
-                        FusedStatus::Inconsistent => t.caught += 1,
+                        FusedStatus::Inconsistent | FusedStatus::PartlyUnseen => t.caught += 1,
                         _ if holds(f.interval, z) => t.harmless += 1,
                         FusedStatus::Single => t.wrong_single += 1,
                         _ => t.wrong_fused += 1,

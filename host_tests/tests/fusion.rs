@@ -1118,13 +1118,19 @@ fn key_points_put_the_fused_intervals_in_3d() {
                 };
                 let kid = key.id() as usize;
                 if step.retired.is_some() {
-                    assert!(f.key_point(0, 0).is_none(), "frame {j}: a retired key frame's point");
+                    assert!(
+                        f.key_point(0, 0).is_none(),
+                        "frame {j}: a retired key frame's point"
+                    );
                     after_retire += 1;
                     retired_before = true;
                     return;
                 }
                 if retired_before && key.len(0) > 0 {
-                    assert!(f.key_point(0, 0).is_some(), "frame {j}: the new key frame's point");
+                    assert!(
+                        f.key_point(0, 0).is_some(),
+                        "frame {j}: the new key frame's point"
+                    );
                 }
                 retired_before = false;
                 for b in 0..B {
@@ -1167,6 +1173,77 @@ fn key_points_put_the_fused_intervals_in_3d() {
     assert!(after_retire > 20, "{after_retire}");
 }
 
+/// The sight check (`FusionConfig::with_sight_check`, off by default) on
+/// the random drives, rounded, next to the same drives without it: every
+/// consistent point still holds the truth, no wrong fused point, and what
+/// it costs: the share of fused snapshots it flags `PartlyUnseen` (how many
+/// of those hold the truth: the check cannot tell them from the wrong
+/// ones), and the narrowing of the unflagged intervals after 8 partners
+/// (`docs/FUSION.md`, "The sight check"). A test that can fail: the share
+/// flagged is bounded (it flags none where every partner sees the whole
+/// hull), and the check must flag something here.
+#[test]
+fn the_sight_check_on_the_random_drives() {
+    let (off_policy, on_policy) = (
+        FusionConfig::DEFAULT,
+        FusionConfig::DEFAULT.with_sight_check(true),
+    );
+    let narrow = FusionConfig::new(8, 0).expect("policy");
+    let mut rows = Vec::new();
+    let (mut off_all, mut on_all) = (Tally::default(), Tally::default());
+    let (mut n_off, mut n_on) = (Narrowing::default(), Narrowing::default());
+    for family in DriveFamily::ALL {
+        let (ds, _) = drives(family, 12, FRAMES);
+        let (mut off, mut on) = (Tally::default(), Tally::default());
+        for (seed, d) in &ds {
+            let input = d.input(Noise::Rounded, None, *seed);
+            off.add(&tally(d, &run(d, &input, off_policy, |_, _, _| {})));
+            on.add(&tally(d, &run(d, &input, on_policy, |_, _, _| {})));
+            n_off.add(d, &run(d, &input, narrow, |_, _, _| {}));
+            n_on.add(
+                d,
+                &run(d, &input, narrow.with_sight_check(true), |_, _, _| {}),
+            );
+        }
+        rows.push(format!(
+            "| {} | {} | {} | {} ({}) | {} of {} |",
+            family.name(),
+            off.drives,
+            off.consistent,
+            on.consistent,
+            pct(on.unseen, on.unseen + on.consistent),
+            on.unseen_contained,
+            on.unseen,
+        ));
+        off_all.add(&off);
+        on_all.add(&on);
+    }
+    let (_, gain_off) = n_off.row("off");
+    let (_, gain_on) = n_on.row("on");
+    println!(
+        "\nthe sight check, 12 rounded drives a family:\n| family | drives | consistent snapshots, off | on (share flagged partly unseen) | partly unseen holding the truth |\n|---|---:|---:|---:|---:|\n{}\nall: off {} consistent, on {} consistent and {} partly unseen ({}); wrong fused off {} on {}; narrowing after 8 partners of the unflagged intervals off {gain_off:.2}×, on {gain_on:.2}×",
+        rows.join("\n"),
+        off_all.consistent,
+        on_all.consistent,
+        on_all.unseen,
+        pct(on_all.unseen, on_all.unseen + on_all.consistent),
+        off_all.wrong_fused,
+        on_all.wrong_fused
+    );
+    assert_eq!(on_all.consistent_contained, on_all.consistent);
+    assert_eq!(on_all.wrong_fused, 0);
+    assert_eq!(on_all.wrong_pairs_observed, 0);
+    // The check only ever takes consistent points away (flags them).
+    assert!(on_all.consistent <= off_all.consistent);
+    assert!(on_all.unseen > 0, "the check flagged nothing");
+    assert!(
+        on_all.unseen * 4 < on_all.unseen + on_all.consistent,
+        "the check flagged a quarter or more: {} of {}",
+        on_all.unseen,
+        on_all.unseen + on_all.consistent
+    );
+}
+
 /// The limit of the consistency check, pinned (`docs/FUSION.md`, "Limits"; found by
 /// an adversarial review, reduced from its crest family): every pair's
 /// stick is guaranteed only where the point's true correspondent is in
@@ -1182,14 +1259,26 @@ fn key_points_put_the_fused_intervals_in_3d() {
 /// match), and no check on these polylines could: the three views agree.
 /// (The per-frame rotation errors are inside the configured bounds.) If a
 /// change catches it, this test fails: update `docs/FUSION.md`'s limits with it.
+/// With the sight check on (`FusionConfig::with_sight_check`) the point is
+/// `PartlyUnseen`: the partners' polylines cover 3 and 4 rows, so neither
+/// is shown to see the key frame's ray over any depth.
 #[test]
 fn limit_two_partners_past_a_crest_agree_on_the_hidden_stretch() {
+    let policy = FusionConfig::new(64, 0).expect("policy");
+    let p = crest_point(policy);
+    assert_eq!((p.status, p.pairs), (FusedStatus::Consistent, 2), "{p:?}");
+    let p = crest_point(policy.with_sight_check(true));
+    assert_eq!((p.status, p.pairs), (FusedStatus::PartlyUnseen, 2), "{p:?}");
+}
+
+/// [`limit_two_partners_past_a_crest_agree_on_the_hidden_stretch`]'s drive
+/// under `policy`: the key frame's point 1 after the three partners.
+fn crest_point(policy: FusionConfig) -> roadstereo::fusion::FusedPoint {
     let cam = roadstereo::Camera::new(2040.024, 1751.3557, 555.9182, 350.90897, 1280, 720)
         .expect("camera");
     let config = Config::new(0.25, 0.25, 5.0, 1000.0)
         .and_then(|c| c.with_rotation_error([0.0005, 0.000_357_564_16, 0.000_332_282_54]))
         .expect("config");
-    let policy = FusionConfig::new(64, 0).expect("policy");
     let mut f = Box::new(HostFusion::new(config, policy));
     let frames: [&[(f32, f32)]; 4] = [
         &[(33.720425, 535.8427), (40.37532, 533.3972)],
@@ -1244,9 +1333,9 @@ fn limit_two_partners_past_a_crest_agree_on_the_hidden_stretch() {
         assert!(s.z_near > 4.0 * z_seen, "a far-stretch stick: {s:?}");
     }
     let p = f.key().expect("key").point(0, 1).expect("point");
-    assert_eq!((p.status, p.pairs), (FusedStatus::Consistent, 2), "{p:?}");
     let iv = p.interval.expect("interval");
     assert!(iv.z_near > 4.0 * z_seen && iv.z_far < 70.0, "{iv:?}");
+    p
 }
 
 /// The same limit with one pair (`docs/FUSION.md`, "Limits"): the partner sees only

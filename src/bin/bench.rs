@@ -215,8 +215,45 @@ fn fusion_bench() -> bool {
     fusion.set_fold_counting(true);
     let counted = fusion_counted(fusion);
     fusion.set_fold_counting(false);
-    fusion.reset();
-    counted
+    fusion.reset_with(POLICY.with_sight_check(true));
+    let sighted = fusion_sighted(fusion);
+    fusion.reset_with(POLICY);
+    counted && sighted
+}
+
+/// The demo drive again through `Fusion::step` with the sight check on
+/// (`FusionConfig::with_sight_check`): per frame the step's instructions
+/// (the matching is the same as [`fusion_bench`]'s), and the key frame's
+/// consistent and partly unseen points after it.
+fn fusion_sighted(fusion: &mut Fusion<256, 2, 512>) -> bool {
+    let Ok(mut drive) = fw::Drive::new(DRIVE) else {
+        return false;
+    };
+    let mut frame = Frame::<256, 2>::new(drive.camera);
+    for i in 0..drive.frames {
+        let Ok(motion) = drive.next_frame(&mut frame) else {
+            return false;
+        };
+        let chained = motion.map(|m| ChainedMotion {
+            from: i.wrapping_sub(1),
+            motion: m,
+        });
+        let (result, instr) = fw::measure(|| fusion.step(black_box(i), &frame, chained.as_ref()));
+        let Ok(step) = result else {
+            return false;
+        };
+        let counts = fusion.key().map(|k| k.counts()).unwrap_or_default();
+        defmt::info!(
+            "fusion_sighted frame={=u32} step_instr={=u32} paired={=bool} consistent={=u32} partly_unseen={=u32} map={=u32}",
+            i,
+            instr,
+            step.paired.is_some(),
+            counts.consistent,
+            counts.partly_unseen,
+            (fusion.map().len(0) + fusion.map().len(1)) as u32
+        );
+    }
+    true
 }
 
 /// The demo drive again through `Fusion::step` with the counting rule for

@@ -755,6 +755,13 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
         self.sighted
     }
 
+    /// A new policy's map admission and sight check (before the next
+    /// key frame starts: [`super::Fusion::reset_with`]).
+    pub(crate) fn reconfigure(&mut self, min_pairs: u8, sighted: bool) {
+        self.min_pairs = min_pairs;
+        self.sighted = sighted;
+    }
+
     /// Fuse an outside interval into point `index` of `boundary`.
     pub(crate) fn constrain(
         &mut self,
@@ -931,6 +938,58 @@ mod tests {
         assert_eq!(c.interval().map(|i| (i.z_near, i.z_far)), Some((3.5, 3.5)));
     }
 
+    /// The sight check's rule (`super::sight`) on an adversarial review's
+    /// numbers: a right but wide stick `[9.21, 371]` whose partner sees the
+    /// ray from 4.6, and a wrong `[14.7, 16.9]` whose partner sees it only
+    /// from 13 (the truth, 11.7, was off its image): in either order the
+    /// point is `PartlyUnseen`, out of the map, and its counts kept; a
+    /// right narrow stick seen from 6 instead leaves it `Consistent`; a
+    /// range constraint that lowers `H` below `U` flags it too.
+    #[test]
+    fn the_sight_check_flags_a_stick_its_partner_could_not_see_under() {
+        let s = sc();
+        let wide = (9.21, 371.0, (s.down(9.21), s.up(4.6)));
+        let wrong = (14.7, 16.9, (s.down(14.7).max(s.up(13.0)), s.up(13.0)));
+        let narrow = (11.0, 12.5, (s.down(11.0), s.up(6.0)));
+        let fuse = |a: (f32, f32, (u16, u16)), b: (f32, f32, (u16, u16))| {
+            let mut c = Cell::EMPTY;
+            assert_eq!(c.add_sighted(a.0, a.1, &s, a.2), Added::Agreed);
+            let added = c.add_sighted(b.0, b.1, &s, b.2);
+            (c, added)
+        };
+        for (a, b) in [(wide, wrong), (wrong, wide)] {
+            let (c, added) = fuse(a, b);
+            assert!(matches!(added, Added::Unseen { .. }), "{added:?}");
+            assert_eq!(c.status(), FusedStatus::PartlyUnseen);
+            assert!(!c.admitted(1) && !c.admitted(2));
+            let p = c.public();
+            assert_eq!((p.pairs, p.disagreeing), (2, 0));
+            assert_eq!(p.interval.map(|i| (i.z_near, i.z_far)), Some((14.7, 16.9)));
+            // Sticky: a third agreeing pair does not clear it, a missing
+            // one makes it inconsistent.
+            let mut c2 = c;
+            let _ = c2.add_sighted(15.0, 16.0, &s, (s.down(15.0), s.up(7.0)));
+            assert_eq!(c2.status(), FusedStatus::PartlyUnseen);
+            assert!(matches!(
+                c2.add_sighted(30.0, 31.0, &s, (s.down(30.0), 0)),
+                Added::Conflict { .. }
+            ));
+            assert_eq!(c2.status(), FusedStatus::Inconsistent);
+        }
+        let (c, added) = fuse(wide, narrow);
+        assert_eq!(added, Added::Agreed);
+        assert_eq!(c.status(), FusedStatus::Consistent);
+        assert!(c.admitted(2));
+        // A range constraint down to 5 (below U = 6): flagged.
+        let mut c3 = c;
+        let added = c3.add_sighted(5.0, 12.0, &s, (s.down(5.0), SEEN_ANY));
+        assert!(matches!(added, Added::Unseen { .. }));
+        // The counts: an admitted point leaves the admitted.
+        let (mut adm, mut inc) = (1u16, 0u16);
+        count(added, &c3, 2, &mut adm, &mut inc);
+        assert_eq!((adm, inc), (0, 0));
+    }
+
     #[test]
     fn a_wrong_pair_is_flagged_and_outvoted() {
         let mut c = Cell::EMPTY;
@@ -971,7 +1030,7 @@ mod tests {
     fn a_fresh_key_frame_shows_none_of_the_previous_ones_cells() {
         extern crate std;
         use std::format;
-        let mut k = KeyFrame::<4, 1>::new(sc(), 1);
+        let mut k = KeyFrame::<4, 1>::new(sc(), 1, false);
         k.start(1, [3]);
         for i in 0..3 {
             k.constrain(0, i, 7.0, 7.5 + i as f32);

@@ -408,6 +408,16 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         self.map.clear();
     }
 
+    /// [`Fusion::reset`] with the policy `config` from now on (the map's
+    /// tilt, its admission, the key-frame rule, the sight check).
+    pub fn reset_with(&mut self, config: FusionConfig) {
+        self.reset();
+        self.config = config;
+        self.key
+            .reconfigure(config.map_min_pairs, config.sight_check);
+        self.map.clear_tilted(config.tilt_sc);
+    }
+
     /// Process frame `id` with the motion from the last accepted frame
     /// (ignored for the first frame, or the first after
     /// [`Fusion::reset`]).

@@ -158,7 +158,11 @@ impl Sight {
             r1[0] * x + r1[1] * y + r1[2],
             r2[0] * x + r2[1] * y + r2[2],
         ];
-        let p = [d * a[0] - self.b[0], d * a[1] - self.b[1], d * a[2] - self.b[2]];
+        let p = [
+            d * a[0] - self.b[0],
+            d * a[1] - self.b[1],
+            d * a[2] - self.b[2],
+        ];
         // At infinity the direction `a` (the key pixel's error alone), at
         // `d` the point `P` (the translation's too). (A NaN fails.)
         let [delta, e1] = self.err;
@@ -186,36 +190,65 @@ impl Sight {
         let (w, k) = (self.win, self.side);
         let [delta, e1] = self.err;
         // (Side: the coefficient of the depth and the bound's right-hand
-        // side, `d (c·a − k ε₁) ≥ c·b + k δ`.)
+        // side, `d (c·a − k ε₁) ≥ c·b + k δ`, and the sums of their terms'
+        // magnitudes, which bound their rounding.)
         let sides = [
-            (a[2], b[2]),
+            ((a[2], a[2].abs()), (b[2], b[2].abs())),
             (
-                a[0] - w[0] * a[2] - k[0] * e1,
-                b[0] - w[0] * b[2] + k[0] * delta,
+                (
+                    a[0] - w[0] * a[2] - k[0] * e1,
+                    a[0].abs() + (w[0] * a[2]).abs() + k[0] * e1,
+                ),
+                (
+                    b[0] - w[0] * b[2] + k[0] * delta,
+                    b[0].abs() + (w[0] * b[2]).abs() + k[0] * delta,
+                ),
             ),
             (
-                w[1] * a[2] - a[0] - k[1] * e1,
-                w[1] * b[2] - b[0] + k[1] * delta,
+                (
+                    w[1] * a[2] - a[0] - k[1] * e1,
+                    (w[1] * a[2]).abs() + a[0].abs() + k[1] * e1,
+                ),
+                (
+                    w[1] * b[2] - b[0] + k[1] * delta,
+                    (w[1] * b[2]).abs() + b[0].abs() + k[1] * delta,
+                ),
             ),
             (
-                a[1] - w[2] * a[2] - k[2] * e1,
-                b[1] - w[2] * b[2] + k[2] * delta,
+                (
+                    a[1] - w[2] * a[2] - k[2] * e1,
+                    a[1].abs() + (w[2] * a[2]).abs() + k[2] * e1,
+                ),
+                (
+                    b[1] - w[2] * b[2] + k[2] * delta,
+                    b[1].abs() + (w[2] * b[2]).abs() + k[2] * delta,
+                ),
             ),
             (
-                w[3] * a[2] - a[1] - k[3] * e1,
-                w[3] * b[2] - b[1] + k[3] * delta,
+                (
+                    w[3] * a[2] - a[1] - k[3] * e1,
+                    (w[3] * a[2]).abs() + a[1].abs() + k[3] * e1,
+                ),
+                (
+                    w[3] * b[2] - b[1] + k[3] * delta,
+                    (w[3] * b[2]).abs() + b[1].abs() + k[3] * delta,
+                ),
             ),
         ];
         let mut e = 0.0f32;
-        for (c, rhs) in sides {
-            // (A NaN fails: not seen.)
-            if !(c > 0.0) {
+        for ((c, c_abs), (rhs, rhs_abs)) in sides {
+            // Each rounded by at most a few units of the last place of its
+            // terms' magnitudes (`a`, `b` and `w` themselves by as much):
+            // `2⁻²⁰` of them, against the bound. (A NaN fails: not seen.)
+            let c_lo = c - c_abs * POS_ERR;
+            if !(c_lo > 0.0) {
                 return f32::INFINITY;
             }
-            e = fmax(e, rhs / c);
+            e = fmax(e, (rhs + rhs_abs * POS_ERR) / c_lo);
         }
-        // (The bounds' rounding, a few ulps of their terms: 1e-5 over.)
-        let e = e * (1.0 + 1.0e-5) + 1.0e-30;
+        // (The division's rounding, and the probe's, `Self::sees_from`,
+        // whose own terms round at `d` about as these do.)
+        let e = e * (1.0 + POS_ERR);
         if e.is_finite() {
             e
         } else {
@@ -223,6 +256,10 @@ impl Sight {
         }
     }
 }
+
+/// The relative rounding allowed for the sight's linear terms: `2⁻²⁰`
+/// (each term is a handful of `f32` operations, `2⁻²⁴` each).
+const POS_ERR: f32 = 9.54e-7;
 
 /// `q` in front of the camera and inside the window's cone, each side by
 /// `side · e` (`q` off by at most `e` in each coordinate stays inside).
@@ -233,4 +270,100 @@ fn inside(q: [f32; 3], win: &[f32; 4], side: &[f32; 4], e: f32) -> bool {
         && win[1] * q[2] - q[0] >= side[1] * e
         && q[1] - win[2] * q[2] >= side[2] * e
         && win[3] * q[2] - q[1] >= side[3] * e
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_rng::Rng;
+
+    fn cam() -> Camera {
+        Camera::new(800.0, 780.0, 255.5, 239.5, 512, 480).unwrap()
+    }
+
+    /// A random forward-ish motion, rotations up to 0.1 rad an axis.
+    fn motion(g: &mut Rng) -> Motion {
+        let t = [g.next() - 0.5, 0.4 * (g.next() - 0.5), 0.2 + 2.0 * g.next()];
+        let r = [
+            0.2 * (g.next() - 0.5),
+            0.2 * (g.next() - 0.5),
+            0.2 * (g.next() - 0.5),
+        ];
+        Motion::new(t, r).unwrap()
+    }
+
+    /// The exact depth from which the partner sees a ray is where the probe
+    /// turns from no to yes: the probe says yes just above it and at every
+    /// depth beyond (up to 10⁴ times it), no 10 % below (and 0.1 % below
+    /// in all but 1 % of the cases: the rounding allowed); where it says
+    /// the far end is not seen, no probe says yes.
+    #[test]
+    fn the_exact_depth_is_where_the_probe_turns() {
+        let mut g = Rng(0x5EED_0007);
+        let (mut finite, mut unseen, mut loose) = (0, 0, 0usize);
+        for case in 0..20_000 {
+            let cfg = Config::DEFAULT
+                .with_translation_error(0.02 * g.next())
+                .unwrap()
+                .with_rotation_error([0.002 * g.next(); 3])
+                .unwrap();
+            let m = motion(&mut g);
+            let rows = [
+                Pixel::new(100.0, 80.0 + 200.0 * g.next()),
+                Pixel::new(300.0, 300.0 + 180.0 * g.next()),
+            ];
+            let Some(s) = Sight::new(&cam(), &cam(), &rows, &m, &cfg) else {
+                continue;
+            };
+            let p = Pixel::new(512.0 * g.next(), 480.0 * g.next());
+            let e = s.seen_from(p);
+            if e == f32::INFINITY {
+                unseen += 1;
+                for d in [0.1, 1.0, 10.0, 100.0, 1.0e4] {
+                    assert!(!s.sees_from(p, d), "case {case}: seen at {d}");
+                }
+                continue;
+            }
+            finite += 1;
+            assert!(e >= 0.0, "case {case}: {e}");
+            for k in [1.0001f32, 1.01, 2.0, 10.0, 1.0e4] {
+                let d = fmax(e, 1.0e-3) * k;
+                assert!(s.sees_from(p, d), "case {case}: not seen at {d} (from {e})");
+            }
+            if e > 1.0e-3 {
+                // (Rounded up by the terms' rounding: where a side is
+                // nearly along the ray it can be loose, never by much.)
+                assert!(!s.sees_from(p, e * 0.9), "case {case}: seen below {e}");
+                loose += usize::from(s.sees_from(p, e * 0.999));
+            }
+        }
+        assert!(finite > 2_000 && unseen > 2_000, "{finite} / {unseen}");
+        assert!(loose * 100 < finite, "{loose} of {finite} loose by 0.1 %");
+    }
+
+    /// The window: the image's columns and the boundary's rows, each shrunk
+    /// by the margin `e₂ + f Σε`; a boundary's rows narrower than twice
+    /// the margin see nothing.
+    #[test]
+    fn the_window_is_the_columns_and_the_boundarys_rows() {
+        let m = Motion::new([0.0, 0.0, 1.0], [0.0; 3]).unwrap();
+        let cfg = Config::DEFAULT;
+        let rows = [Pixel::new(10.0, 200.0), Pixel::new(20.0, 300.0)];
+        let s = Sight::new(&cam(), &cam(), &rows, &m, &cfg).unwrap();
+        // A point on the optical axis's row band, far: seen from about
+        // where its image reaches the window's edge.
+        let inside = Pixel::new(255.5, 250.0);
+        assert!(s.sees_from(inside, 1.0e3));
+        let above = Pixel::new(255.5, 150.0);
+        assert!(!s.sees_from(above, 1.0e3), "rows above the boundary's");
+        let e = s.seen_from(inside);
+        // v − c_y = 10.5 at infinity; at depth d it is 10.5 d/(d − 1),
+        // the window's last row 300 − e₂ − 0 (no rotation error).
+        let limit = 300.0 - cfg.e2() - 239.5;
+        let expect = limit / (limit - 10.5);
+        assert!((e - expect).abs() < 0.05 * expect, "{e} against {expect}");
+        let thin = [Pixel::new(10.0, 200.0), Pixel::new(20.0, 200.5)];
+        assert!(Sight::new(&cam(), &cam(), &thin, &m, &cfg).is_none());
+        assert!(Sight::new(&cam(), &cam(), &[], &m, &cfg).is_none());
+    }
 }

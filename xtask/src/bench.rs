@@ -140,6 +140,7 @@ pub fn bench(b: &Budget) -> Result<(), String> {
     deadline_table(&log, b.deadline(), &mut misses);
     drive_within(&log, b.deadline(), &mut misses);
     drive_counted(&log, b.deadline(), &mut misses);
+    drive_sighted(&log, &mut misses);
     fusion_table(&log, &per, b, &mut misses);
     memory_table(&log, &demo_elf, b, &mut misses)?;
     wire_table(&log, &mut misses);
@@ -599,6 +600,65 @@ the demo drive's fusion steps with the counting rule for folded points (`Fusion:
     println!(
         "with the counting rule: every step within {worst} instructions ({:.1} % of the deadline {deadline}), {over} over it; ok points over the drive's pairs {ok} ({ok0} without the rule), folded {folded} ({folded0})",
         100.0 * worst as f64 / deadline as f64
+    );
+}
+
+/// The demo drive's fusion steps with the sight check on (firmware
+/// `fusion_sighted`: `FusionConfig::with_sight_check`), against the same
+/// steps without it: per paired frame the fusion's and the map's own
+/// instructions (the step less the matching of the run without it, the
+/// same pair), per key-frame point, and the key frame's consistent and
+/// partly unseen points. Reported, not budgeted (the check is off by
+/// default); hard check: the rows are there.
+fn drive_sighted(log: &str, misses: &mut Vec<String>) {
+    let rows = records(log, "fusion_sighted frame=");
+    if rows.is_empty() {
+        misses.push("no fusion_sighted rows in the bench log".into());
+        return;
+    }
+    let plain: BTreeMap<u64, (u64, u64, u64, u64)> = records(log, "fusion frame=")
+        .iter()
+        .map(|r| {
+            let f = num(r, "frame");
+            (
+                f,
+                (
+                    num(r, "step_instr"),
+                    num(r, "matching_instr"),
+                    num(r, "points"),
+                    num(r, "map"),
+                ),
+            )
+        })
+        .collect();
+    println!(
+        "
+the demo drive's fusion steps with the sight check on (`FusionConfig::with_sight_check`; off in every other figure):"
+    );
+    println!("| frame | step (without the check) | fusion and map (without) | per key-frame point (without) | consistent | partly unseen | map points (without) |");
+    println!("|---:|---:|---:|---:|---:|---:|---:|");
+    let (mut worst, mut worst0) = (0u64, 0u64);
+    for r in &rows {
+        if field(r, "paired") != Some("true") {
+            continue;
+        }
+        let f = num(r, "frame");
+        let step = num(r, "step_instr");
+        let (s0, m0, pts, map0) = plain.get(&f).copied().unwrap_or((0, 0, 1, 0));
+        let own = step.saturating_sub(m0);
+        let own0 = s0.saturating_sub(m0);
+        let (pp, pp0) = (own / pts.max(1), own0 / pts.max(1));
+        worst = worst.max(pp);
+        worst0 = worst0.max(pp0);
+        println!(
+            "| {f} | {step} ({s0}) | {own} ({own0}) | {pp} ({pp0}) | {} | {} | {} ({map0}) |",
+            num(r, "consistent"),
+            num(r, "partly_unseen"),
+            num(r, "map")
+        );
+    }
+    println!(
+        "with the sight check: the fusion and map's own work at most {worst} instructions a key-frame point ({worst0} without it)"
     );
 }
 

@@ -98,7 +98,8 @@ fn main() -> ! {
         FusionConfig::new(black_box(8), black_box(500))
             .and_then(|c| c.with_tilt(black_box(0.4)))
             .and_then(|c| c.with_map_min_pairs(black_box(2)))
-            .unwrap_or_default(),
+            .unwrap_or_default()
+            .with_sight_check(black_box(true)),
     );
     let mut id = 0u32;
     let mut points = [Pixel::default(); N];
@@ -204,6 +205,9 @@ fn main() -> ! {
             for p in k.points(black_box(1)) {
                 black_box(p);
             }
+        }
+        if black_box(false) {
+            fusion.reset_with(FusionConfig::DEFAULT.with_sight_check(black_box(false)));
         }
         let kp = fusion.key_point(black_box(1), black_box(7));
         black_box((kp, kp.and_then(|p| p.stick())));

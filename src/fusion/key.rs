@@ -551,8 +551,6 @@ pub struct KeyFrame<const N: usize, const B: usize> {
     /// Since [`KeyFrame::start`], no pair and no range constraint: every
     /// point is unmatched, whatever its cell holds.
     fresh: bool,
-    /// The sight check is on ([`super::FusionConfig::with_sight_check`]).
-    sighted: bool,
 }
 
 /// The live cells of a key frame, boundary by boundary ([`KeyFrame`]'s
@@ -585,7 +583,7 @@ impl<const N: usize, const B: usize> fmt::Debug for KeyFrame<N, B> {
 }
 
 impl<const N: usize, const B: usize> KeyFrame<N, B> {
-    pub(crate) const fn new(scale: DepthScale, min_pairs: u8, sighted: bool) -> Self {
+    pub(crate) const fn new(scale: DepthScale, min_pairs: u8) -> Self {
         Self {
             cells: [[Cell::EMPTY; N]; B],
             lens: [0; B],
@@ -597,7 +595,6 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
             best_matched: 0,
             scale,
             fresh: false,
-            sighted,
         }
     }
 
@@ -750,25 +747,20 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
         out
     }
 
-    /// Whether the sight check is on.
-    pub(crate) fn sighted(&self) -> bool {
-        self.sighted
-    }
-
-    /// A new policy's map admission and sight check (before the next
-    /// key frame starts: [`super::Fusion::reset_with`]).
-    pub(crate) fn reconfigure(&mut self, min_pairs: u8, sighted: bool) {
+    /// A new policy's map admission (before the next key frame starts:
+    /// [`super::Fusion::reset_with`]).
+    pub(crate) fn reconfigure(&mut self, min_pairs: u8) {
         self.min_pairs = min_pairs;
-        self.sighted = sighted;
     }
 
-    /// Fuse an outside interval into point `index` of `boundary`.
+    /// Fuse an outside interval into point `index` of `boundary` (with the
+    /// sight check when `sighted`).
     pub(crate) fn constrain(
         &mut self,
         boundary: usize,
         index: usize,
-        near: f32,
-        far: f32,
+        (near, far): (f32, f32),
+        sighted: bool,
     ) -> Option<Added> {
         let len = usize::from(*self.lens.get(boundary)?);
         if index >= len {
@@ -777,7 +769,7 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
         self.unfresh();
         let (scale, min) = (self.scale, self.min_pairs);
         let c = self.cells.get_mut(boundary)?.get_mut(index)?;
-        let added = if self.sighted {
+        let added = if sighted {
             c.add_sighted(near, far, &scale, (scale.down(near), SEEN_ANY))
         } else {
             c.add(near, far, &scale)
@@ -1030,10 +1022,10 @@ mod tests {
     fn a_fresh_key_frame_shows_none_of_the_previous_ones_cells() {
         extern crate std;
         use std::format;
-        let mut k = KeyFrame::<4, 1>::new(sc(), 1, false);
+        let mut k = KeyFrame::<4, 1>::new(sc(), 1);
         k.start(1, [3]);
         for i in 0..3 {
-            k.constrain(0, i, 7.0, 7.5 + i as f32);
+            k.constrain(0, i, (7.0, 7.5 + i as f32), false);
         }
         assert_eq!(k.point(0, 2).unwrap().status, FusedStatus::Single);
         // The next key frame: its cells are not cleared, but nothing sees
@@ -1047,7 +1039,7 @@ mod tests {
             "{shown}"
         );
         // A range constraint on a fresh key frame: that point only.
-        k.constrain(0, 1, 3.0, 4.0);
+        k.constrain(0, 1, (3.0, 4.0), false);
         let st: [FusedStatus; 3] = core::array::from_fn(|i| k.point(0, i).unwrap().status);
         let (u, s1) = (FusedStatus::Unmatched, FusedStatus::Single);
         assert_eq!(st, [u, s1, u]);

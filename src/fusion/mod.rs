@@ -384,7 +384,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             processor: Processor::new(base),
             base,
             config,
-            key: KeyFrame::new(scale, config.map_min_pairs, config.sight_check),
+            key: KeyFrame::new(scale, config.map_min_pairs),
             has_key: false,
             chain: Chain::IDENTITY,
             last: None,
@@ -413,8 +413,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     pub fn reset_with(&mut self, config: FusionConfig) {
         self.reset();
         self.config = config;
-        self.key
-            .reconfigure(config.map_min_pairs, config.sight_check);
+        self.key.reconfigure(config.map_min_pairs);
         self.map.clear_tilted(config.tilt_sc);
     }
 
@@ -586,7 +585,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         // (The composition's rounding, which the processor carries.)
         self.pair_rounding = rounding;
         // (The pair's configuration, for the sight check's margins.)
-        let cfg = self.key.sighted().then(|| *self.processor.config());
+        let cfg = self.config.sight_check.then(|| *self.processor.config());
         match self.processor.process_composed_within(
             frame,
             motion,
@@ -594,18 +593,10 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             !last_partner,
             deadline,
         ) {
-            Ok(s) => {
-                // What the partner sees of each boundary's rays.
-                let key_cam = s.camera1();
-                let Some(cfg) = cfg else {
-                    return self.key.fuse(s);
-                };
-                let sights: [Option<sight::Sight>; B] = core::array::from_fn(|k| {
-                    let points = frame.boundaries().get(k).map_or(&[][..], |b| b.points());
-                    sight::Sight::new(key_cam, frame.camera(), points, motion, &cfg)
-                });
-                self.key.fuse_sighted(s, &sights)
-            }
+            Ok(s) => match cfg {
+                None => self.key.fuse(s),
+                Some(cfg) => fuse_sighted(&mut self.key, s, (frame, motion, &cfg)),
+            },
             // (A kept frame exists: not reached.)
             Err(_) => PairFused::default(),
         }
@@ -760,7 +751,10 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             return Err(FusionError::InvalidRange);
         }
         self.settle();
-        match self.key.constrain(boundary, index, zn, zf) {
+        match self
+            .key
+            .constrain(boundary, index, (zn, zf), self.config.sight_check)
+        {
             Some(Added::Agreed | Added::Unseen { .. } | Added::Conflict { .. }) => {}
             None => return Err(FusionError::NoSuchPoint),
         }
@@ -911,3 +905,20 @@ const _: () = assert!(
     core::mem::size_of::<Fusion<256, 2, 512>>() - core::mem::size_of::<Processor<256, 2>>()
         <= 24 * 1024
 );
+
+/// [`KeyFrame::fuse_sighted`] for a pair with `partner` under `motion`
+/// and the pair's configuration: what the partner sees of each
+/// boundary's rays first (`sight`). Out of line, so that a step without
+/// the check keeps its stack.
+#[inline(never)]
+fn fuse_sighted<const N: usize, const B: usize>(
+    key: &mut KeyFrame<N, B>,
+    s: &Structure<N, B>,
+    (partner, motion, cfg): (&Frame<N, B>, &Motion, &Config),
+) -> PairFused {
+    let sights: [Option<sight::Sight>; B] = core::array::from_fn(|k| {
+        let points = partner.boundaries().get(k).map_or(&[][..], |b| b.points());
+        sight::Sight::new(s.camera1(), partner.camera(), points, motion, cfg)
+    });
+    key.fuse_sighted(s, &sights)
+}

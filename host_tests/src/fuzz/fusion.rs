@@ -75,6 +75,10 @@ pub struct PolicyIn {
     pub min_pairs: Option<u8>,
     /// [`FusionConfig::with_tilt`].
     pub tilt: Option<f32>,
+    /// [`FusionConfig::with_sight_check`] (drawn after everything else: a
+    /// case saved before it reads what follows its draws, or 0, the check
+    /// off).
+    pub sight: bool,
 }
 
 /// One call.
@@ -142,6 +146,7 @@ fn policy(src: &mut Source) -> PolicyIn {
         new: (partners, keep),
         min_pairs,
         tilt,
+        sight: false,
     }
 }
 
@@ -304,6 +309,7 @@ pub fn generate(src: &mut Source) -> Case {
             last = Some(id);
         }
     }
+    policy.sight = !src.chance(1, 2);
     Case {
         large,
         config,
@@ -336,8 +342,11 @@ pub mod bit {
     pub const MAP_POINTS: u32 = 93;
     pub const FULL_BATCHES: u32 = 94;
     pub const BLANK_PAIRED: u32 = 95;
+    /// The sight check's flag seen (`FusedStatus::PartlyUnseen`, apart
+    /// from `STATUS`'s four, added before it).
+    pub const PARTLY_UNSEEN: u32 = 96;
     /// One past the last.
-    pub const END: u32 = 96;
+    pub const END: u32 = 97;
 }
 
 use frame::set;
@@ -386,6 +395,7 @@ fn build_policy(p: &PolicyIn, features: &mut u128) -> FusionConfig {
             }
         }
     }
+    c = c.with_sight_check(p.sight);
     if let Some(t) = p.tilt {
         let ok = t.abs() <= core::f32::consts::FRAC_PI_2;
         match c.with_tilt(t) {
@@ -789,7 +799,7 @@ fn check_state<const N: usize, const B: usize, const M: usize>(
     if let Some(k) = f.key() {
         assert!(u32::from(k.partners()) <= allowed, "{at}: partners");
         assert!(k.boundaries() <= B, "{at}: boundaries");
-        let mut tally = [0u32; 4];
+        let mut tally = [0u32; 5];
         for b in 0..k.boundaries() {
             assert!(k.len(b) <= N, "{at}: boundary {b} length");
             let mut n = 0;
@@ -797,7 +807,14 @@ fn check_state<const N: usize, const B: usize, const M: usize>(
                 check_point(&p, &format!("{at}: key point {b}/{i}"));
                 assert_eq!(k.point(b, i), Some(p), "{at}: point({b}, {i})");
                 tally[p.status as usize] += 1;
-                set(features, bit::STATUS + p.status as u32);
+                set(
+                    features,
+                    if p.status == FusedStatus::PartlyUnseen {
+                        bit::PARTLY_UNSEEN
+                    } else {
+                        bit::STATUS + p.status as u32
+                    },
+                );
                 n += 1;
             }
             assert_eq!(n, k.len(b), "{at}: boundary {b}: one point each");
@@ -805,7 +822,13 @@ fn check_state<const N: usize, const B: usize, const M: usize>(
         }
         let c = k.counts();
         assert_eq!(
-            [c.unmatched, c.single, c.consistent, c.inconsistent],
+            [
+                c.unmatched,
+                c.single,
+                c.consistent,
+                c.inconsistent,
+                c.partly_unseen
+            ],
             tally,
             "{at}: counts"
         );

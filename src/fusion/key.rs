@@ -256,9 +256,7 @@ impl Cell {
     }
 
     /// [`Self::add`] with the sight check ([`super::sight`]): the interval's
-    /// sight `(h, u)` (codes) is the lowest depth the truth can have if
-    /// this pair is right (its near end, or the depth from which its
-    /// partner sees the ray if that is above) and the depth from which its
+    /// sight `(h, u)` (codes) is its near end and a depth from which its
     /// partner sees the ray (for a range constraint: its near end and
     /// [`SEEN_ANY`]). While no interval has missed the point, `H` and `U`
     /// take them in, and `H < U` flags it.
@@ -425,10 +423,10 @@ fn count(added: Added, c: &Cell, min: u8, admitted: &mut u16, inconsistent: &mut
 }
 
 /// The sight of the pair's interval for `r`'s point, for its cell `c`
-/// ([`Cell::add`], [`super::sight`]): the partner is probed from half the
-/// pairs' lowest depth `H` (this pair's near end counted); seen there, the
-/// sight is `(near, H/2)`; if not, the depth `e` from which it sees the ray
-/// is worked out, and the sight is `(max(near, e), e)`. A cell whose sight
+/// ([`Cell::add_sighted`], [`super::sight`]): its near end, and a depth
+/// from which the partner sees the ray, probed at half the pairs' lowest
+/// near end `H` (this pair's counted); where that fails, the exact depth
+/// ([`SEEN_NONE`] if the partner sees none of the ray). A cell whose sight
 /// is no longer watched gets `(0, SEEN_ANY)` (not looked at); a partner
 /// that sees nothing of the boundary (`sight` `None`), `(near, SEEN_NONE)`.
 #[inline(always)]
@@ -445,19 +443,19 @@ fn sight_of(c: &Cell, r: &PointResult, sight: Option<&Sight>, scale: &DepthScale
     if sight.sees_from(r.pixel1, half) {
         return (near, scale.up(half));
     }
-    sight_exact(r.pixel1, near, sight, scale)
+    (near, sight_exact(r.pixel1, sight, scale))
 }
 
-/// [`sight_of`] where the probe failed (out of line: rare).
+/// [`sight_of`] where the probe failed: the exact depth's code (out of
+/// line: rare).
 #[inline(never)]
-fn sight_exact(p: Pixel, near: u16, sight: &Sight, scale: &DepthScale) -> (u16, u16) {
+fn sight_exact(p: Pixel, sight: &Sight, scale: &DepthScale) -> u16 {
     let e = sight.seen_from(p);
     if e == f32::INFINITY {
-        return (near, SEEN_NONE);
+        SEEN_NONE
+    } else {
+        scale.up(e)
     }
-    let u = scale.up(e);
-    // (Codes compare as depths: at `e`'s, when it is above the near end.)
-    (near.max(u), u)
 }
 
 /// The first pair of a fresh key frame on one boundary ([`KeyFrame::fuse`]):

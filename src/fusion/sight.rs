@@ -17,19 +17,25 @@
 //! # The rule
 //! Say a pair `c` is *right* when the point's true correspondent is in
 //! its partner's data: its stick `S_c` holds the truth. Suppose one pair is
-//! right. If every pair's stick lies in what every *other* partner `j`
-//! sees along the ray (`S_i ⊂ V_j`), then the truth (in `S_c`) is seen by
-//! every partner, every partner's match is the correspondent's, and every
-//! stick holds the truth: so does their intersection. With `H` the lowest
-//! near end of the point's sticks (their hull's) and `U` a depth from
-//! which every partner so far was shown to see the ray (`V_j ⊃ [U, ∞)`),
-//! `H ≥ U` gives `S_i ⊂ [H, ∞) ⊂ V_j` for all of them. Both are running
-//! extremes, so the test does not depend on the pairs' order: a point
-//! whose pairs break it is flagged `PartlyUnseen` for good (out of the
-//! map), whichever pair came first. (A pair's own stick need not lie in
-//! what its own partner sees: if it is the right one, the truth is seen by
-//! definition. A first pair therefore never flags.) If no pair is right,
-//! nothing in the views can tell: `docs/FUSION.md`, "Limits".
+//! right. If every pair's stick lies in what every partner `j` was shown
+//! to see along the ray (`S_i ⊂ V_j`), then the truth (in `S_c`) is seen
+//! by every partner, every partner's match is the correspondent's, and
+//! every stick holds the truth: so does their intersection. With `H` the
+//! lowest near end of the point's sticks (their hull's) and `U` a depth
+//! from which every partner so far was shown to see the ray (`V_j ⊃ [U,
+//! ∞)`), `H ≥ U` gives `S_i ⊂ [H, ∞) ⊂ V_j` for all of them. Both are
+//! running extremes, so the test does not depend on the pairs' order: a
+//! point whose pairs break it is flagged `PartlyUnseen` for good (out of
+//! the map), whichever pair came first. A first pair never flags (one
+//! stick, nothing to check). `H` is each stick's own near end, not raised
+//! to where its own partner was shown to see: the window is shrunk by the
+//! margins, so a right partner whose truth lies within them of its image's
+//! edge is shown to see only from beyond its truth, and raising `H` there
+//! let a wrong pair through (a second review's three views: a right stick
+//! `[9.58, 24.07]` whose truth, 13.69, was 0.8 px inside its partner's
+//! edge, and a wrong `[22.98, 28.06]`, fused `[22.98, 24.07]`). If no pair
+//! is right (two wrong pairs that agree), nothing in the views can tell:
+//! `docs/FUSION.md`, "Limits".
 //!
 //! # Seen from a depth on
 //! The ray's points at depths `[d, ∞)` map into the partner (motion
@@ -39,12 +45,17 @@
 //! `d` to the image at infinity, inside the convex window (the partner's
 //! columns and its boundary's rows, shrunk by a margin) when both ends are.
 //! The tests are linear in `P`: `P_x ≥ ū₀ P_z` and so on, no division.
-//! The margin covers what moves the true ray's image from the detected
-//! one's: `e₁ + e₂ + 1` pixels and the rotation error's `f ε` (in the
-//! window), the translation error `δ` (in the tests: `T` off by `δ` moves
-//! `P_x − ū P_z` by at most `δ (1 + |ū|)`). A margin, not a derived bound:
-//! the zero wrong unflagged fused points is what the tests show
-//! (`docs/FUSION.md`).
+//! The margins cover what moves the true ray's image from the detected
+//! one's, to first order: in the window, `e₂` (the polyline's own error)
+//! and the rotation error's `f Σε (1 + ū² + v̄²)` (a turn `ε` about the
+//! partner's axes moves a normalised image point by at most `Σε (1 + x² +
+//! y²)` in each coordinate); in the tests, the translation error (`T` off
+//! by `δ` in each frame-1 axis is off by at most `√3 δ` in each partner
+//! axis, which moves `P_x − ū P_z` by at most `√3 δ (1 + |ū|)`) and the key
+//! pixel's `e₁` (its ray's direction off by `ε₁ = e₁/f`, so `P` by `ε₁ d`).
+//! First-order margins, not a derived bound: the zero wrong unflagged
+//! fused points is what the tests show (`docs/FUSION.md`), and two wrong
+//! pairs that agree are beyond any margin ("Limits").
 //!
 //! A point's `U` is set by probing: each pair `j` asks whether its partner
 //! sees the ray from `H/2` (`H` counting this pair's stick), then from
@@ -73,8 +84,9 @@ pub(crate) struct Sight {
     /// `win`: a change of `P` by at most `ε` in each coordinate moves the
     /// side's value `P_x − ū P_z` (and so on) by at most `ε (1 + |ū|)`.
     side: [f32; 4],
-    /// The translation error `δ` and the key pixel's, `ε₁ = e₁/min(f)`
-    /// (normalised): the slack of a side at depth `d` is `(1 + |ū|)(δ + ε₁ d)`.
+    /// The translation error in partner axes, `√3 δ`, and the key pixel's,
+    /// `ε₁ = e₁/min(f)` (normalised): the slack of a side at depth `d` is
+    /// `(1 + |ū|)(√3 δ + ε₁ d)`.
     err: [f32; 2],
 }
 
@@ -107,13 +119,18 @@ impl Sight {
             rt[1][0] * t[0] + rt[1][1] * t[1] + rt[1][2] * t[2],
             rt[2][0] * t[0] + rt[2][1] * t[1] + rt[2][2] * t[2],
         ];
-        let eps = cfg.rotation_error();
-        let margin = cfg.e2() + fmax(cam.fx(), cam.fy()) * (eps[0] + eps[1] + eps[2]);
         let (v_lo, v_hi) = if first.v <= last.v {
             (first.v, last.v)
         } else {
             (last.v, first.v)
         };
+        // The rotation error's shift, from the window before its margin
+        // (module docs).
+        let eps = cfg.rotation_error();
+        let mu = fmax(cam.cx(), f32::from(cam.width()) - 1.0 - cam.cx()).abs() / cam.fx();
+        let mv = fmax((v_lo - cam.cy()).abs(), (v_hi - cam.cy()).abs()) / cam.fy();
+        let turn = (eps[0] + eps[1] + eps[2]) * (1.0 + mu * mu + mv * mv);
+        let margin = cfg.e2() + fmax(cam.fx(), cam.fy()) * turn;
         let (u0, u1) = (margin, f32::from(cam.width()) - 1.0 - margin);
         let (v0, v1) = (v_lo + margin, v_hi - margin);
         // (A NaN fails.)
@@ -127,8 +144,9 @@ impl Sight {
             (v1 - cam.cy()) / cam.fy(),
         ];
         let side = win.map(|w| 1.0 + w.abs());
+        // (`√3` rounded up: the translation's error in partner axes.)
         let err = [
-            cfg.translation_error(),
+            cfg.translation_error() * 1.7321,
             cfg.e1() / fmin(key_cam.fx(), key_cam.fy()),
         ];
         Some(Self {

@@ -1244,6 +1244,100 @@ fn the_sight_check_on_the_random_drives() {
     );
 }
 
+/// A second review's three views (`tests/data/sight_margin_case.txt`;
+/// exact motions and pixels, `e₁ = e₂ = 0.5`): the key point's truth, at
+/// depth 13.69, is seen by partner 1 (its stick `[9.58, 24.07]` holds it),
+/// 0.8 px inside that partner's left edge; partner 2, 6 ahead, 2 left and
+/// turned 0.16 rad, sees it off its image and matches another stretch,
+/// `[22.98, 28.06]`. Without the sight check the point is `Consistent` at
+/// `[22.98, 24.07]` and enters the map (the limit); with it on it is
+/// `PartlyUnseen`. (Before the check took each stick's own near end for
+/// `H`, it raised partner 1's to where its shrunk window let it see, past
+/// the truth, and let this through.)
+#[test]
+fn the_sight_check_catches_a_wrong_pair_beside_a_right_one_at_the_edge() {
+    let text = include_str!("data/sight_margin_case.txt");
+    let (mut poses, mut polys) = (Vec::new(), Vec::new());
+    for line in text.lines().filter(|l| !l.starts_with('#')) {
+        let (kind, rest) = line.split_once(' ').expect("a line");
+        let v: Vec<f64> = rest
+            .split(' ')
+            .map(|x| x.parse().expect("a number"))
+            .collect();
+        match kind {
+            "pose" => poses.push(([v[0], v[1], v[2]], [v[3], v[4], v[5]])),
+            "poly" => polys.push(
+                v.chunks(2)
+                    .map(|c| Pixel::new(c[0] as f32, c[1] as f32))
+                    .collect::<Vec<_>>(),
+            ),
+            _ => panic!("{kind}"),
+        }
+    }
+    assert_eq!((poses.len(), polys.len()), (4, 4));
+    let (key_index, truth) = (13usize, 13.693_010_897_123_422_f64);
+    let cam = roadstereo::Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).expect("camera");
+    let config = Config::new(0.5, 0.5, 10.0, 1000.0).expect("config");
+    let run = |on: bool| {
+        let policy = FusionConfig::new(2, 0)
+            .and_then(|p| p.with_map_min_pairs(2))
+            .expect("policy")
+            .with_sight_check(on);
+        let mut f = Box::new(HostFusion::new(config, policy));
+        let mut last = None;
+        for (j, (pose, poly)) in poses.iter().zip(&polys).enumerate() {
+            let mut fr = Frame::<N, B>::new(cam);
+            fr.push_boundary(poly).expect("valid");
+            // The motion from the frame before: `R₀ᵀ (c₁ − c₀)` and the
+            // turn between them (here either the one before is unturned or
+            // both are turned alike).
+            let m = (j > 0).then(|| {
+                let (a0, c0) = poses[j - 1];
+                let (a1, c1) = *pose;
+                let r0 = Motion::new([0.0, 0.0, 1.0], a0.map(|x| x as f32))
+                    .expect("turn")
+                    .rotation_matrix();
+                let d = [c1[0] - c0[0], c1[1] - c0[1], c1[2] - c0[2]];
+                let t: [f32; 3] = core::array::from_fn(|i| {
+                    (0..3).map(|k| f64::from(r0[k][i]) * d[k]).sum::<f64>() as f32
+                });
+                let turn = if a0 == [0.0; 3] {
+                    a1
+                } else {
+                    assert_eq!(a0, a1, "turned alike");
+                    [0.0; 3]
+                };
+                ChainedMotion {
+                    from: j as u32 - 1,
+                    motion: Motion::new(t, turn.map(|x| x as f32)).expect("motion"),
+                }
+            });
+            f.step(j as u32, &fr, m.as_ref()).expect("step");
+            if let Some(k) = f.key().filter(|k| k.id() == 0) {
+                last = k.point(0, key_index);
+            }
+        }
+        last.expect("the key point")
+    };
+    let holds = |p: &roadstereo::fusion::FusedPoint| {
+        p.interval
+            .is_some_and(|i| f64::from(i.z_near) <= truth && truth <= f64::from(i.z_far))
+    };
+    let off = run(false);
+    assert_eq!(
+        (off.status, off.pairs),
+        (FusedStatus::Consistent, 2),
+        "{off:?}"
+    );
+    assert!(!holds(&off), "the limit: a wrong fused interval {off:?}");
+    let on = run(true);
+    assert_eq!(
+        (on.status, on.pairs),
+        (FusedStatus::PartlyUnseen, 2),
+        "{on:?}"
+    );
+}
+
 /// The limit of the consistency check, pinned (`docs/FUSION.md`, "Limits"; found by
 /// an adversarial review, reduced from its crest family): every pair's
 /// stick is guaranteed only where the point's true correspondent is in

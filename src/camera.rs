@@ -108,7 +108,20 @@ impl Camera {
     /// assert_eq!(Camera::new(f32::NAN, 800.0, 255.5, 239.5, 512, 480), Err(CameraError::NotFinite));
     /// # Ok::<(), CameraError>(())
     /// ```
-    pub fn new(
+    ///
+    /// `const`, so a camera (and a [`crate::Frame`] of it) can be built at
+    /// compile time, e.g. in a `static`:
+    ///
+    /// ```
+    /// use roadstereo::{Camera, Frame};
+    /// const CAM: Camera = match Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480) {
+    ///     Ok(c) => c,
+    ///     Err(_) => panic!("a valid camera"),
+    /// };
+    /// static FRAME: Frame<64, 2> = Frame::new(CAM);
+    /// assert_eq!(FRAME.camera().width(), 512);
+    /// ```
+    pub const fn new(
         fx: f32,
         fy: f32,
         cx: f32,
@@ -119,14 +132,15 @@ impl Camera {
         if !(fx.is_finite() && fy.is_finite() && cx.is_finite() && cy.is_finite()) {
             return Err(CameraError::NotFinite);
         }
-        if !(2..=MAX_IMAGE_SIDE).contains(&width) || !(2..=MAX_IMAGE_SIDE).contains(&height) {
+        if width < 2 || width > MAX_IMAGE_SIDE || height < 2 || height > MAX_IMAGE_SIDE {
             return Err(CameraError::ImageSize);
         }
-        if !((1.0..=1.0e5).contains(&fx) && (1.0..=1.0e5).contains(&fy)) {
+        if !(fx >= 1.0 && fx <= 1.0e5 && fy >= 1.0 && fy <= 1.0e5) {
             return Err(CameraError::FocalLength);
         }
-        let (w, h) = (f32::from(width), f32::from(height));
-        if !((0.0..=w - 1.0).contains(&cx) && (0.0..=h - 1.0).contains(&cy)) {
+        // (Exact: a `u16` is an `f32` exactly.)
+        let (w, h) = (width as f32, height as f32);
+        if !(cx >= 0.0 && cx <= w - 1.0 && cy >= 0.0 && cy <= h - 1.0) {
             return Err(CameraError::PrincipalPoint);
         }
         Ok(Self {

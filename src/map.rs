@@ -222,7 +222,9 @@ pub struct Retired {
     /// Points that entered the map.
     pub entered: u32,
     /// Points left out: fewer agreeing pairs than the configured minimum
-    /// (unmatched or single).
+    /// (unmatched, single, consistent with too few pairs), or flagged
+    /// `PartlyUnseen` by the sight check
+    /// ([`crate::fusion::FusionConfig::with_sight_check`]).
     pub unverified: u32,
     /// Points left out: inconsistent.
     pub inconsistent: u32,
@@ -409,7 +411,6 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         }
     }
 
-    /// Forget every point (the counters too).
     /// [`Self::clear`] for a camera tilted by the angle whose sine and
     /// cosine are `tilt`.
     pub(crate) fn clear_tilted(&mut self, tilt: (f32, f32)) {
@@ -417,6 +418,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         self.tilt = tilt;
     }
 
+    /// Forget every point (the counters too).
     pub(crate) fn clear(&mut self) {
         self.tail = [0; B];
         self.used = [0; B];

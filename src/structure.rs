@@ -150,7 +150,7 @@ pub struct StatusCounts {
 }
 
 /// The statuses by name with their counts, those with none left out:
-/// `{ok: 426, grazing: 3, ...}`.
+/// `{"ok": 426, "grazing": 3, ...}`.
 impl fmt::Debug for StatusCounts {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_map()

@@ -238,6 +238,15 @@ fn fusion_sighted(fusion: &mut Fusion<256, 2, 512>) -> bool {
             from: i.wrapping_sub(1),
             motion: m,
         });
+        // The stack of one step with the check on, on a copy (as
+        // `fusion_bench`'s: a retiring frame and the next).
+        if i == 8 || i == 9 {
+            let mut twin = fusion.clone();
+            let bytes = stack::high_water(|| {
+                let _ = black_box(twin.step(black_box(i), &frame, chained.as_ref()));
+            });
+            defmt::info!("fusion_sighted_stack frame={=u32} bytes={=u32}", i, bytes);
+        }
         let (result, instr) = fw::measure(|| fusion.step(black_box(i), &frame, chained.as_ref()));
         let Ok(step) = result else {
             return false;

@@ -142,11 +142,11 @@ pub struct KeyPoint {
 
 impl KeyPoint {
     /// The fused interval's ends (near, far) on the ray, in key-frame
-    /// camera coordinates, if the point has an interval (an inconsistent
-    /// point's is the majority's, whose far end may be infinite:
-    /// [`FusedPoint::interval`]).
+    /// camera coordinates, if the point has a bounded interval (`None`
+    /// also for an inconsistent point whose majority's far end is
+    /// unbounded: [`FusedPoint::interval`]).
     pub fn stick(&self) -> Option<([f32; 3], [f32; 3])> {
-        let i = self.fused.interval?;
+        let i = self.fused.interval.filter(|i| i.z_far.is_finite())?;
         let [x, y, _] = self.ray;
         Some((
             [x * i.z_near, y * i.z_near, i.z_near],
@@ -508,6 +508,7 @@ pub struct PairFused {
 /// Per-status counts of a key frame's points.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub struct FusedCounts {
     /// [`FusedStatus::Unmatched`] points.
     pub unmatched: u32,
@@ -939,7 +940,7 @@ mod tests {
     fn the_sight_check_flags_a_stick_its_partner_could_not_see_under() {
         let s = sc();
         let wide = (9.21, 371.0, (s.down(9.21), s.up(4.6)));
-        let wrong = (14.7, 16.9, (s.down(14.7).max(s.up(13.0)), s.up(13.0)));
+        let wrong = (14.7, 16.9, (s.down(14.7), s.up(13.0)));
         let narrow = (11.0, 12.5, (s.down(11.0), s.up(6.0)));
         let fuse = |a: (f32, f32, (u16, u16)), b: (f32, f32, (u16, u16))| {
             let mut c = Cell::EMPTY;

@@ -657,8 +657,13 @@ the demo drive's fusion steps with the sight check on (`FusionConfig::with_sight
             num(r, "map")
         );
     }
+    let stack = records(log, "fusion_sighted_stack frame=")
+        .iter()
+        .map(|r| num(r, "bytes"))
+        .max()
+        .unwrap_or(0);
     println!(
-        "with the sight check: the fusion and map's own work at most {worst} instructions a key-frame point ({worst0} without it)"
+        "with the sight check: the fusion and map's own work at most {worst} instructions a key-frame point ({worst0} without it); the stack of a step (frames 8 and 9) {stack} B"
     );
 }
 

@@ -488,7 +488,10 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// much of the key frame is still in view). The fusion's own work after
     /// the matching (one pass over the key frame's points, the map) is not
     /// cut: it is bounded by the points (`docs/FUSION.md`), so
-    /// leave room for it in the limit.
+    /// leave room for it in the limit: at most 74 instructions a key-frame
+    /// point on the demo drive, 187 with the sight check on
+    /// ([`FusionConfig::with_sight_check`]; 66 842 in its costliest frame
+    /// against 8 141 without).
     pub fn step_within<D: Deadline>(
         &mut self,
         id: u32,

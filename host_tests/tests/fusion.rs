@@ -1338,6 +1338,93 @@ fn the_sight_check_catches_a_wrong_pair_beside_a_right_one_at_the_edge() {
     );
 }
 
+/// The sight check's limit, pinned (`docs/FUSION.md`, "The sight check"):
+/// a review's side-exit drive (`tests/data/side_exit_two_wrong.txt`; exact
+/// motions and pixels). The key frame's point 10, at depth 10.12, has left
+/// its partners 12 and 13 at the side (38 and 47 px off their left edges);
+/// both match the same farther stretch of the boundary, their sticks
+/// overlap, and no partner that saw the truth gave a stick. The point comes
+/// out `Consistent` and wrong with the check off **and on**: every partner
+/// that gave a stick does see the depths the sticks allow, and with no
+/// right pair among them nothing in these views can tell. If a change
+/// catches it, this test fails: update the docs' limits with it.
+#[test]
+fn limit_two_wrong_pairs_at_a_side_exit_pass_the_sight_check() {
+    let text = include_str!("data/side_exit_two_wrong.txt");
+    let (mut config, mut truth) = (None, 0.0f64);
+    let (mut motions, mut frames) = (Vec::new(), Vec::<Vec<Vec<Pixel>>>::new());
+    let mut last_frame = String::new();
+    for line in text.lines().filter(|l| !l.starts_with('#')) {
+        let (kind, rest) = line.split_once(' ').expect("a line");
+        let v: Vec<f64> = rest
+            .split(' ')
+            .map(|x| x.parse().expect("a number"))
+            .collect();
+        match kind {
+            "config" => {
+                config = Some(
+                    Config::new(v[0] as f32, v[1] as f32, v[2] as f32, v[3] as f32)
+                        .expect("config"),
+                )
+            }
+            "motion" => motions.push(
+                Motion::new(
+                    [v[0] as f32, v[1] as f32, v[2] as f32],
+                    [v[3] as f32, v[4] as f32, v[5] as f32],
+                )
+                .expect("motion"),
+            ),
+            "truth" => truth = v[0],
+            frame => {
+                if frame != last_frame {
+                    frames.push(Vec::new());
+                    last_frame = frame.to_string();
+                }
+                let pts = v
+                    .chunks(2)
+                    .map(|c| Pixel::new(c[0] as f32, c[1] as f32))
+                    .collect();
+                frames.last_mut().expect("a frame").push(pts);
+            }
+        }
+    }
+    assert_eq!((frames.len(), motions.len()), (9, 8));
+    let config = config.expect("config");
+    let cam = roadstereo::Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).expect("camera");
+    let run = |on: bool| {
+        let policy = FusionConfig::new(8, 500)
+            .and_then(|p| p.with_tilt(0.272_687_97))
+            .expect("policy")
+            .with_sight_check(on);
+        let mut f = Box::new(HostFusion::new(config, policy));
+        let mut last = None;
+        for (j, boundaries) in frames.iter().enumerate() {
+            let mut fr = Frame::<N, B>::new(cam);
+            for b in boundaries {
+                fr.push_boundary(b).expect("valid");
+            }
+            let m = (j > 0).then(|| ChainedMotion {
+                from: j as u32 - 1,
+                motion: motions[j - 1],
+            });
+            f.step(j as u32, &fr, m.as_ref()).expect("step");
+            if let Some(k) = f.key().filter(|k| k.id() == 0) {
+                last = k.point(0, 10);
+            }
+        }
+        last.expect("the key point")
+    };
+    for on in [false, true] {
+        let p = run(on);
+        let iv = p.interval.expect("an interval");
+        assert_eq!(p.status, FusedStatus::Consistent, "check {on}: {p:?}");
+        assert!(
+            f64::from(iv.z_near) > truth + 5.0,
+            "check {on}: the limit, a wrong fused interval {p:?} for {truth}"
+        );
+    }
+}
+
 /// The limit of the consistency check, pinned (`docs/FUSION.md`, "Limits"; found by
 /// an adversarial review, reduced from its crest family): every pair's
 /// stick is guaranteed only where the point's true correspondent is in

@@ -142,16 +142,19 @@ pub struct KeyPoint {
 
 impl KeyPoint {
     /// The fused interval's ends (near, far) on the ray, in key-frame
-    /// camera coordinates, if the point has a bounded interval (`None`
-    /// also for an inconsistent point whose majority's far end is
-    /// unbounded: [`FusedPoint::interval`]).
+    /// camera coordinates, if the point has a bounded interval whose ends
+    /// are finite points (`None` also for an inconsistent point whose
+    /// majority's far end is unbounded, [`FusedPoint::interval`], and for
+    /// a far end whose coordinates overflow `f32`: a depth near
+    /// `f32::MAX / |x|`, with a `max_depth` that large).
     pub fn stick(&self) -> Option<([f32; 3], [f32; 3])> {
-        let i = self.fused.interval.filter(|i| i.z_far.is_finite())?;
+        let i = self.fused.interval?;
         let [x, y, _] = self.ray;
-        Some((
-            [x * i.z_near, y * i.z_near, i.z_near],
-            [x * i.z_far, y * i.z_far, i.z_far],
-        ))
+        let far = [x * i.z_far, y * i.z_far, i.z_far];
+        // (The near end is at most the far one: finite if it is.)
+        far.iter()
+            .all(|c| c.is_finite())
+            .then_some(([x * i.z_near, y * i.z_near, i.z_near], far))
     }
 }
 

@@ -805,6 +805,25 @@ fn check_state<const N: usize, const B: usize, const M: usize>(
             let mut n = 0;
             for (i, p) in k.points(b).enumerate() {
                 check_point(&p, &format!("{at}: key point {b}/{i}"));
+                // `key_point`: the same fusion, a ray through the pixel, a
+                // finite stick when the interval is bounded.
+                if let Some(kp) = f.key_point(b, i) {
+                    assert_eq!(kp.fused, p, "{at}: key_point({b}, {i})");
+                    assert!(kp.ray[2] == 1.0 && kp.ray[0].is_finite() && kp.ray[1].is_finite());
+                    // (Bounded: the far end a finite point, `KeyPoint::stick`.)
+                    let bounded = p.interval.is_some_and(|iv| {
+                        [kp.ray[0] * iv.z_far, kp.ray[1] * iv.z_far, iv.z_far]
+                            .iter()
+                            .all(|x| x.is_finite())
+                    });
+                    match kp.stick() {
+                        Some((n, fa)) => assert!(
+                            bounded && n.iter().chain(&fa).all(|x| x.is_finite()),
+                            "{at}: key_point({b}, {i}) stick {n:?} {fa:?}"
+                        ),
+                        None => assert!(!bounded, "{at}: key_point({b}, {i}) without a stick"),
+                    }
+                }
                 assert_eq!(k.point(b, i), Some(p), "{at}: point({b}, {i})");
                 tally[p.status as usize] += 1;
                 set(

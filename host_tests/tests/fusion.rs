@@ -1244,6 +1244,19 @@ fn the_sight_check_on_the_random_drives() {
     );
 }
 
+/// The lines of a case file under `tests/data/` (`#` a comment): each a
+/// kind and its numbers.
+fn data_lines(text: &str) -> impl Iterator<Item = (&str, Vec<f64>)> + '_ {
+    text.lines().filter(|l| !l.starts_with('#')).map(|line| {
+        let (kind, rest) = line.split_once(' ').expect("a line");
+        let v = rest
+            .split(' ')
+            .map(|x| x.parse().expect("a number"))
+            .collect();
+        (kind, v)
+    })
+}
+
 /// A second review's three views (`tests/data/sight_margin_case.txt`;
 /// exact motions and pixels, `e₁ = e₂ = 0.5`): the key point's truth, at
 /// depth 13.69, is seen by partner 1 (its stick `[9.58, 24.07]` holds it),
@@ -1258,12 +1271,7 @@ fn the_sight_check_on_the_random_drives() {
 fn the_sight_check_catches_a_wrong_pair_beside_a_right_one_at_the_edge() {
     let text = include_str!("data/sight_margin_case.txt");
     let (mut poses, mut polys) = (Vec::new(), Vec::new());
-    for line in text.lines().filter(|l| !l.starts_with('#')) {
-        let (kind, rest) = line.split_once(' ').expect("a line");
-        let v: Vec<f64> = rest
-            .split(' ')
-            .map(|x| x.parse().expect("a number"))
-            .collect();
+    for (kind, v) in data_lines(text) {
         match kind {
             "pose" => poses.push(([v[0], v[1], v[2]], [v[3], v[4], v[5]])),
             "poly" => polys.push(
@@ -1354,12 +1362,7 @@ fn limit_two_wrong_pairs_at_a_side_exit_pass_the_sight_check() {
     let (mut config, mut truth) = (None, 0.0f64);
     let (mut motions, mut frames) = (Vec::new(), Vec::<Vec<Vec<Pixel>>>::new());
     let mut last_frame = String::new();
-    for line in text.lines().filter(|l| !l.starts_with('#')) {
-        let (kind, rest) = line.split_once(' ').expect("a line");
-        let v: Vec<f64> = rest
-            .split(' ')
-            .map(|x| x.parse().expect("a number"))
-            .collect();
+    for (kind, v) in data_lines(text) {
         match kind {
             "config" => {
                 config = Some(

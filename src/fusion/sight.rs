@@ -214,36 +214,56 @@ impl Sight {
     pub(crate) fn seen_from(&self, p: Pixel) -> f32 {
         let a = self.direction(p);
         let b = self.b;
+        let (w, k) = (self.win, self.side);
         let [delta, e1] = self.err;
-        // (Each bound: the coefficient of the depth and the right-hand
-        // side, with the sums of their terms' magnitudes, which bound their
-        // rounding. In front, `d a_z > b_z`; side `j` of the window, on
-        // coordinate `c = j/2`, its low end (`s = 1`) or its high
-        // (`s = −1`): `d (s (a_c − ū a_z) − k ε₁) ≥ s (b_c − ū b_z) + k δ`.)
-        let front = ((a[2], a[2].abs()), (b[2], b[2].abs()));
-        let sides = (0..4).map(|j| {
-            let (c, s) = (j / 2, if j % 2 == 0 { 1.0 } else { -1.0 });
-            let (a_c, b_c) = (
-                a.get(c).copied().unwrap_or(0.0),
-                b.get(c).copied().unwrap_or(0.0),
-            );
-            let (w, k) = (
-                self.win.get(j).copied().unwrap_or(0.0),
-                self.side.get(j).copied().unwrap_or(0.0),
-            );
+        // (Side: the coefficient of the depth and the bound's right-hand
+        // side, `d (c·a − k ε₁) ≥ c·b + k δ`, and the sums of their terms'
+        // magnitudes, which bound their rounding.)
+        let sides = [
+            ((a[2], a[2].abs()), (b[2], b[2].abs())),
             (
                 (
-                    s * (a_c - w * a[2]) - k * e1,
-                    a_c.abs() + (w * a[2]).abs() + k * e1,
+                    a[0] - w[0] * a[2] - k[0] * e1,
+                    a[0].abs() + (w[0] * a[2]).abs() + k[0] * e1,
                 ),
                 (
-                    s * (b_c - w * b[2]) + k * delta,
-                    b_c.abs() + (w * b[2]).abs() + k * delta,
+                    b[0] - w[0] * b[2] + k[0] * delta,
+                    b[0].abs() + (w[0] * b[2]).abs() + k[0] * delta,
                 ),
-            )
-        });
+            ),
+            (
+                (
+                    w[1] * a[2] - a[0] - k[1] * e1,
+                    (w[1] * a[2]).abs() + a[0].abs() + k[1] * e1,
+                ),
+                (
+                    w[1] * b[2] - b[0] + k[1] * delta,
+                    (w[1] * b[2]).abs() + b[0].abs() + k[1] * delta,
+                ),
+            ),
+            (
+                (
+                    a[1] - w[2] * a[2] - k[2] * e1,
+                    a[1].abs() + (w[2] * a[2]).abs() + k[2] * e1,
+                ),
+                (
+                    b[1] - w[2] * b[2] + k[2] * delta,
+                    b[1].abs() + (w[2] * b[2]).abs() + k[2] * delta,
+                ),
+            ),
+            (
+                (
+                    w[3] * a[2] - a[1] - k[3] * e1,
+                    (w[3] * a[2]).abs() + a[1].abs() + k[3] * e1,
+                ),
+                (
+                    w[3] * b[2] - b[1] + k[3] * delta,
+                    (w[3] * b[2]).abs() + b[1].abs() + k[3] * delta,
+                ),
+            ),
+        ];
         let mut e = 0.0f32;
-        for ((c, c_abs), (rhs, rhs_abs)) in core::iter::once(front).chain(sides) {
+        for ((c, c_abs), (rhs, rhs_abs)) in sides {
             // Each rounded by at most a few units of the last place of its
             // terms' magnitudes (`a`, `b` and `w` themselves by as much):
             // `2⁻²⁰` of them, against the bound. (A NaN fails: not seen.)

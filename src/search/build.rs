@@ -989,6 +989,7 @@ impl<const N: usize> Builder<'_, N> {
         self.finish_with(None, &mut None, (false, false))
     }
 
+    #[inline(always)]
     fn finish_with(
         self,
         near: Option<&dyn Fn(usize) -> bool>,

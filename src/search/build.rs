@@ -114,29 +114,9 @@ impl<const N: usize> Index<N> {
     /// set aside the unkeyed segments and those of outlying vertices, and
     /// rebuild the envelopes without them; `false` when `tick`'s clock
     /// stopped it (the index then unfit for queries).
-    ///
-    /// With `turns` (the fold test's index, periodic keys) a turn lost
-    /// across a spike is taken back first ([`Self::turns_back`]), and the
-    /// orientation is then the one in which the moved keys' envelopes are
-    /// tight.
     #[inline(never)]
-    fn rebuild(
-        &mut self,
-        orient: f32,
-        wide: f32,
-        tick: &mut Tick<'_>,
-        (defer, turns): (bool, bool),
-    ) -> bool {
+    fn rebuild(&mut self, orient: f32, wide: f32, tick: &mut Tick<'_>, defer: bool) -> bool {
         let s = self.segments;
-        let (orient, turned) = if turns && self.period > 0.0 {
-            match self.turns_back(wide, tick) {
-                None => return false,
-                Some(Some(falls)) => (if falls { -self.orient } else { self.orient }, true),
-                Some(None) => (orient, false),
-            }
-        } else {
-            (orient, false)
-        };
         let Some(seg) = self.seg.get_mut(..s) else {
             return true;
         };
@@ -167,7 +147,7 @@ impl<const N: usize> Index<N> {
         // Over `enumerate().skip(from)` instead of the slice from `from`
         // the bench firmware measured dearer, `worst_found` +2.7 %.)
         let from = match aside.first() {
-            _ if flip || turned => 0,
+            _ if flip => 0,
             Some(&(j, _, _)) => usize::from(j),
             None => s,
         };
@@ -203,126 +183,6 @@ impl<const N: usize> Index<N> {
             return true;
         }
         !loose || self.build_tree(tick)
-    }
-
-    /// Periodic keys (pseudo-angles, period 4): take back a turn lost
-    /// across a spike. The pushes unwrap each key within half a turn of
-    /// the one before ([`Builder::push_stored`]); a spurious detector point
-    /// out past the FOE and back makes two segments of about half a turn
-    /// each, and where the two go the same way round the keys after them
-    /// lie a whole turn off those before, folded over them: the index is
-    /// loose, its orientation, from a first and a last key a turn apart,
-    /// often the wrong one, and every query's run the whole boundary (the
-    /// `fwd_spiral` member's fold queries, about 33 units each at
-    /// N = 512).
-    ///
-    /// The candidate: the first segment after a stretch of wide ones (a
-    /// quarter turn or more, or without keys) whose middle lies more than
-    /// three quarters of a turn from the middle of the last narrow segment
-    /// before the stretch. Moving it, and every segment after it, by the
-    /// turn that brings it nearer (the stretch's wide segments each the way
-    /// round nearer the narrow ones about them) is taken only where it
-    /// makes the envelopes of the narrow segments tight where they were
-    /// loose (the largest `pm − sm` over them, in the better of the two
-    /// orientations, within `wide`, the rebuild's measure of looseness,
-    /// where it was beyond it) and keeps the keys' range within what the
-    /// copies of a query handle
-    /// (no wider than before or than 7, no end farther from 0 than before
-    /// or than 24: at most three copies, within [`COPY_REACH`]). A boundary
-    /// that really winds most of a turn past the FOE is monotone as the
-    /// pushes left it, and moving it would fold it: it stays (and so does
-    /// one loose either way, where the move would only trade which part of
-    /// it is loose: a review's boundary curling round the FOE, two radial
-    /// stretches 0.8 turn apart, cost 1 447 units a frame as it was and
-    /// 2 566 moved). At most one
-    /// turn is taken back (an independent review built keys whose stretches
-    /// each looked like a lost turn, and an earlier form, moving at each,
-    /// piled the turns up past [`COPY_REACH`]). Only where the first and
-    /// last narrow segments (among the first and last `CHUNK`) lie more
-    /// than three quarters of a turn apart is the boundary looked at.
-    ///
-    /// Any turn is as good for a segment (a query meets every copy of its
-    /// key within the keys' range, [`Index::copies`]); each end moved is
-    /// widened by more than its rounding (`2⁻²⁴` of the result), so the
-    /// interval still holds the one it was moved from. `Some(Some(falls))`
-    /// when segments moved, `falls` whether the keys then fall overall
-    /// (from the first narrow segment's middle to the last's); `Some(None)`
-    /// when none did; `None` when `tick`'s clock stopped the pass (the
-    /// index is then unfit for queries).
-    #[inline(never)]
-    fn turns_back(&mut self, wide: f32, tick: &mut Tick<'_>) -> Option<Option<bool>> {
-        let s = self.segments;
-        let seg = self.seg.get_mut(..s).unwrap_or_default();
-        // (A middle is NaN where a segment has no keys, `(−∞, ∞)`, or is
-        // empty, `(∞, −∞)`: not narrow.)
-        let narrow = |g: &Seg| {
-            let mid = 0.5 * (g.lo + g.hi);
-            (g.hi - g.lo < 1.0 && mid.is_finite()).then_some(mid)
-        };
-        let head = seg.get(..CHUNK).unwrap_or(seg);
-        let tail = seg.get(s.saturating_sub(CHUNK)..).unwrap_or(seg);
-        if let (Some(a), Some(b)) = (
-            head.iter().find_map(narrow),
-            tail.iter().rev().find_map(narrow),
-        ) {
-            if (b - a).abs() <= 3.0 {
-                return Some(None);
-            }
-        }
-        // The candidate: `at`, the turn `shift`, the stretch from `from`,
-        // the middle between the narrow segments about it.
-        let (mut last, mut gap, mut from) = (f32::NAN, false, 0);
-        let mut candidate = None;
-        for (j, g) in seg.iter().enumerate() {
-            if j % CHUNK == CHUNK - 1 && expired(tick) {
-                return None;
-            }
-            let mid = narrow(g);
-            if let Some(mid) = mid {
-                let d = mid - last;
-                if gap && d.abs() > 3.0 {
-                    let shift = if d > 0.0 { -4.0 } else { 4.0 };
-                    candidate = Some((j, shift, 0.5 * (last + mid + shift)));
-                    break;
-                }
-                (last, from) = (mid, j + 1);
-            }
-            gap = mid.is_none() && !last.is_nan();
-        }
-        let Some((at, shift, about)) = candidate else {
-            return Some(None);
-        };
-        // The turn a segment `j` would move by.
-        let turn = |j: usize, g: &Seg| -> f32 {
-            let mid = 0.5 * (g.lo + g.hi);
-            let finite = g.lo.is_finite() && g.hi.is_finite();
-            if !finite || j < from {
-                0.0
-            } else if j >= at || (mid + shift - about).abs() < (mid - about).abs() {
-                shift
-            } else {
-                0.0
-            }
-        };
-        let before = envelope(seg, |_, _| 0.0, tick)?;
-        let after = envelope(seg, turn, tick)?;
-        let (range, reach) = (fmax(before.1, 7.0), fmax(before.2, 24.0));
-        if !(after.0 <= wide && before.0 > wide && after.1 <= range && after.2 <= reach) {
-            return Some(None);
-        }
-        // Taken: every segment moved; the orientation the one in which the
-        // moved envelopes were measured tight.
-        for (j, g) in seg.iter_mut().enumerate() {
-            if j % CHUNK == CHUNK - 1 && expired(tick) {
-                return None;
-            }
-            let t = turn(j, g);
-            if t != 0.0 {
-                let (lo, hi) = (g.lo + t, g.hi + t);
-                (g.lo, g.hi) = (lo - lo.abs() * 2.4e-7, hi + hi.abs() * 2.4e-7);
-            }
-        }
-        Some(Some(after.3))
     }
 
     /// The block tree over the current intervals (module docs): the key
@@ -959,7 +819,7 @@ impl<const N: usize> Builder<'_, N> {
     /// with `W' < 0`; `None` otherwise). `false` when `tick`'s clock
     /// stopped a pass ([`Tick`]): the index is then unfit for queries.
     pub(crate) fn finish(self, near: Option<&dyn Fn(usize) -> bool>, tick: &mut Tick<'_>) -> bool {
-        self.finish_with(near, tick, (false, true))
+        self.finish_with(near, tick, false)
     }
 
     /// [`Self::finish`] without a clock, a loose index's block tree left
@@ -974,7 +834,7 @@ impl<const N: usize> Builder<'_, N> {
     /// the lean walks are the one search
     /// ([`crate::processor`]'s `frame2_index`).
     pub(crate) fn finish_deferring_tree(self, near: Option<&dyn Fn(usize) -> bool>) -> bool {
-        self.finish_with(near, &mut None, (true, true))
+        self.finish_with(near, &mut None, true)
     }
 
     /// [`Self::finish`], the block tree left to build with `defer`.
@@ -982,19 +842,11 @@ impl<const N: usize> Builder<'_, N> {
     /// representative window 488 067 estimated cycles so, 488 809 with one
     /// copy out of line, 488 823 with one call taking `defer`.)
     #[inline(always)]
-    /// [`Self::finish`] without [`Index::turns_back`] (the tests'
-    /// baseline).
-    #[cfg(test)]
-    pub(super) fn finish_without_turns(self) -> bool {
-        self.finish_with(None, &mut None, (false, false))
-    }
-
-    #[inline(always)]
     fn finish_with(
         self,
         near: Option<&dyn Fn(usize) -> bool>,
         tick: &mut Tick<'_>,
-        (defer, turning): (bool, bool),
+        defer: bool,
     ) -> bool {
         let Builder {
             index,
@@ -1005,7 +857,6 @@ impl<const N: usize> Builder<'_, N> {
             sum,
             order,
             period,
-            unkeyed,
             ..
         } = self;
         let s = n.saturating_sub(1);
@@ -1024,12 +875,7 @@ impl<const N: usize> Builder<'_, N> {
             return false;
         };
         index.loose = loose;
-        // (A turn lost across a spike is taken back in the fold test's
-        // index only, [`Index::turns_back`].)
-        let turns = turning && unkeyed == Unkeyed::MeetNone;
-        if (loose || odd || flip)
-            && !index.rebuild(if flip { -o } else { o }, wide, tick, (defer, turns))
-        {
+        if (loose || odd || flip) && !index.rebuild(if flip { -o } else { o }, wide, tick, defer) {
             return false;
         }
         index.kmin = index.seg.first().map_or(f32::INFINITY, |g| g.sm);
@@ -1058,49 +904,4 @@ impl<const N: usize> Builder<'_, N> {
         }
         true
     }
-}
-
-/// [`Index::turns_back`]'s measures of the segments with each moved by
-/// `turn(j, g)`: the largest `pm − sm` over the narrow segments (an
-/// interval under a quarter turn) in the better of the two orientations
-/// (rising: `max hᵢ − l_k` over narrow `i ≤ k`, which is the largest
-/// prefix maximum of the high ends less the suffix minimum of the low ends
-/// from the same place; falling: `max h_k − lᵢ`), the width of every
-/// finite end's range, and the largest finite end's magnitude. `None`
-/// when `tick`'s clock stopped it.
-fn envelope(
-    seg: &[Seg],
-    turn: impl Fn(usize, &Seg) -> f32,
-    tick: &mut Tick<'_>,
-) -> Option<(f32, f32, f32, bool)> {
-    let (mut pmax, mut pmin) = (f32::NEG_INFINITY, f32::INFINITY);
-    let (mut rising, mut falling) = (0.0f32, 0.0f32);
-    let (mut lo_all, mut hi_all, mut reach) = (f32::INFINITY, f32::NEG_INFINITY, 0.0f32);
-    for (j, g) in seg.iter().enumerate() {
-        if j % CHUNK == CHUNK - 1 && expired(tick) {
-            return None;
-        }
-        let t = turn(j, g);
-        let (lo, hi) = (g.lo + t, g.hi + t);
-        if lo.is_finite() {
-            lo_all = fmin(lo_all, lo);
-            reach = fmax(reach, lo.abs());
-        }
-        if hi.is_finite() {
-            hi_all = fmax(hi_all, hi);
-            reach = fmax(reach, hi.abs());
-        }
-        // (Narrow: under a quarter turn, both ends finite.)
-        if hi - lo < 1.0 && (lo + hi).is_finite() {
-            (pmax, pmin) = (fmax(pmax, hi), fmin(pmin, lo));
-            rising = fmax(rising, pmax - lo);
-            falling = fmax(falling, hi - pmin);
-        }
-    }
-    Some((
-        fmin(rising, falling),
-        hi_all - lo_all,
-        reach,
-        falling < rising,
-    ))
 }

@@ -13,8 +13,12 @@
 //! it; a segment with an unkeyed end meets nothing here).
 //!
 //! One rule, decided the cheapest way the boundary allows, each giving the
-//! brute force's answer (the third unless the work budget runs out first:
-//! then the point is [`Status::OverBudget`]):
+//! brute force's answer, bit for bit and whichever orientation step 1
+//! guessed (the third unless the work budget runs out first: then the
+//! point is [`Status::OverBudget`]; or unless a query of pseudo-angle keys
+//! has more copies than the index handles, a polyline winding about three
+//! turns round the FOE: then a fold is assumed, `crate::search`'s
+//! `MAX_COPIES`):
 //!
 //! 1. The keys are strictly ordered along the polyline (step 1 tracks the
 //!    order, [`KeyOrder`]): no key meets a segment but its own two, nothing

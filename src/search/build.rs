@@ -762,7 +762,12 @@ impl<const N: usize> Builder<'_, N> {
         if self.period > 0.0 && k.is_finite() {
             // Consecutive keys are less than half a turn apart.
             k += self.offset;
-            let d = k - self.keyed;
+            // (`keyed` holds the last key times `o`, in the raw keys'
+            // orientation, `NO_KEY` before the first: the first key gets
+            // a turn added to `o` times it, and either guess holds the
+            // other's keys negated, bit for bit, through the same
+            // decisions and roundings.)
+            let d = k - self.o * self.keyed;
             if d > 2.0 {
                 self.offset -= 4.0;
                 k -= 4.0;
@@ -784,9 +789,9 @@ impl<const N: usize> Builder<'_, N> {
                     .and_then(|j| self.index.margin.get(j))
                     .copied()
                     .unwrap_or(0.0);
-                doubtful = 2.0 - (k - self.keyed).abs() <= 2.0 * m;
+                doubtful = 2.0 - (k - self.o * self.keyed).abs() <= 2.0 * m;
             }
-            self.keyed = k;
+            self.keyed = self.o * k;
         }
         let ends = self.order.push(k, e);
         if let Some(g) = i.checked_sub(1).and_then(|j| self.index.seg.get_mut(j)) {

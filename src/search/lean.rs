@@ -378,6 +378,13 @@ fn copies_in(
     if (m as f32) < m0 {
         m = m.saturating_add(1);
     }
+    // The copy one turn lower may still reach `kmin` as it is rounded
+    // (`qh + 4m` rounds up to it where `kmin − qh` rounded down past
+    // `4m`): the copies are tested as rounded, so it counts.
+    // (`m` is within 10⁷ + 1 of 0.)
+    if qh + 4.0 * m.wrapping_sub(1) as f32 >= kmin {
+        m = m.wrapping_sub(1);
+    }
     let mut c = 0usize;
     for slot in out.iter_mut() {
         let shift = 4.0 * m as f32;

@@ -109,8 +109,9 @@ pub(crate) const MAX_COPIES: usize = 3;
 /// quarter of its margin `2⁻²⁰ (S/D + 4)` ([`crate::pencil`]), and adding
 /// turns rounds it by at most `2⁻²⁴ |k|` more, which the rest of the
 /// margin covers while `|k| ≤ 12 (S/D + 4)`, at least 48 (`S/D ≥ 0`).
-/// The first unwrapped key lies in `[4, 8)`, or `(0, 4]` for keys
-/// oriented the other way (a flip at the rebuild negates them all), and a
+/// The first unwrapped key lies in `[4, 8)`, or `(−8, −4]` for keys
+/// oriented the other way (the negation of the first's, bit for bit, as
+/// every key: a flip at the rebuild negates them all), and a
 /// boundary (monotone in `v`, [`crate::Frame::push_boundary`]) turns less
 /// than once round the FOE, so its keys usually span less than 4 and lie
 /// within 12 of 0. Not always: across the unkeyed disc round the FOE the

@@ -942,3 +942,127 @@ fn a_key_just_outside_a_turned_interval_does_not_fold() {
         assert_folds_are_brute(&mut index, &ks, &ivs, &format!("{guess}"));
     }
 }
+
+/// The fold test is the brute force, bit for bit, whichever orientation
+/// is guessed, where the rounding of the keys decides: (a) a step of
+/// `2 + 2⁻²⁵` (`1.4082891 → 3.4082892`, more than half a turn up by
+/// less than an ulp of the unwrapped keys), which the pushes once
+/// unwrapped one way under the guess −1 (its keys then `4 − k`, rounded
+/// otherwise than `k + 4`) and the other under +1, so that vertex 0
+/// folded under −1 alone; (b) a key whose widened end touches a
+/// segment's interval exactly (vertex 0 against segment 5 a turn on),
+/// which the envelopes' test once re-rounded past it (`(lo + e) − e`);
+/// (c) a copy one turn down whose rounded high end reaches the keys'
+/// low end exactly (vertex 6 against segment 0), where the count of
+/// turns, `(kmin − qh) / 4` rounded the other way, started the copies
+/// one turn too high. (b) missed a fold under either guess, (c) under
+/// the guess +1 (under −1 too once the guesses agree).
+#[test]
+fn folds_are_brute_at_rounding_boundaries() {
+    let a: [(f32, f32); 6] = [
+        (1.0425444, 1.0e-5),
+        (0.7112547, 1.0e-5),
+        (0.6953582, 1.0e-5),
+        (1.4268954, 1.0e-5),
+        (1.4082891, 1.0e-5),
+        (3.4082892, 1.0e-5),
+    ];
+    let b: [(f32, f32); 7] = [
+        (3.3658693, 9.1219954e-5),
+        (2.1023533, 8.7598804e-5),
+        (0.10235214, 1.1396265e-5),
+        (0.10453701, 6.2883955e-5),
+        (0.13209152, 2.0250684e-5),
+        (0.15349817, 1.1113524e-6),
+        (3.3659983, 3.786768e-5),
+    ];
+    let c: [(f32, f32); 7] = [
+        (0.13215089, 2.376586e-6),
+        (2.1321511, 1.9432973e-5),
+        (3.072609, 5.640701e-5),
+        (1.0726104, 6.919929e-5),
+        (1.0822377, 5.8095393e-6),
+        (1.0753374, 3.0983643e-5),
+        (0.13216165, 8.382291e-6),
+    ];
+    let mut index = Index::<CAP>::new();
+    for (name, ks) in [("a", &a[..]), ("b", &b[..]), ("c", &c[..])] {
+        let ivs = intervals(ks, true);
+        for guess in [1.0, -1.0] {
+            let mut bld = index.builder((4.0, guess), Unkeyed::MeetNone);
+            bld.push_all(ks.iter().copied());
+            assert!(bld.finish(None, &mut None));
+            assert_folds_are_brute(&mut index, ks, &ivs, &format!("{name}, guess {guess}"));
+        }
+    }
+}
+
+/// [`folds_are_brute_at_rounding_boundaries`] at random: short periodic
+/// polylines whose steps are half a turn give or take a few ulps and
+/// whose keys touch earlier vertices' widened keys give or take a few
+/// ulps, under either guess (vertices whose query has more copies than
+/// [`MAX_COPIES`], where a fold is assumed, left out).
+#[test]
+fn folds_are_brute_near_half_turns_and_touches() {
+    let ulps = |x: f32, n: i32| {
+        (0..n.abs()).fold(x, |y, _| if n > 0 { y.next_up() } else { y.next_down() })
+    };
+    let mut rng = Rng(0x0da7_e5e1);
+    let mut index = Index::<CAP>::new();
+    for case in 0..40_000 {
+        let n = 6 + (rng.next() * 14.0) as usize;
+        let emode = (rng.next() * 3.0) as u32;
+        let mut ks: Vec<(f32, f32)> = Vec::new();
+        let mut k = rng.next() * 4.0;
+        for i in 0..n {
+            let e = match emode {
+                0 => 1.0e-5,
+                1 => 1.0e-4 * rng.next(),
+                _ => 0.003 * rng.next(),
+            };
+            let (t, dn) = (rng.next(), (rng.next() * 7.0) as i32 - 3);
+            if i > 0 {
+                if t < 0.45 {
+                    k += (rng.next() - 0.4) * 0.05;
+                } else if t < 0.7 {
+                    k = ulps(k + if rng.next() < 0.5 { 2.0 } else { -2.0 }, dn);
+                } else if t < 0.95 && i > 5 {
+                    let (kj, ej) = ks[(rng.next() * (i - 5) as f32) as usize];
+                    let touch = if rng.next() < 0.5 {
+                        kj + ej + e
+                    } else {
+                        kj - ej - e
+                    };
+                    k = ulps(touch, dn);
+                } else {
+                    k += (rng.next() - 0.5) * 3.0;
+                }
+            }
+            ks.push((k.rem_euclid(4.0), e));
+        }
+        let ivs = intervals(&ks, true);
+        for guess in [1.0, -1.0] {
+            let mut b = index.builder((4.0, guess), Unkeyed::MeetNone);
+            b.push_all(ks.iter().copied());
+            assert!(b.finish(None, &mut None));
+            for (i, &(k, e)) in ks.iter().enumerate() {
+                let ko = index.orient * k;
+                let mut c = [(0.0f32, 0.0f32); MAX_COPIES];
+                if index.copies(ko - e, ko + e, &mut c).is_none() {
+                    continue;
+                }
+                let brute = ivs.iter().enumerate().any(|(j, iv)| {
+                    let outside = j + 4 < i || j > i + 3;
+                    outside && iv.is_some_and(|iv| meets(iv, (k - e, k + e), true))
+                });
+                let mut work = Work::new();
+                work.grant(u32::MAX);
+                assert_eq!(
+                    index.folds(i, k, 4, &mut work),
+                    Ok(brute),
+                    "case {case}, guess {guess}, vertex {i}: {ks:?}"
+                );
+            }
+        }
+    }
+}

@@ -17,26 +17,26 @@ impl<const N: usize> Index<N> {
     pub(crate) fn may_fold(&self, i: usize, key: f32, w: usize) -> bool {
         let k = self.orient * key;
         let e = self.margin(i);
-        let test = |k: f32| {
+        let test = |(lo, hi): (f32, f32)| {
             let before = i
                 .checked_sub(w + 1)
                 .and_then(|j| self.seg.get(j))
-                .is_some_and(|g| k - e <= g.pm);
+                .is_some_and(|g| lo <= g.pm);
             let after = self
                 .seg
                 .get(i + w)
                 .filter(|_| i + w < self.segments)
-                .is_some_and(|g| k + e >= g.sm);
+                .is_some_and(|g| hi >= g.sm);
             before || after
         };
         if self.period <= 0.0 {
-            return test(k);
+            return test((k - e, k + e));
         }
         // Periodic keys: every copy of the key that can meet the keys'
         // range (the envelopes hold the unwrapped keys).
         let mut c = [(0.0f32, 0.0f32); MAX_COPIES];
         match self.copies(k - e, k + e, &mut c) {
-            Some(n) => c.iter().take(n).any(|&(lo, _)| test(lo + e)),
+            Some(n) => c.iter().take(n).any(|&q| test(q)),
             None => true,
         }
     }

@@ -15,10 +15,12 @@
 //! One rule, decided the cheapest way the boundary allows, each giving the
 //! brute force's answer, bit for bit and whichever orientation step 1
 //! guessed (the third unless the work budget runs out first: then the
-//! point is [`Status::OverBudget`]; or unless a query of pseudo-angle keys
-//! has more copies than the index handles, a polyline winding about three
-//! turns round the FOE: then a fold is assumed, `crate::search`'s
-//! `MAX_COPIES`):
+//! point is [`Status::OverBudget`]; or unless the index finds more copies
+//! of a query of pseudo-angle keys than it handles, `crate::search`'s
+//! `MAX_COPIES`: a polyline winding about three turns round the FOE, or,
+//! where a copy's rounding meets the keys' range to the last bit, three
+//! copies and a fourth counted that falls just short; then a fold is
+//! assumed where a keyed segment lies outside the window):
 //!
 //! 1. The keys are strictly ordered along the polyline (step 1 tracks the
 //!    order, [`KeyOrder`]): no key meets a segment but its own two, nothing

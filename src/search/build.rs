@@ -763,8 +763,8 @@ impl<const N: usize> Builder<'_, N> {
             // Consecutive keys are less than half a turn apart.
             k += self.offset;
             // (`keyed` holds the last key times `o`, in the raw keys'
-            // orientation, `NO_KEY` before the first: the first key gets
-            // a turn added to `o` times it, and either guess holds the
+            // orientation, `NO_KEY` before the first: the first key is `o`
+            // times its raw key plus a turn, and either guess holds the
             // other's keys negated, bit for bit, through the same
             // decisions and roundings.)
             let d = k - self.o * self.keyed;

@@ -378,10 +378,14 @@ fn copies_in(
     if (m as f32) < m0 {
         m = m.saturating_add(1);
     }
-    // The copy one turn lower may still reach `kmin` as it is rounded
-    // (`qh + 4m` rounds up to it where `kmin − qh` rounded down past
-    // `4m`): the copies are tested as rounded, so it counts.
-    // (`m` is within 10⁷ + 1 of 0.)
+    // The copies are tested as they round: the copy one turn lower may
+    // still reach `kmin` (`qh + 4(m − 1)` rounds up to it on its binade's
+    // coarser grid though the exact `kmin − qh` lies above `4(m − 1)`),
+    // and then it counts. (The mirror case, the copy at `m` rounding just
+    // below `kmin` where the quotient is whole, is left in: a copy too
+    // many, harmless but where it makes more than `MAX_COPIES`, a fold
+    // assumed; its test here measured the representative window 958.5
+    // cycles a point, `docs/PERFORMANCE.md`.) (`m` is within 10⁷ + 1 of 0.)
     if qh + 4.0 * m.wrapping_sub(1) as f32 >= kmin {
         m = m.wrapping_sub(1);
     }

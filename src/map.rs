@@ -222,8 +222,8 @@ pub struct Retired {
     /// Points that entered the map.
     pub entered: u32,
     /// Points left out: fewer agreeing pairs than the configured minimum
-    /// (unmatched, single, consistent with too few pairs), or flagged
-    /// `PartlyUnseen` by the sight check
+    /// (unmatched, single, consistent or widened with too few pairs), or
+    /// flagged `PartlyUnseen` by the sight check
     /// ([`crate::fusion::FusionConfig::with_sight_check`]).
     pub unverified: u32,
     /// Points left out: inconsistent.
@@ -757,7 +757,8 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
     }
 
     /// Put a retiring key frame's fused points into the map: the points
-    /// [`crate::fusion::FusedStatus::Consistent`] (or
+    /// [`crate::fusion::FusedStatus::Consistent`] or
+    /// [`crate::fusion::FusedStatus::Widened`] (or
     /// [`crate::fusion::FusedStatus::Single`] if `min_pairs ≤ 1`) with at
     /// least `min_pairs` agreeing pairs and a bounded interval, as one
     /// batch posed by `chain` (the key frame's motion to the current

@@ -797,6 +797,10 @@ pub struct Tally {
     /// those the ones whose interval holds the truth.
     pub unseen: usize,
     pub unseen_contained: usize,
+    /// Snapshots of points the sight check widened (`Widened`: not
+    /// flagged), and of those the ones whose interval holds the truth.
+    pub widened: usize,
+    pub widened_contained: usize,
     /// Two-view sticks (`Ok`) that miss the truth: all, and those whose
     /// correspondent was in the partner frame (a broken guarantee).
     pub wrong_pairs: usize,
@@ -823,6 +827,8 @@ impl Tally {
         self.inconsistent += o.inconsistent;
         self.unseen += o.unseen;
         self.unseen_contained += o.unseen_contained;
+        self.widened += o.widened;
+        self.widened_contained += o.widened_contained;
         self.wrong_pairs += o.wrong_pairs;
         self.wrong_pairs_observed += o.wrong_pairs_observed;
         self.caught += o.caught;
@@ -862,6 +868,10 @@ pub fn tally(d: &Drive, run: &Run) -> Tally {
                         FusedStatus::PartlyUnseen => {
                             t.unseen += 1;
                             t.unseen_contained += usize::from(holds(p.interval, z));
+                        }
+                        FusedStatus::Widened => {
+                            t.widened += 1;
+                            t.widened_contained += usize::from(holds(p.interval, z));
                         }
                         _ => {}
                     }

@@ -224,7 +224,7 @@ fn fusion_bench() -> bool {
 /// The demo drive again through `Fusion::step` with the sight check on
 /// (`FusionConfig::with_sight_check`): per frame the step's instructions
 /// (the matching is the same as [`fusion_bench`]'s), and the key frame's
-/// consistent and partly unseen points after it.
+/// consistent, widened and partly unseen points after it.
 fn fusion_sighted(fusion: &mut Fusion<256, 2, 512>) -> bool {
     let Ok(mut drive) = fw::Drive::new(DRIVE) else {
         return false;
@@ -253,11 +253,12 @@ fn fusion_sighted(fusion: &mut Fusion<256, 2, 512>) -> bool {
         };
         let counts = fusion.key().map(|k| k.counts()).unwrap_or_default();
         defmt::info!(
-            "fusion_sighted frame={=u32} step_instr={=u32} paired={=bool} consistent={=u32} partly_unseen={=u32} map={=u32}",
+            "fusion_sighted frame={=u32} step_instr={=u32} paired={=bool} consistent={=u32} widened={=u32} partly_unseen={=u32} map={=u32}",
             i,
             instr,
             step.paired.is_some(),
             counts.consistent,
+            counts.widened,
             counts.partly_unseen,
             (fusion.map().len(0) + fusion.map().len(1)) as u32
         );

@@ -71,13 +71,26 @@ pub enum FusedStatus {
     /// interval given is the one most pairs agree on (module docs), not a
     /// guarantee.
     Inconsistent,
-    /// The pairs agree, but some partner was not shown to see the point's
-    /// ray over every depth the pairs allow (it left that partner's image,
-    /// or its boundary's rows): that partner's match may be of another
-    /// stretch, inside a wider right stick, and their intersection wrong
-    /// (`src/fusion/sight.rs`). The interval given is the intersection,
-    /// not a guarantee; the point stays out of the map.
+    /// The pairs agree, but some partner was shown to see none of the
+    /// point's ray (its window, its image's columns and its boundary's
+    /// rows less the margins, is empty or misses the ray's far end): its
+    /// match may be of another stretch, and nothing bounds where the truth
+    /// is then (`src/fusion/sight.rs`). The interval given is the
+    /// intersection, not a guarantee; the point stays out of the map.
+    /// (Sight check only, [`crate::fusion::FusionConfig::with_sight_check`].)
     PartlyUnseen,
+    /// The pairs agree, but their sticks reach depths some partner was not
+    /// shown to see along the point's ray (it left that partner's image,
+    /// or its boundary's rows, there): that partner's match may be of
+    /// another stretch inside a wider right stick, so the interval given is
+    /// the pairs' intersection **widened** over those depths, from the
+    /// lowest near end of the point's sticks to the largest depth from
+    /// which every partner was shown to see the ray (where it is above the
+    /// intersection's far end). It holds the truth whenever one pair is
+    /// right (`src/fusion/sight.rs`, "The rule"), so the point is not
+    /// flagged and enters the map like a consistent one. (Sight check
+    /// only, [`crate::fusion::FusionConfig::with_sight_check`].)
+    Widened,
 }
 
 impl FusedStatus {
@@ -95,6 +108,7 @@ impl FusedStatus {
             FusedStatus::Consistent => "consistent",
             FusedStatus::Inconsistent => "inconsistent",
             FusedStatus::PartlyUnseen => "partly_unseen",
+            FusedStatus::Widened => "widened",
         }
     }
 }
@@ -163,16 +177,19 @@ impl KeyPoint {
 pub(crate) enum Added {
     /// It agreed with the fused interval (or was the first).
     Agreed,
-    /// It agreed, but the pairs' hull reaches below what some partner was
-    /// shown to see: the point is `PartlyUnseen` now ([`super::sight`]).
-    /// The packed counts before it.
+    /// It agreed, but some partner was shown to see none of the point's
+    /// ray where the pairs' hull reaches below what it could see: the point
+    /// is `PartlyUnseen` now ([`super::sight`]). The packed counts before
+    /// it. (An interval that only widens the point, [`FusedStatus::Widened`],
+    /// agreed.)
     Unseen { was_counts: u32 },
     /// It missed it: the point is inconsistent now (or was already). The
     /// packed counts before it.
     Conflict { was_counts: u32 },
 }
 
-/// `Cell::counts`' flag of a `PartlyUnseen` point (bit 24).
+/// `Cell::counts`' flag of a [`FusedStatus::PartlyUnseen`] point (bit 24):
+/// a partner was shown to see none of its ray where that mattered.
 const UNSEEN: u32 = 1 << 24;
 
 /// The depth code from which a partner sees a point's ray, for an
@@ -191,13 +208,16 @@ pub(crate) struct Cell {
     /// (no rival yet), the sight's state instead ([`super::sight`]): the
     /// code of `H`, the lowest near end of the point's intervals (rounded
     /// down), and of `U`, a depth from which every partner so far was
-    /// shown to see the ray (rounded up; [`SEEN_NONE`]: one was not).
+    /// shown to see the ray (rounded up; [`SEEN_NONE`]: one was not). With
+    /// two or more pairs and no other flag, `H < U` is what makes the point
+    /// [`FusedStatus::Widened`] (its interval widened when that began,
+    /// [`Cell::add_sighted`]); without the sight check both stay 0.
     rival: [u16; 2],
     /// The pair counts, a byte each: bits 0–7 the pairs in the majority
     /// (0: no interval yet), 8–15 the pairs in the rival (0: none), 16–23
     /// the pairs that missed both; bit 24 [`UNSEEN`], bits 25–31 zero.
     /// Packed so that one comparison tells a clean point with a given
-    /// majority ([`Cell::is_clean_with`]).
+    /// majority ([`Cell::is_clean_with`]; a widened point is clean).
     counts: u32,
 }
 
@@ -262,7 +282,19 @@ impl Cell {
     /// sight `(h, u)` (codes) is its near end and a depth from which its
     /// partner sees the ray (for a range constraint: its near end and
     /// [`SEEN_ANY`]). While no interval has missed the point, `H` and `U`
-    /// take them in, and `H < U` flags it.
+    /// take them in, and where `H < U` the interval is widened to `[H,
+    /// max(far, U)]` ([`FusedStatus::Widened`]; module docs of
+    /// [`super::sight`], "The rule"), or, where `U` is [`SEEN_NONE`] (a
+    /// partner shown to see none of the ray), the point is flagged
+    /// [`FusedStatus::PartlyUnseen`].
+    ///
+    /// The widened interval is kept as the point's interval, and later
+    /// pairs intersect it: where the exact state would keep the pairs'
+    /// intersection `F` apart, `[H, max(F.far, U)]` read from it, this
+    /// gives the same interval (`H` and `U` only move outwards, so the
+    /// near end stays `H`, and a far end the widened interval holds past
+    /// `F`'s is at most the `U` it was widened to, which the new `U` is not
+    /// below).
     #[inline(always)]
     pub(crate) fn add_sighted(
         &mut self,
@@ -282,8 +314,15 @@ impl Cell {
             let u = self.rival[1].max(u);
             self.rival = [h, u];
             if h < u {
-                self.counts |= UNSEEN;
-                return Added::Unseen { was_counts };
+                if u == SEEN_NONE {
+                    self.counts |= UNSEEN;
+                    return Added::Unseen { was_counts };
+                }
+                // (`H` rounded down and `U` up: the depths they stand for
+                // hold the ones they code. `H < U` in the rival slot is
+                // the widened state, [`Self::status`].)
+                self.near = scale.depth(h);
+                self.far = fmax(self.far, scale.depth(u));
             }
         }
         added
@@ -304,7 +343,8 @@ impl Cell {
         (self.major() > 0).then(|| scale.depth(self.rival[0]))
     }
 
-    /// No interval has missed the majority, and `major` pairs are in it.
+    /// No interval has missed the majority, the point is not
+    /// `PartlyUnseen`, and `major` pairs are in it.
     #[inline(always)]
     fn is_clean_with(&self, major: u8) -> bool {
         self.counts == u32::from(major)
@@ -343,17 +383,21 @@ impl Cell {
             (0, _, _) => FusedStatus::Unmatched,
             (_, 0, 0) if self.counts & UNSEEN != 0 => FusedStatus::PartlyUnseen,
             (1, 0, 0) => FusedStatus::Single,
+            // (A first pair keeps its own `H < U` without widening: one
+            // stick, nothing to check.)
+            (_, 0, 0) if self.rival[0] < self.rival[1] => FusedStatus::Widened,
             (_, 0, 0) => FusedStatus::Consistent,
             _ => FusedStatus::Inconsistent,
         }
     }
 
     /// Whether the point goes into the map with at least `min_pairs`
-    /// agreeing pairs (no disagreeing one, seen by every partner, a
-    /// bounded interval), in one range test on the packed counts: clean
-    /// (nothing above the majority byte, [`UNSEEN`] included) with at
-    /// least `min_pairs`, and at least one, pairs in the majority. (Every interval fused is finite, so a fused interval is
-    /// bounded.)
+    /// agreeing pairs (no disagreeing one, not `PartlyUnseen`, a bounded
+    /// interval; a widened one counts), in one range test on the packed
+    /// counts: clean (nothing above the majority byte, [`UNSEEN`]
+    /// included) with at least `min_pairs`, and at least one, pairs in the
+    /// majority. (Every interval fused is finite, and a widened one is
+    /// widened to a finite depth, so a fused interval is bounded.)
     #[inline(always)]
     pub(crate) fn admitted(&self, min_pairs: u8) -> bool {
         (u32::from(min_pairs.max(1))..=0xFF).contains(&self.counts)
@@ -414,7 +458,8 @@ fn count(added: Added, c: &Cell, min: u8, admitted: &mut u16, inconsistent: &mut
             }
         }
         Added::Conflict { was_counts } => {
-            // (Consistent or `PartlyUnseen` before: no interval had missed.)
+            // (Consistent, widened or `PartlyUnseen` before: no interval
+            // had missed.)
             if was_counts & 0x00FF_FF00 == 0 {
                 *inconsistent = inconsistent.saturating_add(1);
             }
@@ -523,6 +568,8 @@ pub struct FusedCounts {
     pub inconsistent: u32,
     /// [`FusedStatus::PartlyUnseen`] points.
     pub partly_unseen: u32,
+    /// [`FusedStatus::Widened`] points.
+    pub widened: u32,
 }
 
 /// The fusion state of one key frame: a `Cell` per boundary point.
@@ -877,6 +924,7 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
                     FusedStatus::Consistent => c.consistent += 1,
                     FusedStatus::Inconsistent => c.inconsistent += 1,
                     FusedStatus::PartlyUnseen => c.partly_unseen += 1,
+                    FusedStatus::Widened => c.widened += 1,
                 }
             }
         }
@@ -936,11 +984,15 @@ mod tests {
     /// numbers: a right but wide stick `[9.21, 371]` whose partner sees the
     /// ray from 4.6, and a wrong `[14.7, 16.9]` whose partner sees it only
     /// from 13 (the truth, 11.7, was off its image): in either order the
-    /// point is `PartlyUnseen`, out of the map, and its counts kept; a
-    /// right narrow stick seen from 6 instead leaves it `Consistent`; a
-    /// range constraint that lowers `H` below `U` flags it too.
+    /// point is `Widened` to `[9.21, 16.9]` (codes rounded outwards), which
+    /// holds the truth, and is admitted to the map; a third pair keeps the
+    /// near end at the lowest near end and the far end at least the
+    /// largest depth seen from; a missing one makes it inconsistent. A right
+    /// narrow stick seen from 6 instead leaves it `Consistent`; a range
+    /// constraint that lowers `H` below `U` widens it; a partner shown to
+    /// see none of the ray flags it `PartlyUnseen` (out of the map).
     #[test]
-    fn the_sight_check_flags_a_stick_its_partner_could_not_see_under() {
+    fn the_sight_check_widens_over_what_a_partner_could_not_see() {
         let s = sc();
         let wide = (9.21, 371.0, (s.down(9.21), s.up(4.6)));
         let wrong = (14.7, 16.9, (s.down(14.7), s.up(13.0)));
@@ -951,19 +1003,29 @@ mod tests {
             let added = c.add_sighted(b.0, b.1, &s, b.2);
             (c, added)
         };
+        let truth = 11.7;
         for (a, b) in [(wide, wrong), (wrong, wide)] {
             let (c, added) = fuse(a, b);
-            assert!(matches!(added, Added::Unseen { .. }), "{added:?}");
-            assert_eq!(c.status(), FusedStatus::PartlyUnseen);
-            assert!(!c.admitted(1) && !c.admitted(2));
+            assert_eq!(added, Added::Agreed);
+            assert_eq!(c.status(), FusedStatus::Widened);
+            assert!(!c.status().is_flagged());
+            assert!(c.admitted(1) && c.admitted(2) && !c.admitted(3));
             let p = c.public();
             assert_eq!((p.pairs, p.disagreeing), (2, 0));
-            assert_eq!(p.interval.map(|i| (i.z_near, i.z_far)), Some((14.7, 16.9)));
-            // Sticky: a third agreeing pair does not clear it, a missing
-            // one makes it inconsistent.
+            let (n, f) = p.interval.map(|i| (i.z_near, i.z_far)).unwrap();
+            assert!(n <= 9.21 && n > 9.2 && f == 16.9, "{n} {f}");
+            assert!(n <= truth && truth <= f);
+            // A third agreeing pair: the near end stays `H`, the far end
+            // is the intersection's or `U`, whichever is larger.
             let mut c2 = c;
             let _ = c2.add_sighted(15.0, 16.0, &s, (s.down(15.0), s.up(7.0)));
-            assert_eq!(c2.status(), FusedStatus::PartlyUnseen);
+            assert_eq!(c2.status(), FusedStatus::Widened);
+            let (n2, f2) = c2.ends();
+            assert!(n2 == n && f2 == 16.0, "{n2} {f2}");
+            let mut c3 = c2;
+            let _ = c3.add_sighted(15.0, 15.5, &s, (s.down(15.0), s.up(15.8)));
+            let (n3, f3) = c3.ends();
+            assert!(n3 == n && (15.8..15.81).contains(&f3), "{n3} {f3}");
             assert!(matches!(
                 c2.add_sighted(30.0, 31.0, &s, (s.down(30.0), 0)),
                 Added::Conflict { .. }
@@ -974,14 +1036,36 @@ mod tests {
         assert_eq!(added, Added::Agreed);
         assert_eq!(c.status(), FusedStatus::Consistent);
         assert!(c.admitted(2));
-        // A range constraint down to 5 (below U = 6): flagged.
+        assert_eq!(c.ends(), (11.0, 12.5));
+        // A range constraint down to 5 (below U = 6): widened, still
+        // admitted, and counted so.
         let mut c3 = c;
         let added = c3.add_sighted(5.0, 12.0, &s, (s.down(5.0), SEEN_ANY));
-        assert!(matches!(added, Added::Unseen { .. }));
-        // The counts: an admitted point leaves the admitted.
+        assert_eq!(added, Added::Agreed);
+        assert_eq!(c3.status(), FusedStatus::Widened);
+        let (n, f) = c3.ends();
+        assert!(n <= 5.0 && n > 4.99 && f == 12.0, "{n} {f}");
         let (mut adm, mut inc) = (1u16, 0u16);
         count(added, &c3, 2, &mut adm, &mut inc);
+        assert_eq!((adm, inc), (1, 0));
+        // A partner that sees none of the ray: flagged, out of the map.
+        let mut c4 = c;
+        let added = c4.add_sighted(11.5, 12.0, &s, (s.down(11.5), SEEN_NONE));
+        assert!(matches!(added, Added::Unseen { .. }));
+        assert_eq!(c4.status(), FusedStatus::PartlyUnseen);
+        assert!(c4.status().is_flagged() && !c4.admitted(2));
+        let (mut adm, mut inc) = (1u16, 0u16);
+        count(added, &c4, 2, &mut adm, &mut inc);
         assert_eq!((adm, inc), (0, 0));
+        // A widened point reaching the map's minimum is admitted then.
+        let mut c5 = Cell::EMPTY;
+        let (mut adm, mut inc) = (0u16, 0u16);
+        for (i, x) in [wide, wrong, narrow].into_iter().enumerate() {
+            let added = c5.add_sighted(x.0, x.1, &s, x.2);
+            count(added, &c5, 3, &mut adm, &mut inc);
+            assert_eq!(adm, u16::from(i == 2), "{i}");
+        }
+        assert_eq!(c5.status(), FusedStatus::Widened);
     }
 
     #[test]

@@ -230,20 +230,23 @@ impl FusionConfig {
     }
 
     /// The same policy with the **sight check** on or off (off by
-    /// default): a point whose pairs' sticks reach depths some contributing
-    /// partner was not shown to see along its ray (it left that partner's
-    /// image, or its boundary's rows) is flagged
-    /// [`FusedStatus::PartlyUnseen`] and kept out of the map, as that
-    /// partner's match may be of another stretch that happens to lie
-    /// inside a wider right stick (`src/fusion/sight.rs`; `docs/FUSION.md`,
-    /// "The sight check"). It costs points and narrowing, and the fusion's
-    /// work (up to 187 instructions a key-frame point on the demo drive
-    /// against 74 without: not within the 80 budgeted for the default):
-    /// measured there. A range constraint ([`Fusion::constrain`]) counts
-    /// as a pair whose partner sees everything: its near end lowers `H`
-    /// like a stick's, so a constraint reaching below what a partner was
-    /// shown to see (a return "nothing within 80 m", `near = 0`, say)
-    /// flags the point too.
+    /// default): where a point's pairs' sticks reach depths some
+    /// contributing partner was not shown to see along its ray (it left
+    /// that partner's image, or its boundary's rows), that partner's match
+    /// may be of another stretch that happens to lie inside a wider right
+    /// stick, and the point's interval is **widened** over those depths
+    /// ([`FusedStatus::Widened`]: it then holds the truth whenever one of
+    /// its pairs is right; `src/fusion/sight.rs`, "The rule";
+    /// `docs/FUSION.md`, "The sight check"); a point where such a partner
+    /// was shown to see none of the ray is flagged
+    /// [`FusedStatus::PartlyUnseen`] and kept out of the map. It costs
+    /// narrowing and the fusion's work (measured in `docs/FUSION.md`: not
+    /// within the 80 instructions a key-frame point budgeted for the
+    /// default). A range constraint ([`Fusion::constrain`]) counts as a
+    /// pair whose partner sees everything: its near end lowers `H` like a
+    /// stick's, so a constraint reaching below what a partner was shown to
+    /// see (a return "nothing within 80 m", `near = 0`, say) widens the
+    /// point down to it.
     pub const fn with_sight_check(mut self, on: bool) -> Self {
         self.sight_check = on;
         self
@@ -489,8 +492,8 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// the matching (one pass over the key frame's points, the map) is not
     /// cut: it is bounded by the points (`docs/FUSION.md`), so
     /// leave room for it in the limit: at most 74 instructions a key-frame
-    /// point on the demo drive, 187 with the sight check on
-    /// ([`FusionConfig::with_sight_check`]; 66 842 in its costliest frame
+    /// point on the demo drive, 191 with the sight check on
+    /// ([`FusionConfig::with_sight_check`]; 68 232 in its costliest frame
     /// against 8 141 without).
     pub fn step_within<D: Deadline>(
         &mut self,
@@ -701,8 +704,9 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// centre** (what a lidar or radar return gives), `0 ≤ near ≤ far`,
     /// both finite. It counts as one more pair: an interval missing the
     /// fused one flags the point; with the sight check on
-    /// ([`FusionConfig::with_sight_check`]), so does one whose near end lies
-    /// below what a partner was shown to see. Returns the point after.
+    /// ([`FusionConfig::with_sight_check`]) one whose near end lies below
+    /// what a partner was shown to see widens it down to that near end
+    /// ([`FusedStatus::Widened`]). Returns the point after.
     ///
     /// The distance `r` along the ray through normalised `(x, y)` is the
     /// depth `Z = r / √(1 + x² + y²)`, on the **true** point's ray, whose

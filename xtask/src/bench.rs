@@ -607,8 +607,8 @@ the demo drive's fusion steps with the counting rule for folded points (`Fusion:
 /// `fusion_sighted`: `FusionConfig::with_sight_check`), against the same
 /// steps without it: per paired frame the fusion's and the map's own
 /// instructions (the step less the matching of the run without it, the
-/// same pair), per key-frame point, and the key frame's consistent and
-/// partly unseen points. Reported, not budgeted (the check is off by
+/// same pair), per key-frame point, and the key frame's consistent,
+/// widened and partly unseen points. Reported, not budgeted (the check is off by
 /// default); hard check: the rows are there.
 fn drive_sighted(log: &str, misses: &mut Vec<String>) {
     let rows = records(log, "fusion_sighted frame=");
@@ -635,8 +635,8 @@ fn drive_sighted(log: &str, misses: &mut Vec<String>) {
         "
 the demo drive's fusion steps with the sight check on (`FusionConfig::with_sight_check`; off in every other figure):"
     );
-    println!("| frame | step (without the check) | fusion and map (without) | per key-frame point (without) | consistent | partly unseen | map points (without) |");
-    println!("|---:|---:|---:|---:|---:|---:|---:|");
+    println!("| frame | step (without the check) | fusion and map (without) | per key-frame point (without) | consistent | widened | partly unseen | map points (without) |");
+    println!("|---:|---:|---:|---:|---:|---:|---:|---:|");
     let (mut worst, mut worst0) = (0u64, 0u64);
     for r in &rows {
         if field(r, "paired") != Some("true") {
@@ -651,8 +651,9 @@ the demo drive's fusion steps with the sight check on (`FusionConfig::with_sight
         worst = worst.max(pp);
         worst0 = worst0.max(pp0);
         println!(
-            "| {f} | {step} ({s0}) | {own} ({own0}) | {pp} ({pp0}) | {} | {} | {} ({map0}) |",
+            "| {f} | {step} ({s0}) | {own} ({own0}) | {pp} ({pp0}) | {} | {} | {} | {} ({map0}) |",
             num(r, "consistent"),
+            num(r, "widened"),
             num(r, "partly_unseen"),
             num(r, "map")
         );

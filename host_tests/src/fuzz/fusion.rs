@@ -345,8 +345,10 @@ pub mod bit {
     /// The sight check's flag seen (`FusedStatus::PartlyUnseen`, apart
     /// from `STATUS`'s four, added before it).
     pub const PARTLY_UNSEEN: u32 = 96;
+    /// The sight check's widening seen (`FusedStatus::Widened`).
+    pub const WIDENED: u32 = 97;
     /// One past the last.
-    pub const END: u32 = 97;
+    pub const END: u32 = 98;
 }
 
 use frame::set;
@@ -705,7 +707,7 @@ fn check_point(p: &roadstereo::fusion::FusedPoint, at: &str) {
         FusedStatus::Inconsistent => {
             assert!(p.interval.is_some() && p.disagreeing >= 1, "{at}: {p:?}");
         }
-        FusedStatus::PartlyUnseen => {
+        FusedStatus::PartlyUnseen | FusedStatus::Widened => {
             assert!(
                 p.interval.is_some() && p.pairs >= 2 && p.disagreeing == 0,
                 "{at}: {p:?}"
@@ -799,7 +801,7 @@ fn check_state<const N: usize, const B: usize, const M: usize>(
     if let Some(k) = f.key() {
         assert!(u32::from(k.partners()) <= allowed, "{at}: partners");
         assert!(k.boundaries() <= B, "{at}: boundaries");
-        let mut tally = [0u32; 5];
+        let mut tally = [0u32; 6];
         for b in 0..k.boundaries() {
             assert!(k.len(b) <= N, "{at}: boundary {b} length");
             let mut n = 0;
@@ -828,10 +830,10 @@ fn check_state<const N: usize, const B: usize, const M: usize>(
                 tally[p.status as usize] += 1;
                 set(
                     features,
-                    if p.status == FusedStatus::PartlyUnseen {
-                        bit::PARTLY_UNSEEN
-                    } else {
-                        bit::STATUS + p.status as u32
+                    match p.status {
+                        FusedStatus::PartlyUnseen => bit::PARTLY_UNSEEN,
+                        FusedStatus::Widened => bit::WIDENED,
+                        s => bit::STATUS + s as u32,
                     },
                 );
                 n += 1;
@@ -846,7 +848,8 @@ fn check_state<const N: usize, const B: usize, const M: usize>(
                 c.single,
                 c.consistent,
                 c.inconsistent,
-                c.partly_unseen
+                c.partly_unseen,
+                c.widened
             ],
             tally,
             "{at}: counts"

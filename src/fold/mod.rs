@@ -36,7 +36,7 @@
 
 mod count;
 
-pub(crate) use count::{cut_short, images, partners, settle};
+pub(crate) use count::{cut_short, images, partners, settle, unsearched};
 
 use crate::deadline::{Deadline, Guard};
 use crate::math::{fmax, fmin};

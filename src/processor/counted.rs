@@ -73,7 +73,8 @@ pub(super) fn counted_search<const N: usize, D: Deadline>(
     let margins = index.margins_mut();
     for i in 0..slots.len() {
         if i % CHUNK == 0 && guard.check() {
-            crate::fold::settle(slots, true);
+            // (Before the partners' pass: no standings to settle by.)
+            crate::fold::unsearched(slots);
             return;
         }
         let (Some(r), Some(m)) = (slots.get_mut(i), margins.get_mut(i)) else {
@@ -121,7 +122,7 @@ pub(super) fn counted_search<const N: usize, D: Deadline>(
         Some(&mut ask)
     };
     if stopped || !builder.finish(None, &mut tick) {
-        crate::fold::settle(slots, true);
+        crate::fold::unsearched(slots);
         return;
     }
     let at = |p: Pixel| recompensate(pair, keying, p).map(|(c, _)| c.pixel2.arr());

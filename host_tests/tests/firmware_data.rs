@@ -167,8 +167,8 @@ fn adversarial_base_is_the_representative_pair() {
 /// the bench's `FOUND`, stored as found): each decodes as the firmware
 /// reads it, two frames of two boundaries of the N the bench runs it at,
 /// every boundary accepted by `Frame::push_boundary` (with the file's
-/// camera; the frame 1 of `rev_e4`, `rev_f1` and `rev_g1` has its own
-/// too, `CAMERA1`, which the bench checks as it loads it), the motion by `Motion::new`; and the bench's
+/// camera; the frame 1 of `rev_e4`, `rev_f1`, `rev_g1` and `rev_h1` has
+/// its own too, `CAMERA1`, which the bench checks as it loads it), the motion by `Motion::new`; and the bench's
 /// table names every file.
 #[test]
 fn found_pairs_pass_validation() {
@@ -185,6 +185,7 @@ fn found_pairs_pass_validation() {
         ("rev_e4", 64),
         ("rev_f1", 64),
         ("rev_g1", 512),
+        ("rev_h1", 512),
     ];
     for (name, n) in found {
         assert!(

@@ -252,36 +252,48 @@ pub(crate) fn partners<const N: usize, D: Deadline>(
             continue;
         };
         let key = r.z_far;
-        let standing = match Ray::of(r.pixel2.arr(), foe, r.z_near, e2) {
+        // (The clock before the ray: once it has said yes, the points left
+        // cost a flag each, not a ray and its square root; a fifth
+        // review's pair was 73 943 late with them after the yes.)
+        let standing = if !key.is_finite() {
             // (Without step 1's values: no key.)
-            _ if !key.is_finite() => Standing::Folded,
-            _ if !guard.proceed(work) => Standing::OverBudget,
-            None => Standing::Folded,
-            Some(ray) => {
-                let e = index.margin(i);
-                let skip = (
-                    i.saturating_sub(FOLD_WINDOW),
-                    i.saturating_add(FOLD_WINDOW).saturating_sub(1),
-                );
-                let mut v = Partners {
-                    ray,
-                    slots,
-                    at,
-                    partner: None,
-                    keep: false,
-                };
-                match index.visit(
-                    Query::Keys(key - e, key + e),
-                    false,
-                    Some(skip),
-                    work,
-                    &mut v,
-                ) {
-                    Err(OutOfWork) => Standing::OverBudget,
-                    Ok(()) => match (v.keep, v.partner) {
-                        (false, Some(x)) => Standing::Partner(x),
-                        _ => Standing::Folded,
-                    },
+            Standing::Folded
+        } else if !guard.proceed(work) {
+            // Out of time: this point and the rest of the boundary's that
+            // fold `over_budget` (their `z_far` holds no standing yet).
+            if let Some(rest) = slots.get_mut(i..) {
+                unsearched(rest);
+            }
+            return any;
+        } else {
+            match Ray::of(r.pixel2.arr(), foe, r.z_near, e2) {
+                None => Standing::Folded,
+                Some(ray) => {
+                    let e = index.margin(i);
+                    let skip = (
+                        i.saturating_sub(FOLD_WINDOW),
+                        i.saturating_add(FOLD_WINDOW).saturating_sub(1),
+                    );
+                    let mut v = Partners {
+                        ray,
+                        slots,
+                        at,
+                        partner: None,
+                        keep: false,
+                    };
+                    match index.visit(
+                        Query::Keys(key - e, key + e),
+                        false,
+                        Some(skip),
+                        work,
+                        &mut v,
+                    ) {
+                        Err(OutOfWork) => Standing::OverBudget,
+                        Ok(()) => match (v.keep, v.partner) {
+                            (false, Some(x)) => Standing::Partner(x),
+                            _ => Standing::Folded,
+                        },
+                    }
                 }
             }
         };
@@ -318,10 +330,16 @@ pub(crate) fn images<const N: usize, D: Deadline>(
         let Standing::Partner(xq) = Standing::of(r.z_far) else {
             continue;
         };
+        // (The clock before the key and the ray, as in [`partners`]: once
+        // it has said yes the points left keep their standings, which
+        // [`settle`] gives their flags.)
+        if !guard.proceed(work) {
+            r.z_far = Standing::OverBudget.z_far();
+            return;
+        }
         let p = r.pixel2.arr();
         let (key, e) = keying.key(p);
         let found = match Ray::of(p, foe, r.z_near, e2) {
-            _ if !guard.proceed(work) => Err(OutOfWork),
             // (Not reached: step 1 keyed the point, `partners` placed it.)
             None => Ok(false),
             Some(_) if key == NO_KEY => Ok(false),

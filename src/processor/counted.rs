@@ -127,8 +127,9 @@ pub(super) fn counted_search<const N: usize, D: Deadline>(
     }
     let at = |p: Pixel| recompensate(pair, keying, p).map(|(c, _)| c.pixel2.arr());
     let e2 = pair.e2();
-    if !crate::fold::partners(index, slots, at, (foe, e2), work, guard) {
-        // No point has a partner: nothing to look for in frame 2.
+    if !crate::fold::partners(index, slots, at, (foe, e2), work, guard) || guard.has_expired() {
+        // No point has a partner: nothing to look for in frame 2 (or the
+        // time ran out: no frame-2 index either).
         crate::fold::settle(slots, guard.has_expired());
         return;
     }

@@ -48,11 +48,13 @@ impl<const N: usize> Index<N> {
     /// answer ([`Self::may_fold`]) is taken in the loop itself, and only the
     /// vertices it cannot clear go through [`Self::folds`]. Before each
     /// query `proceed(Some(work))` is asked (the caller's deadline,
-    /// [`crate::deadline::Guard::proceed`]): `false` answers
-    /// [`OutOfWork`] without a query. In the loop that clears vertices by
-    /// the envelopes, `proceed(None)` is also asked before every
-    /// [`CHUNK`] vertices (whether the time is not up yet): `false` stops
-    /// the loop, the items from there on left as they are.
+    /// [`crate::deadline::Guard::proceed`]): `false` stops the general
+    /// loop, that item and the rest left as they are (for the caller's
+    /// flags), and answers [`OutOfWork`] without a query in the loop that
+    /// clears vertices by the envelopes, where `proceed(None)` is also
+    /// asked before every [`CHUNK`] vertices (whether the time is not up
+    /// yet): `false` stops that loop, the items from there on left as they
+    /// are.
     #[inline(always)]
     pub(crate) fn folds_all<T>(
         &mut self,

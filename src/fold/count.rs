@@ -253,7 +253,7 @@ pub(crate) fn partners<const N: usize, D: Deadline>(
         };
         let key = r.z_far;
         // (The clock before the ray: once it has said yes, the points left
-        // cost a flag each, not a ray and its square root; a fifth
+        // cost a flag each, not a ray and its square root; a sixth
         // review's pair was 73 943 late with them after the yes.)
         let standing = if !key.is_finite() {
             // (Without step 1's values: no key.)
@@ -392,8 +392,8 @@ pub(crate) fn cut_short(slots: &mut [PointResult], counting: bool) {
     }
 }
 
-/// Every point the fold test flagged `over_budget`, where the deadline
-/// stopped the rule before it looked for their partners (their `z_far`
+/// Every point the fold test flagged (`folded`) made `over_budget`, where
+/// the deadline stopped the rule before it looked for their partners (their `z_far`
 /// does not hold a [`Standing`] yet, so [`settle`] cannot tell them
 /// apart): the rule might have searched any of them.
 #[cold]

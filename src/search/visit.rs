@@ -75,7 +75,7 @@ impl<const N: usize> Index<N> {
                 if !proceed(Some(work)) {
                     // The caller's clock said the time is up: this item
                     // and the rest are left as they are, for the caller to
-                    // flag in one pass (a sixth review measured this loop
+                    // flag in one pass (a seventh review measured this loop
                     // going on to the boundary's end after the yes, about
                     // 40 instructions an item with a key).
                     return;

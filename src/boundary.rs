@@ -1,4 +1,6 @@
 //! Road-boundary polylines and frames, validated on construction.
+//! A boundary the detector lost in a frame is pushed absent
+//! ([`Frame::push_absent`]): no points, its slot kept.
 //!
 //! A raw polyline from the camera front end is a `&[Pixel]`. A [`Boundary`]
 //! is known to be finite, inside the image, ordered and within capacity; the
@@ -126,11 +128,19 @@ impl<const N: usize> Boundary<N> {
     pub fn points(&self) -> &[Pixel] {
         self.points.as_slice()
     }
+
+    /// Whether the boundary was pushed as absent ([`Frame::push_absent`]):
+    /// no points (a pushed polyline has at least two).
+    pub fn is_absent(&self) -> bool {
+        self.points.as_slice().is_empty()
+    }
 }
 
 /// One camera frame: its intrinsics and up to `B` validated boundaries of up
 /// to `N` points each (index 0 = left road edge, 1 = right, by convention;
-/// boundary `k` of one frame corresponds to boundary `k` of the next).
+/// boundary `k` of one frame corresponds to boundary `k` of the next; a
+/// boundary not detected in a frame is pushed absent,
+/// [`Frame::push_absent`], so that the others keep their numbers).
 ///
 /// Its storage is `B` boundary slots of `N` points, filled once when the
 /// frame is made: adding a boundary copies its points into the next slot,
@@ -200,6 +210,36 @@ impl<const N: usize, const B: usize> Frame<N, B> {
         };
         Boundary::<N>::check(points, &self.camera)?;
         slot.points.copy_from(points);
+        self.count += 1;
+        Ok(())
+    }
+
+    /// Append the next boundary as **absent**: the detector did not find
+    /// it in this frame. The slot keeps the boundaries' numbering (boundary
+    /// `k` of one frame is boundary `k` of the next), so a lost left edge
+    /// does not turn the right edge into boundary 0. An absent boundary has
+    /// no points: as frame 1 of a pair it gives no results, as frame 2
+    /// every point of the other frame's boundary `k` is `no_intersection`
+    /// (or flagged earlier, as any point is). A polyline of fewer than two
+    /// points stays an error of [`Frame::push_boundary`]: absence is said,
+    /// not inferred. `Err(TooManyBoundaries)` when the frame holds `B`
+    /// boundaries (the frame unchanged).
+    ///
+    /// ```
+    /// use roadstereo::{Camera, Frame, Pixel};
+    /// let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).unwrap();
+    /// let mut frame = Frame::<64, 2>::new(cam);
+    /// frame.push_absent()?; // the left edge was not detected
+    /// frame.push_boundary(&[Pixel::new(400.0, 470.0), Pixel::new(398.5, 469.0)])?;
+    /// assert!(frame.boundaries()[0].is_absent());
+    /// assert_eq!(frame.boundaries()[1].points().len(), 2);
+    /// # Ok::<(), roadstereo::BoundaryError>(())
+    /// ```
+    pub fn push_absent(&mut self) -> Result<(), BoundaryError> {
+        let Some(slot) = self.slots.get_mut(self.count) else {
+            return Err(BoundaryError::TooManyBoundaries);
+        };
+        slot.points.set_len(0);
         self.count += 1;
         Ok(())
     }

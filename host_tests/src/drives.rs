@@ -391,7 +391,12 @@ impl Input {
     pub fn frame(&self, k: &Intrinsics, i: usize) -> Frame<N, B> {
         let mut f = Frame::new(k.camera());
         for b in &self.frames[i] {
-            f.push_boundary(b).expect("valid boundary");
+            // (An empty polyline: the boundary marked absent.)
+            if b.is_empty() {
+                f.push_absent().expect("a free slot");
+            } else {
+                f.push_boundary(b).expect("valid boundary");
+            }
         }
         f
     }

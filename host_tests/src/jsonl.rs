@@ -160,9 +160,13 @@ pub fn parse_line<const N: usize, const B: usize>(
     let mut frame = Frame::new(cam);
     for (i, b) in f.boundaries.iter().enumerate() {
         let pts: Vec<Pixel> = b.iter().map(|p| Pixel::new(p[0], p[1])).collect();
-        frame
-            .push_boundary(&pts)
-            .map_err(|e| format!("field `boundaries[{i}]`: {e}"))?;
+        // (An empty list: a boundary the detector lost, `push_absent`.)
+        if pts.is_empty() {
+            frame.push_absent()
+        } else {
+            frame.push_boundary(&pts)
+        }
+        .map_err(|e| format!("field `boundaries[{i}]`: {e}"))?;
     }
     Ok((frame, motion))
 }

@@ -254,6 +254,14 @@ impl<const N: usize, const B: usize> Reference<N, B> {
                     capacity: N as u16,
                 });
             }
+            if n == 0 {
+                // An absent boundary: its radius ignored.
+                frame.push_absent().expect("a slot: the count is at most B");
+                quality[k] = p[off + 1];
+                radius[k] = 0.0;
+                off += 6;
+                continue;
+            }
             if n < 2 {
                 return Out::Err(WireError::Boundary {
                     boundary: k as u8,

@@ -860,9 +860,11 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
         self.best_matched
     }
 
-    /// The number of boundaries (as in the key frame).
+    /// The number of boundaries: up to the key frame's last boundary with
+    /// points (one pushed absent, `Frame::push_absent`, before it counts,
+    /// with no points; one after it does not, as it has none either).
     pub fn boundaries(&self) -> usize {
-        self.lens.iter().take_while(|&&l| l > 0).count()
+        self.lens.len() - self.lens.iter().rev().take_while(|&&l| l == 0).count()
     }
 
     /// The number of points of `boundary` (0 beyond the key frame's).

@@ -34,7 +34,8 @@ pub struct FrameInfo<const B: usize> {
     pub counter: u16,
     /// Quality of each boundary (index as in the frame).
     pub quality: [u8; B],
-    /// Localisation-error radius of each boundary, pixels.
+    /// Localisation-error radius of each boundary, pixels (0 for an
+    /// absent one, whatever the packet said).
     pub radius_px: [f32; B],
 }
 
@@ -738,6 +739,18 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
                 len: n,
                 capacity: u16::try_from(N).unwrap_or(u16::MAX),
             });
+        }
+        if n == 0 {
+            // An absent boundary (`Frame::push_absent`): its quality kept,
+            // its radius ignored (0, so that it widens no pair's error).
+            if let Some(q) = self.info.quality.get_mut(k) {
+                *q = quality;
+            }
+            if let Some(r) = self.info.radius_px.get_mut(k) {
+                *r = 0.0;
+            }
+            self.points = 0;
+            return self.boundary_done();
         }
         if n < 2 {
             return self.fault(WireError::Boundary {

@@ -190,6 +190,42 @@ fn round_trip_at_every_chunking() {
 }
 
 #[test]
+fn an_absent_boundary_round_trips_and_one_point_is_an_error() {
+    let b1 = line(20, 400.0);
+    let mut stream = vec![0u8];
+    stream.extend(camera_packet(0));
+    // Boundary 0 absent (no points, its radius ignored), boundary 1 seen.
+    stream.extend(frame_packet(0, 5, &[(3.0, Vec::new()), (1.25, b1.clone())]));
+    let mut expect = Frame::<64, 2>::new(cam());
+    expect.push_absent().unwrap();
+    expect.push_boundary(&b1).unwrap();
+    for chunk in [1, 3, 7, 64, 10_000] {
+        let mut d = Decoder::<64, 2>::new(IDS);
+        let out = run(&mut d, &stream, chunk);
+        assert_eq!(out.len(), 2, "chunk {chunk}: {out:?}");
+        let Out::Frame(f, info, 0) = &out[1] else {
+            panic!("{:?}", out[1])
+        };
+        assert_eq!(f, &expect, "chunk {chunk}");
+        assert!(f.boundaries()[0].is_absent());
+        assert_eq!(info.quality, [7, 8]);
+        assert_eq!(info.radius_px, [0.0, 1.25]);
+        assert_eq!(info.max_radius(2), 1.25);
+    }
+    // One point is not a boundary: the error it always was.
+    let mut d = Decoder::<64, 2>::new(IDS);
+    run(&mut d, &camera_packet(0), 9);
+    let out = run(&mut d, &frame_packet(1, 6, &[(0.5, line(1, 50.0))]), 9);
+    assert_eq!(
+        out,
+        [Out::Err(WireError::Boundary {
+            boundary: 0,
+            error: crate::BoundaryError::TooFewPoints
+        })]
+    );
+}
+
+#[test]
 fn typed_errors_and_resync() {
     let good = frame_packet(1, 1, &[(0.5, line(10, 50.0))]);
     let mut d = Decoder::<64, 2>::new(IDS);

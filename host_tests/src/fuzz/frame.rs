@@ -535,8 +535,15 @@ pub(super) fn boundaries(
     cap: usize,
     last: &mut Vec<Vec<[f32; 2]>>,
 ) -> Vec<Vec<[f32; 2]>> {
+    // (Now and then a boundary the detector lost: empty, pushed absent.)
     let out: Vec<_> = (0..nb)
-        .map(|b| boundary(src, scene, b, pose, k, size, cap, last.get(b)))
+        .map(|b| {
+            if src.chance(1, 20) {
+                Vec::new()
+            } else {
+                boundary(src, scene, b, pose, k, size, cap, last.get(b))
+            }
+        })
         .collect();
     last.clone_from(&out);
     out
@@ -644,6 +651,9 @@ mod bit {
     pub const SAMPLES: u32 = 61;
     pub const CAMERA_CHANGE: u32 = 62;
     pub const LOOSER_STICK: u32 = 63;
+    // (64–98: the fusion target's, `fuzz::fusion`, whose frames are built
+    // here too.)
+    pub const ABSENT: u32 = 99; // a boundary pushed as absent
 }
 
 pub(super) fn set(f: &mut u128, b: u32) {
@@ -798,10 +808,19 @@ pub(super) fn build_frame<const N: usize, const B: usize>(
         let before = frame.clone();
         let want = if frame.boundaries().len() >= B {
             Some(BoundaryError::TooManyBoundaries)
+        } else if b.is_empty() {
+            // (An empty polyline is pushed as an absent boundary.)
+            None
         } else {
             expected_boundary_error(b, &cam, N)
         };
-        match frame.push_boundary(&pts) {
+        let pushed = if b.is_empty() {
+            set(features, bit::ABSENT);
+            frame.push_absent()
+        } else {
+            frame.push_boundary(&pts)
+        };
+        match pushed {
             Ok(()) => {
                 assert_eq!(want, None, "boundary {i} accepted: {b:?}");
                 assert_eq!(frame.boundaries().len(), before.boundaries().len() + 1);

@@ -106,11 +106,32 @@ use crate::math::{cross, dot, fmax, fmin, sqrt_pos};
 /// localisation errors lies in `[z_near, z_far]` (length unit of the motion).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+///
+/// The interval is what the errors allow, however wide: `Config::max_depth`
+/// bounds the depth estimate (a point past it is `beyond_max_depth`), not
+/// `z_far`, which can lie far beyond it where the disparity is only a few
+/// times its error. A consumer that wants only informative points filters
+/// on [`DepthInterval::relative_width`].
 pub struct DepthInterval {
     /// Nearest consistent depth `Z_near` (> 0).
     pub z_near: f32,
     /// Farthest consistent depth `Z_far`.
     pub z_far: f32,
+}
+
+impl DepthInterval {
+    /// `(z_far − z_near) / z`: the interval's length relative to the depth
+    /// estimate `z` (`PointResult`'s point's `Z`), what Sec. 4.1 calls the
+    /// relative error range. Infinite or NaN where `z` is not above 0.
+    ///
+    /// ```
+    /// use roadstereo::DepthInterval;
+    /// let stick = DepthInterval { z_near: 9.5, z_far: 10.6 };
+    /// assert!((stick.relative_width(10.0) - 0.11).abs() < 1e-6);
+    /// ```
+    pub fn relative_width(&self, z: f32) -> f32 {
+        (self.z_far - self.z_near) / z
+    }
 }
 
 /// The error terms of one point (pixels, and the translation spreads).

@@ -253,8 +253,11 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     }
 
     /// [`Self::process`] within the caller's `deadline`
-    /// ([`crate::deadline`]): asked before each point's search, and once
-    /// it has expired every point not yet matched is flagged
+    /// ([`crate::deadline`]): asked between stretches of bounded work, one
+    /// to three times a point (step 1 where the pair is not certified, the
+    /// fold queries, each point's search) and between chunks of each pass
+    /// over a boundary, from the first step on; once it has said yes every
+    /// point not yet matched is flagged
     /// [`Status::OverBudget`] and the call returns
     /// ([`Self::deadline_expired`] then says so). The frame becomes the
     /// previous one either way, as with [`Self::process`]; the points done
@@ -262,7 +265,12 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     /// search may spend at most [`crate::deadline::CARRY`] times its
     /// allowance between two questions (what it leaves still carries
     /// over), so the point in progress when the time is up ends within a
-    /// bounded cost.
+    /// bounded cost; so a point may also come out with a looser stick
+    /// (still holding the truth) than [`Self::process`] gives it, or `Ok`
+    /// where that call ran out of budget. The call returns at most about
+    /// 35 000 instructions after the clock's yes (README, "Within a
+    /// deadline": allow 40 000, about 60 000 estimated Cortex-M4F cycles
+    /// for a cycle counter).
     pub fn process_within<D: Deadline>(
         &mut self,
         frame: &Frame<N, B>,

@@ -834,7 +834,8 @@ fn bad_inputs_are_typed_errors_and_change_nothing() {
     let mut f = Box::new(HostFusion::new(Config::DEFAULT, FusionConfig::DEFAULT));
     let mut twin = Box::new(HostFusion::new(Config::DEFAULT, FusionConfig::DEFAULT));
     // No key frame yet: constraints have nothing to act on.
-    assert_eq!(f.constrain(0, 0, 1.0, 2.0), Err(FusionError::NoKeyFrame));
+    assert_eq!(f.constrain(0, 0, 0, 1.0, 2.0), Err(FusionError::NoKeyFrame));
+    assert_eq!(f.key_id(), None);
     // A first frame without points is accepted but is no key frame.
     let s = f
         .step(0, &edge_frame(cam, 0.0, 0), None)
@@ -865,15 +866,27 @@ fn bad_inputs_are_typed_errors_and_change_nothing() {
             f.step(1, &frame2, Some(&chained(1))),
             Err(FusionError::RepeatedFrame(1))
         );
-        assert_eq!(f.constrain(3, 0, 1.0, 2.0), Err(FusionError::NoSuchPoint));
-        assert_eq!(f.constrain(0, 99, 1.0, 2.0), Err(FusionError::NoSuchPoint));
+        assert_eq!(f.key_id(), Some(1));
+        assert_eq!(
+            f.constrain(1, 3, 0, 1.0, 2.0),
+            Err(FusionError::NoSuchPoint)
+        );
+        assert_eq!(
+            f.constrain(1, 0, 99, 1.0, 2.0),
+            Err(FusionError::NoSuchPoint)
+        );
+        // A range for another key frame's pixels is refused.
+        assert_eq!(
+            f.constrain(0, 0, 0, 1.0, 2.0),
+            Err(FusionError::KeyMismatch { key: 1, given: 0 })
+        );
         for (n, r) in [
             (f32::NAN, 2.0),
             (1.0, f32::INFINITY),
             (3.0, 2.0),
             (-1.0, 2.0),
         ] {
-            assert_eq!(f.constrain(0, 0, n, r), Err(FusionError::InvalidRange));
+            assert_eq!(f.constrain(1, 0, 0, n, r), Err(FusionError::InvalidRange));
         }
         assert_eq!(f.digest(), before, "a rejected input changed the state");
     }
@@ -946,17 +959,30 @@ fn a_failed_constraint_after_a_retire_changes_nothing() {
     assert_eq!(retired.map(|r| r.key), Some(0), "frame 2 retires key 0");
     let (view, digest) = (key_view(&f), f.digest());
     assert!(view.starts_with("0 2 "), "{view}");
-    for (b, i, near, far, e) in [
-        (0, 999, 1.0, 2.0, FusionError::NoSuchPoint),
-        (3, 0, 1.0, 2.0, FusionError::NoSuchPoint),
-        (0, 0, 3.0, 2.0, FusionError::InvalidRange),
+    // Constraints go to the new key frame (frame 2) while `key` still
+    // shows the retired one: a range meant for key 0 is refused.
+    assert_eq!(f.key_id(), Some(2));
+    for (key, b, i, near, far, e) in [
+        (2, 0, 999, 1.0, 2.0, FusionError::NoSuchPoint),
+        (2, 3, 0, 1.0, 2.0, FusionError::NoSuchPoint),
+        (2, 0, 0, 3.0, 2.0, FusionError::InvalidRange),
+        (
+            0,
+            0,
+            0,
+            1.0,
+            2.0,
+            FusionError::KeyMismatch { key: 2, given: 0 },
+        ),
     ] {
-        assert_eq!(f.constrain(b, i, near, far), Err(e));
+        assert_eq!(f.constrain(key, b, i, near, far), Err(e));
         assert_eq!(key_view(&f), view, "constrain({b}, {i}, {near}, {far})");
         assert_eq!(f.digest(), digest);
     }
     // A good one is on the new key frame (frame 2), which starts then.
-    let p = f.constrain(0, 0, 1.0, 100.0).expect("a point of frame 2");
+    let p = f
+        .constrain(2, 0, 0, 1.0, 100.0)
+        .expect("a point of frame 2");
     assert_eq!(p.pairs, 1);
     assert_eq!(f.key().map(|k| (k.id(), k.partners())), Some((2, 0)));
 }
@@ -995,11 +1021,11 @@ fn ranges_past_the_depth_codes_stay_out_of_the_map() {
     let k = f.key().expect("key").len(0) - 1;
     let digest = f.digest();
     assert_eq!(
-        f.constrain(0, k, 1.0, f32::MAX),
+        f.constrain(0, 0, k, 1.0, f32::MAX),
         Err(FusionError::InvalidRange)
     );
     assert_eq!(f.digest(), digest);
-    let p = f.constrain(0, k, 1.0, 1.0e30).expect("a valid range");
+    let p = f.constrain(0, 0, k, 1.0, 1.0e30).expect("a valid range");
     assert_eq!(p.status, FusedStatus::Single);
     let mut unbounded = 0;
     for id in 1..=2u32 {
@@ -1609,9 +1635,9 @@ fn range_constraints_narrow_or_flag() {
             let z = d.z_true(0, b, i);
             let r = z * (1.0 + f64::from(x * x + y * y)).sqrt();
             let q = if i % 10 == 0 {
-                f.constrain(b, i, (r * 0.99) as f32, (r * 1.01) as f32)
+                f.constrain(0, b, i, (r * 0.99) as f32, (r * 1.01) as f32)
             } else {
-                f.constrain(b, i, (r * 1.3) as f32, (r * 1.35) as f32)
+                f.constrain(0, b, i, (r * 1.3) as f32, (r * 1.35) as f32)
             }
             .expect("constraint");
             if i % 10 == 0 {

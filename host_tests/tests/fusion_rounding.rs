@@ -121,7 +121,7 @@ fn a_range_return_holding_the_truth_keeps_it() {
             f32::from_bits(r32.to_bits() + 1)
         };
         assert!(near as f64 <= r && r <= far as f64);
-        let fp = fusion.constrain(0, i, near, far).unwrap();
+        let fp = fusion.constrain(0, 0, i, near, far).unwrap();
         let iv = fp.interval.unwrap();
         let ok = iv.z_near as f64 <= z_true && z_true <= iv.z_far as f64;
         println!(
@@ -169,7 +169,7 @@ fn a_constrained_point_and_two_exact_pairs_keep_the_truth() {
     let r = norm(q[i]);
     let (near, far) = ((r * (1.0 - 1e-5)) as f32, (r * (1.0 + 1e-5)) as f32);
     assert!((near as f64) < r && r < far as f64);
-    let c = fusion.constrain(0, i, near, far).unwrap();
+    let c = fusion.constrain(0, 0, i, near, far).unwrap();
     println!(
         "constrain(0, {i}, {near}, {far}) -> {:?}; true depth {}",
         c, q[i][2]

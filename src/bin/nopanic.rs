@@ -202,7 +202,13 @@ fn main() -> ! {
         }
         black_box(
             fusion
-                .constrain(black_box(0), black_box(3), black_box(1.0), black_box(2.0))
+                .constrain(
+                    black_box(0),
+                    black_box(0),
+                    black_box(3),
+                    black_box(1.0),
+                    black_box(2.0),
+                )
                 .ok(),
         );
         if let Some(k) = fusion.key() {

@@ -303,6 +303,15 @@ pub enum FusionError {
     RepeatedFrame(u32),
     /// There is no key frame (to constrain).
     NoKeyFrame,
+    /// A constraint named another key frame than the one it would go to
+    /// ([`Fusion::key_id`]): it was meant for a key frame that has
+    /// retired, or not yet started.
+    KeyMismatch {
+        /// The id of the key frame constraints go to now.
+        key: u32,
+        /// The id the constraint named.
+        given: u32,
+    },
     /// The key frame has no such boundary point.
     NoSuchPoint,
     /// A range is not `0 ≤ near ≤ far` with both finite (or its far end
@@ -322,6 +331,10 @@ impl fmt::Display for FusionError {
             ),
             Self::RepeatedFrame(id) => write!(f, "frame {id} was the last frame already"),
             Self::NoKeyFrame => f.write_str("there is no key frame"),
+            Self::KeyMismatch { key, given } => write!(
+                f,
+                "the constraint is for key frame {given}, the key frame is {key}"
+            ),
             Self::NoSuchPoint => f.write_str("the key frame has no such point"),
             Self::InvalidRange => {
                 f.write_str("a range must be finite with 0 <= near <= far, its far depth too")
@@ -717,13 +730,19 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// detected pixel's ray alone missed the truth by about `|x| e₁/f`
     /// of the depth, found by an adversarial review.)
     ///
-    /// The key frame is the processor's kept frame: right after a step
-    /// that retired a key frame, the constraint is on the **new** one,
-    /// whose fusion starts with it ([`Fusion::key`] shows the new key frame
-    /// from then on, not the retired one's final state). An error leaves
-    /// everything as it was, [`Fusion::key`] included.
+    /// `key` names the key frame the range belongs to (its frame id, as
+    /// given to [`Fusion::step`]); it must be the one constraints go to,
+    /// [`Fusion::key_id`], the processor's kept frame, else
+    /// [`FusionError::KeyMismatch`]: right after a step that retired a key
+    /// frame that is the **new** one, whose fusion starts with it
+    /// ([`Fusion::key`] shows the new key frame from then on, not the
+    /// retired one's final state), so a range measured for the retired
+    /// one's pixels is refused rather than put on another point. An error
+    /// leaves everything as it was, [`Fusion::key`] included. The checks,
+    /// in order: the range, a key frame, the key, the point.
     pub fn constrain(
         &mut self,
+        key: u32,
         boundary: usize,
         index: usize,
         near: f32,
@@ -731,6 +750,13 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     ) -> Result<FusedPoint, FusionError> {
         if !(near.is_finite() && far.is_finite() && 0.0 <= near && near <= far) {
             return Err(FusionError::InvalidRange);
+        }
+        let current = self.key_id().ok_or(FusionError::NoKeyFrame)?;
+        if key != current {
+            return Err(FusionError::KeyMismatch {
+                key: current,
+                given: key,
+            });
         }
         // Every check before the pending key frame's fusion starts
         // (`settle`): the kept frame is that key frame, and an error must
@@ -777,6 +803,18 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         self.key
             .point(boundary, index)
             .ok_or(FusionError::NoSuchPoint)
+    }
+
+    /// The id of the key frame that [`Fusion::constrain`] and
+    /// [`Fusion::key_point`] address: the processor's kept frame, the
+    /// newest key frame (right after a step that retired one, the new one,
+    /// while [`Fusion::key`] still shows the retired one). `None` without a
+    /// key frame.
+    pub fn key_id(&self) -> Option<u32> {
+        if !self.has_key || self.processor.previous().is_none() {
+            return None;
+        }
+        Some(self.pending.map_or(self.key.id(), |(id, _)| id))
     }
 
     /// The current key frame's fusion, if there is a key frame. Right

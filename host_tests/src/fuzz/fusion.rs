@@ -347,8 +347,11 @@ pub mod bit {
     pub const PARTLY_UNSEEN: u32 = 96;
     /// The sight check's widening seen (`FusedStatus::Widened`).
     pub const WIDENED: u32 = 97;
+    /// A constraint for another key frame refused
+    /// (`FusionError::KeyMismatch`).
+    pub const KEY_MISMATCH: u32 = 98;
     /// One past the last.
-    pub const END: u32 = 98;
+    pub const END: u32 = 99;
 }
 
 use frame::set;
@@ -422,7 +425,8 @@ fn error_bit(e: &FusionError) -> u32 {
         FusionError::RepeatedFrame(_) => 2,
         FusionError::NoKeyFrame => 3,
         FusionError::NoSuchPoint => 4,
-        // (Non-exhaustive: a later variant counts with the last one.)
+        FusionError::KeyMismatch { .. } => bit::KEY_MISMATCH - bit::FUSION_ERR,
+        // (Non-exhaustive: a later variant counts with `InvalidRange`.)
         _ => 5,
     }
 }
@@ -480,6 +484,7 @@ fn run_case<const N: usize, const B: usize, const M: usize>(case: &Case) -> Outc
     let mut shadow = f.clone();
     // The model: the last accepted frame, the points that entered the map.
     let mut last: Option<u32> = None;
+    let mut model_key: Option<u32> = None;
     let mut entered: u64 = 0;
     // Frames without points paired with the key frame: each may take a
     // partner's place beyond `max_partners` (it cannot be the last
@@ -495,6 +500,7 @@ fn run_case<const N: usize, const B: usize, const M: usize>(case: &Case) -> Outc
                 f.reset();
                 shadow.reset();
                 last = None;
+                model_key = None;
                 entered = 0;
                 blank_paired = 0;
                 allowed = u32::from(policy.max_partners());
@@ -581,6 +587,11 @@ fn run_case<const N: usize, const B: usize, const M: usize>(case: &Case) -> Outc
                         if s.new_key.is_some() || f.key().is_none() {
                             blank_paired = 0;
                         }
+                        if s.new_key.is_some() {
+                            model_key = Some(*id);
+                        } else if f.key().is_none() {
+                            model_key = None;
+                        }
                     }
                 }
             }
@@ -592,9 +603,12 @@ fn run_case<const N: usize, const B: usize, const M: usize>(case: &Case) -> Outc
                 times,
             } => {
                 for rep in 0..*times {
+                    // (One call in five names a key frame one off.)
+                    let key = model_key.unwrap_or(0).wrapping_add(u32::from(n % 5 == 4));
                     constrain(
                         &mut f,
                         &mut shadow,
+                        (model_key, key),
                         (*boundary, *index, *near, *far),
                         // (The whole state as for a step, on the first.)
                         rep == 0 && n % 8 == 0,
@@ -620,6 +634,7 @@ fn run_case<const N: usize, const B: usize, const M: usize>(case: &Case) -> Outc
 fn constrain<const N: usize, const B: usize, const M: usize>(
     f: &mut Fusion<N, B, M>,
     shadow: &mut Fusion<N, B, M>,
+    (model_key, key): (Option<u32>, u32),
     (boundary, index, near, far): (usize, usize, f32, f32),
     check_whole: bool,
     features: &mut u128,
@@ -627,12 +642,22 @@ fn constrain<const N: usize, const B: usize, const M: usize>(
 ) {
     let valid = near.is_finite() && far.is_finite() && 0.0 <= near && near <= far;
     let kept = f.processor().previous().filter(|_| f.key().is_some());
+    // (The model's key frame: the last step that started one.)
+    assert_eq!(
+        f.key_id(),
+        model_key.filter(|_| kept.is_some()),
+        "{at}: key_id"
+    );
     let want = if !valid {
         Some(FusionError::InvalidRange)
     } else {
-        match kept {
-            None => Some(FusionError::NoKeyFrame),
-            Some(k) => k
+        match (kept, model_key) {
+            (None, _) | (_, None) => Some(FusionError::NoKeyFrame),
+            (Some(_), Some(current)) if current != key => Some(FusionError::KeyMismatch {
+                key: current,
+                given: key,
+            }),
+            (Some(k), Some(_)) => k
                 .boundaries()
                 .get(boundary)
                 .and_then(|b| b.points().get(index))
@@ -641,7 +666,7 @@ fn constrain<const N: usize, const B: usize, const M: usize>(
     };
     let before = f.digest();
     let whole = (want.is_some() && check_whole).then(|| format!("{f:?}"));
-    match f.constrain(boundary, index, near, far) {
+    match f.constrain(key, boundary, index, near, far) {
         Err(e) => {
             // A far end whose depth overflows is an invalid range too (its
             // depth is `far` over at least 1, rounded up by 10⁻⁶).
@@ -673,7 +698,7 @@ fn constrain<const N: usize, const B: usize, const M: usize>(
                 set(features, bit::SATURATED);
             }
             assert_eq!(
-                shadow.constrain(boundary, index, near, far),
+                shadow.constrain(key, boundary, index, near, far),
                 Ok(p),
                 "{at}: the shadow differs"
             );

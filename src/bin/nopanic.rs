@@ -260,6 +260,10 @@ fn main() -> ! {
         for _ in 0..black_box(3) {
             let _ = link.poll(&mut rx, |ev| match ev {
                 Event::Frame(job) => {
+                    // (Into the fusion too, as the optimiser cannot tell.)
+                    if black_box(false) {
+                        black_box(job.run_fused(&mut fusion).ok());
+                    }
                     if let Ok(step) = job.run(&mut processor) {
                         let head = job.result_head(black_box(7));
                         if let Ok(n) =

@@ -317,6 +317,11 @@ pub enum FusionError {
     /// A range is not `0 ≤ near ≤ far` with both finite (or its far end
     /// converted to a depth overflows).
     InvalidRange,
+    /// A frame from the link declared a localisation error or motion-error
+    /// bounds larger than the fusion's configuration
+    /// ([`crate::wire::FrameJob::run_fused`]): its sticks would not be
+    /// guaranteed.
+    ErrorsAboveConfig,
 }
 
 impl core::error::Error for FusionError {}
@@ -338,6 +343,9 @@ impl fmt::Display for FusionError {
             Self::NoSuchPoint => f.write_str("the key frame has no such point"),
             Self::InvalidRange => {
                 f.write_str("a range must be finite with 0 <= near <= far, its far depth too")
+            }
+            Self::ErrorsAboveConfig => {
+                f.write_str("the frame's declared errors exceed the fusion's configuration")
             }
         }
     }
@@ -904,9 +912,23 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         self.processor.set_fold_counting(on);
     }
 
+    /// The id of the last frame a step accepted (`None` before the first
+    /// and after [`Fusion::reset`]): the frame the next step's motion must
+    /// start from ([`FusionError::BrokenChain`]).
+    pub fn last_frame(&self) -> Option<u32> {
+        self.last
+    }
+
     /// The policy.
     pub fn config(&self) -> &FusionConfig {
         &self.config
+    }
+
+    /// The processor's configuration the fusion was made with
+    /// ([`Fusion::new`]'s `base`): every pair's error model, before the
+    /// composed motion's bounds are added.
+    pub fn base_config(&self) -> &Config {
+        &self.base
     }
 
     /// A 32-bit FNV-1a digest of the key frame's fusion and the map, bit

@@ -24,6 +24,8 @@
 use super::decode::{FrameInfo, MotionPacket, Packet};
 use super::encode::ResultHead;
 use super::{DataIds, Decoder, ErrorKind, WireError};
+use crate::fusion::{ChainedMotion, Fusion, FusionError, FusionStep};
+use crate::math::fmin;
 use crate::{Config, Frame, Motion, ProcessError, Processor, Step};
 
 /// What the receiver counted.
@@ -108,6 +110,63 @@ impl<const N: usize, const B: usize> FrameJob<'_, N, B> {
             processor.reset();
         }
         processor.process_within(self.frame, self.motion.as_ref(), deadline)
+    }
+
+    /// Run the frame through a key-frame fusion ([`Fusion::step`]) rather
+    /// than pairing it with the last frame: the per-frame motion from the
+    /// kept frame chains as [`ChainedMotion`] from [`Self::kept_id`], and
+    /// the fusion pairs the frame with its key frame.
+    ///
+    /// The fusion's error model is fixed when it is made
+    /// ([`Fusion::base_config`]), so the job's must fit in it: this frame's
+    /// localisation-error radius (the largest of its boundaries) at most
+    /// both its `e₁` (the frame may become the key frame) and its `e₂`, and
+    /// the motion's error bounds (the packet's, else the receiver's base
+    /// configuration's) at most its bounds, per component. Otherwise
+    /// [`FusionError::ErrorsAboveConfig`] and nothing changes: the sticks
+    /// would not be guaranteed. Make the fusion with the largest errors the
+    /// front end and the odometry declare. A frame whose motion does not
+    /// start from the fusion's last frame ([`Fusion::last_frame`]: the
+    /// motion packet was lost, [`Self::motion`] `None`, or the frame before
+    /// was refused or not run) resets the fusion first ([`Fusion::reset`])
+    /// and starts it anew: the chain of motions is broken and the map
+    /// cannot be carried to this frame.
+    pub fn run_fused<const M: usize>(
+        &self,
+        fusion: &mut Fusion<N, B, M>,
+    ) -> Result<FusionStep, FusionError> {
+        self.run_fused_within(fusion, &mut crate::deadline::NoDeadline)
+    }
+
+    /// [`Self::run_fused`] within the caller's `deadline`
+    /// ([`Fusion::step_within`]).
+    pub fn run_fused_within<const M: usize, D: crate::deadline::Deadline>(
+        &self,
+        fusion: &mut Fusion<N, B, M>,
+        deadline: &mut D,
+    ) -> Result<FusionStep, FusionError> {
+        let base = fusion.base_config();
+        let radius = self.info.max_radius(self.frame.boundaries().len());
+        let mut within = radius <= fmin(base.e1(), base.e2());
+        if self.motion.is_some() {
+            let (have, allow) = (self.config.rotation_error(), base.rotation_error());
+            within &= self.config.translation_error() <= base.translation_error()
+                && have.iter().zip(&allow).all(|(h, a)| h <= a);
+        }
+        if !within {
+            return Err(FusionError::ErrorsAboveConfig);
+        }
+        let chained = self
+            .motion
+            .map(|motion| ChainedMotion {
+                from: self.kept_id,
+                motion,
+            })
+            .filter(|c| fusion.last_frame() == Some(c.from));
+        if chained.is_none() {
+            fusion.reset();
+        }
+        fusion.step_within(self.info.frame_id, self.frame, chained.as_ref(), deadline)
     }
 
     /// The result packet's head for this job.

@@ -531,3 +531,101 @@ fn a_refused_boundary_leaves_the_packet_as_it_was() {
         assert_eq!(&got[..len], &want[..], "room {room}");
     }
 }
+
+/// A drive through the link into a key-frame fusion (`FrameJob::run_fused`)
+/// fuses what the same frames and motions given to `Fusion::step` fuse,
+/// bit for bit; a frame declaring a larger error than the fusion's is
+/// refused with the state unchanged; a lost motion packet, or a motion from
+/// the refused frame, resets the fusion (the chain is broken) and the frame
+/// starts a new key frame.
+#[test]
+fn frames_from_the_link_fuse_as_the_same_frames_stepped() {
+    use crate::fusion::{ChainedMotion, Fusion, FusionConfig, FusionError, KeyReason};
+    use crate::{Config, Motion};
+    // A straight edge on the ground 1 below the camera and 1 to the left,
+    // depths 10 to 21, after n steps of 0.25 forward and 0.02 right;
+    // pixels on the link's 1/16 px grid, so the link carries them exactly.
+    let edge = |n: f32| -> Vec<Pixel> {
+        (0..12)
+            .map(|i| {
+                let (x, z) = (-1.0 - 0.02 * n, 10.0 + i as f32 - 0.25 * n);
+                let g = |c: f32| (c * 16.0).round() / 16.0;
+                Pixel::new(g(255.5 + 800.0 * x / z), g(239.5 + 800.0 / z))
+            })
+            .collect()
+    };
+    let step = Motion::new([0.02, 0.0, 0.25], [0.0; 3]).unwrap();
+    let motion_raw = |counter: u16, from: u32, to: u32| {
+        let mut raw = [0u8; 80];
+        let m = MotionFields {
+            from,
+            to,
+            translation: step.translation(),
+            rotation: step.angles(),
+            translation_error: None,
+            rotation_error: None,
+        };
+        let n = encode::motion(&mut raw, IDS.motion, counter, &m).unwrap();
+        link(&raw[..n])
+    };
+    let policy = FusionConfig::new(4, 500).unwrap();
+    let mut via_link = Fusion::<64, 2, 128>::new(Config::DEFAULT, policy);
+    let mut direct = Fusion::<64, 2, 128>::new(Config::DEFAULT, policy);
+    let mut rx = super::Receiver::<64, 2>::new(IDS, Config::DEFAULT);
+    rx.feed(&[0], |_| {});
+    rx.feed(&camera_packet(0), |_| {});
+    let mut retired = 0;
+    for id in 0..20u32 {
+        let pts = edge(id as f32);
+        // Frame 8's motion packet is lost.
+        if id > 0 && id != 8 {
+            rx.feed(&motion_raw(id as u16, id - 1, id), |_| {});
+        }
+        // Frame 3 declares 0.75 px, above the fusion's 0.5.
+        let r = if id == 3 { 0.75 } else { 0.5 };
+        let packet = frame_packet(id as u16, id, &[(r, pts.clone()), (r, pts.clone())]);
+        let mut got = None;
+        let before = via_link.digest();
+        rx.feed(&packet, |e| {
+            if let super::Event::Frame(job) = e {
+                got = Some(job.run_fused(&mut via_link));
+            }
+        });
+        let got = got.expect("a frame job");
+        if id == 3 {
+            assert_eq!(got, Err(FusionError::ErrorsAboveConfig));
+            assert_eq!(
+                via_link.digest(),
+                before,
+                "a refused frame changed the state"
+            );
+            assert_eq!(via_link.last_frame(), Some(2));
+            continue;
+        }
+        let mut frame = Frame::<64, 2>::new(cam());
+        frame.push_boundary(&pts).unwrap();
+        frame.push_boundary(&pts).unwrap();
+        // After the refused frame 3 (frame 4's motion starts from it) and
+        // the lost motion of frame 8, the chain starts anew.
+        let anew = id == 0 || id == 4 || id == 8;
+        if anew {
+            direct.reset();
+        }
+        let chained = (!anew).then_some(ChainedMotion {
+            from: id - 1,
+            motion: step,
+        });
+        let want = direct.step(id, &frame, chained.as_ref()).unwrap();
+        let s = got.unwrap();
+        assert_eq!(s, want, "frame {id}");
+        assert_eq!(via_link.digest(), direct.digest(), "frame {id}");
+        if anew {
+            assert_eq!(s.new_key, Some(KeyReason::First), "frame {id}");
+            assert_eq!(via_link.map().batches(), 0);
+        }
+        retired += usize::from(s.retired.is_some());
+    }
+    // Key frames retired into the map after the resets.
+    assert!(retired >= 2, "{retired}");
+    assert!(via_link.map().points(0).count() > 0);
+}

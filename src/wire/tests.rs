@@ -611,7 +611,7 @@ fn frames_from_the_link_fuse_as_the_same_frames_stepped() {
         if anew {
             direct.reset();
         }
-        let chained = (!anew).then_some(ChainedMotion {
+        let chained = (!anew).then(|| ChainedMotion {
             from: id - 1,
             motion: step,
         });

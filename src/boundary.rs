@@ -220,7 +220,11 @@ impl<const N: usize, const B: usize> Frame<N, B> {
     /// does not turn the right edge into boundary 0. An absent boundary has
     /// no points: as frame 1 of a pair it gives no results, as frame 2
     /// every point of the other frame's boundary `k` is `no_intersection`
-    /// (or flagged earlier, as any point is). A polyline of fewer than two
+    /// (or flagged earlier, as any point is). The other boundaries' results
+    /// are what they would be with it present while the frame's work
+    /// budget ([`crate::Config::with_work_budget`], whose unused units carry
+    /// from one boundary to the next) and the caller's deadline do not run
+    /// out. A polyline of fewer than two
     /// points stays an error of [`Frame::push_boundary`]: absence is said,
     /// not inferred. `Err(TooManyBoundaries)` when the frame holds `B`
     /// boundaries (the frame unchanged).

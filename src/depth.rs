@@ -104,14 +104,14 @@ use crate::math::{cross, dot, fmax, fmin, sqrt_pos};
 
 /// Depth interval along the frame-1 ray: every depth consistent with the
 /// localisation errors lies in `[z_near, z_far]` (length unit of the motion).
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 ///
 /// The interval is what the errors allow, however wide: `Config::max_depth`
 /// bounds the depth estimate (a point past it is `beyond_max_depth`), not
 /// `z_far`, which can lie far beyond it where the disparity is only a few
 /// times its error. A consumer that wants only informative points filters
 /// on [`DepthInterval::relative_width`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct DepthInterval {
     /// Nearest consistent depth `Z_near` (> 0).
     pub z_near: f32,
@@ -122,7 +122,8 @@ pub struct DepthInterval {
 impl DepthInterval {
     /// `(z_far − z_near) / z`: the interval's length relative to the depth
     /// estimate `z` (`PointResult`'s point's `Z`), what Sec. 4.1 calls the
-    /// relative error range. Infinite or NaN where `z` is not above 0.
+    /// relative error range (an `ok` point's `z` is above 0; for any other
+    /// `z` the quotient is whatever `f32` division gives).
     ///
     /// ```
     /// use roadstereo::DepthInterval;

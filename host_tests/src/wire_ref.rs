@@ -242,25 +242,25 @@ impl<const N: usize, const B: usize> Reference<N, B> {
                     got: index,
                 });
             }
+            let n = le16(p, off + 4);
+            if n == 0 {
+                // An absent boundary: its radius ignored, unchecked.
+                frame.push_absent().expect("a slot: the count is at most B");
+                quality[k] = p[off + 1];
+                radius[k] = 0.0;
+                off += 6;
+                continue;
+            }
             let r = raw_to_radius(le16(p, off + 2));
             if r > 100.0 {
                 return Out::Err(WireError::Radius { boundary: k as u8 });
             }
-            let n = le16(p, off + 4);
             if usize::from(n) > N {
                 return Out::Err(WireError::TooManyPoints {
                     boundary: k as u8,
                     len: n,
                     capacity: N as u16,
                 });
-            }
-            if n == 0 {
-                // An absent boundary: its radius ignored.
-                frame.push_absent().expect("a slot: the count is at most B");
-                quality[k] = p[off + 1];
-                radius[k] = 0.0;
-                off += 6;
-                continue;
             }
             if n < 2 {
                 return Out::Err(WireError::Boundary {

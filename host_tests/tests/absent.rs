@@ -230,3 +230,71 @@ fn fusion_over_drives_where_boundaries_come_and_go() {
     assert_eq!(all.wrong_fused, 0);
     assert!(all.consistent > 5_000, "{all:?}");
 }
+
+/// With a work budget that binds (16 units a point), an absent boundary
+/// changes what the budget leaves the other (its unused units carry from
+/// one boundary to the next), never the match a point gets: each of the
+/// other boundary's points is the unlimited run's result, `over_budget`,
+/// or `ok` with the same match and a stick round the unlimited one (a
+/// refinement left unpaid).
+#[test]
+fn with_a_budget_that_binds_the_other_boundary_only_moves_its_budget_line() {
+    let small = Config::DEFAULT.with_work_budget(16).expect("valid");
+    let run = |f1: &Frame<N, B>, f2: &Frame<N, B>, m: &roadstereo::Motion, c: Config| {
+        let mut p = Box::new(Processor::<N, B>::new(c));
+        assert!(matches!(p.process(f1, None), Ok(Step::First)));
+        p.process_against_kept(f2, m).expect("structure").clone()
+    };
+    let (mut moved, mut compared) = (0usize, 0usize);
+    for s in (0..40).map(scenarios::random) {
+        let r = s.render();
+        if r.frame1.len() < 2 || r.frame2.len() < 2 {
+            continue;
+        }
+        let cam = s.intrinsics.camera();
+        let p1 = synth::Rendered::pixels(&r.frame1, true);
+        let p2 = synth::Rendered::pixels(&r.frame2, true);
+        let m = r.motion();
+        let full1 = frame_with(cam, &[Some(&p1[0]), Some(&p1[1])]);
+        let full2 = frame_with(cam, &[Some(&p2[0]), Some(&p2[1])]);
+        let (unlimited, _) = pair(&full1, &full2, &m);
+        let budgeted = run(&full1, &full2, &m, small);
+        let variants = [
+            (
+                frame_with(cam, &[Some(&p1[0]), Some(&p1[1])]),
+                frame_with(cam, &[None, Some(&p2[1])]),
+            ),
+            (
+                frame_with(cam, &[None, Some(&p1[1])]),
+                frame_with(cam, &[Some(&p2[0]), Some(&p2[1])]),
+            ),
+        ];
+        for (f1, f2) in &variants {
+            let got = run(f1, f2, &m, small);
+            for ((g, u), b) in got.boundaries()[1]
+                .points()
+                .iter()
+                .zip(unlimited.boundaries()[1].points())
+                .zip(budgeted.boundaries()[1].points())
+            {
+                // (Or a looser stick round the same match: a refinement the
+                // budget did not pay for, as any budget may leave.)
+                let looser = g.status() == Status::Ok
+                    && u.status() == Status::Ok
+                    && g.pixel2() == u.pixel2()
+                    && g.interval()
+                        .zip(u.interval())
+                        .is_some_and(|(a, b)| a.z_near <= b.z_near && b.z_far <= a.z_far);
+                assert!(
+                    g == u || looser || g.status() == Status::OverBudget,
+                    "{}: {g:?} vs {u:?}",
+                    s.name
+                );
+                moved += usize::from(g != b);
+                compared += 1;
+            }
+        }
+    }
+    println!("budget 16: {moved} of {compared} points of the other boundary differ from the run with both boundaries, each the unlimited result, over_budget or a looser stick");
+    assert!(compared > 10_000, "{compared}");
+}

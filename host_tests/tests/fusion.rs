@@ -878,7 +878,10 @@ fn bad_inputs_are_typed_errors_and_change_nothing() {
         // A range for another key frame's pixels is refused.
         assert_eq!(
             f.constrain(0, 0, 0, 1.0, 2.0),
-            Err(FusionError::KeyMismatch { key: 1, given: 0 })
+            Err(FusionError::KeyMismatch {
+                expected: 1,
+                given: 0
+            })
         );
         for (n, r) in [
             (f32::NAN, 2.0),
@@ -972,7 +975,10 @@ fn a_failed_constraint_after_a_retire_changes_nothing() {
             0,
             1.0,
             2.0,
-            FusionError::KeyMismatch { key: 2, given: 0 },
+            FusionError::KeyMismatch {
+                expected: 2,
+                given: 0,
+            },
         ),
     ] {
         assert_eq!(f.constrain(key, b, i, near, far), Err(e));

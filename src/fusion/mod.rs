@@ -308,7 +308,7 @@ pub enum FusionError {
     /// retired, or not yet started.
     KeyMismatch {
         /// The id of the key frame constraints go to now.
-        key: u32,
+        expected: u32,
         /// The id the constraint named.
         given: u32,
     },
@@ -336,9 +336,9 @@ impl fmt::Display for FusionError {
             ),
             Self::RepeatedFrame(id) => write!(f, "frame {id} was the last frame already"),
             Self::NoKeyFrame => f.write_str("there is no key frame"),
-            Self::KeyMismatch { key, given } => write!(
+            Self::KeyMismatch { expected, given } => write!(
                 f,
-                "the constraint is for key frame {given}, the key frame is {key}"
+                "the constraint is for key frame {given}, the key frame is {expected}"
             ),
             Self::NoSuchPoint => f.write_str("the key frame has no such point"),
             Self::InvalidRange => {
@@ -762,7 +762,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         let current = self.key_id().ok_or(FusionError::NoKeyFrame)?;
         if key != current {
             return Err(FusionError::KeyMismatch {
-                key: current,
+                expected: current,
                 given: key,
             });
         }
@@ -813,11 +813,11 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             .ok_or(FusionError::NoSuchPoint)
     }
 
-    /// The id of the key frame that [`Fusion::constrain`] and
-    /// [`Fusion::key_point`] address: the processor's kept frame, the
-    /// newest key frame (right after a step that retired one, the new one,
-    /// while [`Fusion::key`] still shows the retired one). `None` without a
-    /// key frame.
+    /// The id of the key frame that [`Fusion::constrain`] addresses: the
+    /// processor's kept frame, the newest key frame (right after a step
+    /// that retired one, the new one, while [`Fusion::key`] still shows
+    /// the retired one and [`Fusion::key_point`] gives `None` until the
+    /// new one's fusion starts). `None` without a key frame.
     pub fn key_id(&self) -> Option<u32> {
         if !self.has_key || self.processor.previous().is_none() {
             return None;

@@ -729,6 +729,19 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
                 got: index,
             });
         }
+        if n == 0 {
+            // An absent boundary (`Frame::push_absent`): its quality kept,
+            // its radius ignored, unchecked (0, so that it widens no pair's
+            // error).
+            if let Some(q) = self.info.quality.get_mut(k) {
+                *q = quality;
+            }
+            if let Some(r) = self.info.radius_px.get_mut(k) {
+                *r = 0.0;
+            }
+            self.points = 0;
+            return self.boundary_done();
+        }
         let radius = raw_to_radius(radius);
         if radius > super::MAX_RADIUS_PX {
             return self.fault(WireError::Radius { boundary: kb });
@@ -739,18 +752,6 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
                 len: n,
                 capacity: u16::try_from(N).unwrap_or(u16::MAX),
             });
-        }
-        if n == 0 {
-            // An absent boundary (`Frame::push_absent`): its quality kept,
-            // its radius ignored (0, so that it widens no pair's error).
-            if let Some(q) = self.info.quality.get_mut(k) {
-                *q = quality;
-            }
-            if let Some(r) = self.info.radius_px.get_mut(k) {
-                *r = 0.0;
-            }
-            self.points = 0;
-            return self.boundary_done();
         }
         if n < 2 {
             return self.fault(WireError::Boundary {

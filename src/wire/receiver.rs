@@ -120,9 +120,10 @@ impl<const N: usize, const B: usize> FrameJob<'_, N, B> {
     /// The fusion's error model is fixed when it is made
     /// ([`Fusion::base_config`]), so the job's must fit in it: this frame's
     /// localisation-error radius (the largest of its boundaries) at most
-    /// both its `e₁` (the frame may become the key frame) and its `e₂`, and
-    /// the motion's error bounds (the packet's, else the receiver's base
-    /// configuration's) at most its bounds, per component. Otherwise
+    /// both its `e₁` (the frame may become the key frame) and its `e₂`, and,
+    /// where the motion chains on, the motion's error bounds (the packet's,
+    /// else the receiver's base configuration's) at most its bounds, per
+    /// component. Otherwise
     /// [`FusionError::ErrorsAboveConfig`] and nothing changes: the sticks
     /// would not be guaranteed. Make the fusion with the largest errors the
     /// front end and the odometry declare. A frame whose motion does not
@@ -145,17 +146,6 @@ impl<const N: usize, const B: usize> FrameJob<'_, N, B> {
         fusion: &mut Fusion<N, B, M>,
         deadline: &mut D,
     ) -> Result<FusionStep, FusionError> {
-        let base = fusion.base_config();
-        let radius = self.info.max_radius(self.frame.boundaries().len());
-        let mut within = radius <= fmin(base.e1(), base.e2());
-        if self.motion.is_some() {
-            let (have, allow) = (self.config.rotation_error(), base.rotation_error());
-            within &= self.config.translation_error() <= base.translation_error()
-                && have.iter().zip(&allow).all(|(h, a)| h <= a);
-        }
-        if !within {
-            return Err(FusionError::ErrorsAboveConfig);
-        }
         let chained = self
             .motion
             .map(|motion| ChainedMotion {
@@ -163,6 +153,18 @@ impl<const N: usize, const B: usize> FrameJob<'_, N, B> {
                 motion,
             })
             .filter(|c| fusion.last_frame() == Some(c.from));
+        let base = fusion.base_config();
+        let radius = self.info.max_radius(self.frame.boundaries().len());
+        let mut within = radius <= fmin(base.e1(), base.e2());
+        // (A motion the broken chain throws away bounds nothing.)
+        if chained.is_some() {
+            let (have, allow) = (self.config.rotation_error(), base.rotation_error());
+            within &= self.config.translation_error() <= base.translation_error()
+                && have.iter().zip(&allow).all(|(h, a)| h <= a);
+        }
+        if !within {
+            return Err(FusionError::ErrorsAboveConfig);
+        }
         if chained.is_none() {
             fusion.reset();
         }

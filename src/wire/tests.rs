@@ -212,6 +212,22 @@ fn an_absent_boundary_round_trips_and_one_point_is_an_error() {
         assert_eq!(info.radius_px, [0.0, 1.25]);
         assert_eq!(info.max_radius(2), 1.25);
     }
+    // An absent boundary's radius is not checked: one past the 100 px
+    // limit (raw 0xFFFF, which the encoder would refuse) still decodes.
+    let mut raw = frame_raw(2, 7, &[(3.0, Vec::new()), (1.25, b1.clone())]);
+    let at = HEADER_LEN + 18 + 2;
+    raw[at..at + 2].copy_from_slice(&0xFFFFu16.to_le_bytes());
+    let body = raw.len() - 4;
+    let crc = CRC.checksum(&raw[..body]);
+    raw[body..].copy_from_slice(&crc.to_le_bytes());
+    let mut d = Decoder::<64, 2>::new(IDS);
+    run(&mut d, &[vec![0u8], camera_packet(0)].concat(), 9);
+    let out = run(&mut d, &link(&raw), 9);
+    let [Out::Frame(f, info, 0)] = &out[..] else {
+        panic!("{out:?}")
+    };
+    assert!(f.boundaries()[0].is_absent());
+    assert_eq!(info.radius_px, [0.0, 1.25]);
     // One point is not a boundary: the error it always was.
     let mut d = Decoder::<64, 2>::new(IDS);
     run(&mut d, &camera_packet(0), 9);
@@ -628,4 +644,91 @@ fn frames_from_the_link_fuse_as_the_same_frames_stepped() {
     // Key frames retired into the map after the resets.
     assert!(retired >= 2, "{retired}");
     assert!(via_link.map().points(0).count() > 0);
+}
+
+/// `run_fused` refuses a motion whose error bounds exceed the fusion's
+/// where the motion chains on (translation, then rotation), with nothing
+/// changed; the next frame, whose motion starts from the refused one,
+/// starts the fusion anew without its bounds being judged; an absent
+/// boundary (0 points, its radius ignored even at 99 px) pairs on.
+#[test]
+fn run_fused_judges_the_motion_bounds_it_uses() {
+    use crate::fusion::{Fusion, FusionConfig, FusionError, KeyReason};
+    use crate::{Config, Motion};
+    let edge = |n: f32, x0: f32| -> Vec<Pixel> {
+        (0..12)
+            .map(|i| {
+                let (x, z) = (x0 - 0.02 * n, 10.0 + i as f32 - 0.25 * n);
+                let g = |c: f32| (c * 16.0).round() / 16.0;
+                Pixel::new(g(255.5 + 800.0 * x / z), g(239.5 + 800.0 / z))
+            })
+            .collect()
+    };
+    let step = Motion::new([0.02, 0.0, 0.25], [0.0; 3]).unwrap();
+    let motion_raw = |counter: u16, to: u32, te: Option<f32>, re: Option<[f32; 3]>| {
+        let mut raw = [0u8; 80];
+        let m = MotionFields {
+            from: to - 1,
+            to,
+            translation: step.translation(),
+            rotation: step.angles(),
+            translation_error: te,
+            rotation_error: re,
+        };
+        let n = encode::motion(&mut raw, IDS.motion, counter, &m).unwrap();
+        link(&raw[..n])
+    };
+    let base = Config::DEFAULT.with_translation_error(0.01).unwrap();
+    let mut f = Fusion::<64, 2, 128>::new(base, FusionConfig::new(4, 500).unwrap());
+    let mut rx = super::Receiver::<64, 2>::new(IDS, Config::DEFAULT);
+    rx.feed(&[0], |_| {});
+    rx.feed(&camera_packet(0), |_| {});
+    let mut paired_absent = 0;
+    for id in 0..12u32 {
+        let (te, re) = match id {
+            4 | 5 => (Some(0.02), None),
+            7 => (Some(0.01), Some([0.0, 0.001, 0.0])),
+            _ => (Some(0.01), None),
+        };
+        if id > 0 {
+            rx.feed(&motion_raw(id as u16, id, te, re), |_| {});
+        }
+        let absent = [2, 3, 9].contains(&id);
+        let b0 = if absent {
+            (99.0, Vec::new())
+        } else {
+            (0.5, edge(id as f32, -1.0))
+        };
+        let packet = frame_packet(100 + id as u16, id, &[b0, (0.5, edge(id as f32, 1.0))]);
+        let before = (f.digest(), f.last_frame(), f.key_id());
+        let mut got = None;
+        rx.feed(&packet, |e| {
+            if let super::Event::Frame(job) = e {
+                got = Some(job.run_fused(&mut f));
+            }
+        });
+        let got = got.expect("a frame job");
+        match id {
+            // The translation bound (4), the rotation bound (7): refused.
+            4 | 7 => {
+                assert_eq!(got, Err(FusionError::ErrorsAboveConfig), "frame {id}");
+                assert_eq!((f.digest(), f.last_frame(), f.key_id()), before);
+            }
+            // Their motions start from the refused frame: anew, frame 5's
+            // bound (above the fusion's) thrown away with its motion.
+            5 | 8 => {
+                let s = got.unwrap();
+                assert_eq!(s.new_key, Some(KeyReason::First), "frame {id}");
+                assert_eq!((f.key_id(), f.last_frame()), (Some(id), Some(id)));
+            }
+            _ => {
+                let s = got.unwrap();
+                assert_eq!(f.last_frame(), Some(id));
+                if absent && s.paired.is_some() {
+                    paired_absent += 1;
+                }
+            }
+        }
+    }
+    assert!(paired_absent >= 2, "{paired_absent}");
 }

@@ -651,9 +651,9 @@ mod bit {
     pub const SAMPLES: u32 = 61;
     pub const CAMERA_CHANGE: u32 = 62;
     pub const LOOSER_STICK: u32 = 63;
-    // (64–98: the fusion target's, `fuzz::fusion`, whose frames are built
-    // here too.)
-    pub const ABSENT: u32 = 99; // a boundary pushed as absent
+    // (64 up to `fuzz::fusion::bit::END`: the fusion target's, whose
+    // frames are built here too.)
+    pub const ABSENT: u32 = 120; // a boundary pushed as absent
 }
 
 pub(super) fn set(f: &mut u128, b: u32) {

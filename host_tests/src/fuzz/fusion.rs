@@ -654,7 +654,7 @@ fn constrain<const N: usize, const B: usize, const M: usize>(
         match (kept, model_key) {
             (None, _) | (_, None) => Some(FusionError::NoKeyFrame),
             (Some(_), Some(current)) if current != key => Some(FusionError::KeyMismatch {
-                key: current,
+                expected: current,
                 given: key,
             }),
             (Some(k), Some(_)) => k

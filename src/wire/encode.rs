@@ -4,8 +4,8 @@
 use core::fmt;
 
 use super::{
-    px_to_raw, radius_to_raw, PacketType, BOUNDARY_HEAD_LEN, CRC, CRC_LEN, FRAME_HEAD_LEN,
-    HEADER_LEN, MAGIC, VERSION,
+    px_to_raw, radius_to_raw, raw_to_px, PacketType, BOUNDARY_HEAD_LEN, CRC, CRC_LEN,
+    FRAME_HEAD_LEN, HEADER_LEN, MAGIC, VERSION,
 };
 use crate::{Camera, Motion, Pixel, Status, Step, Structure};
 
@@ -121,8 +121,13 @@ pub struct FrameHead {
 pub struct BoundaryHead {
     /// Quality from the detector (0–255, carried to the result).
     pub quality: u8,
-    /// Localisation-error radius of every point, pixels (`[0, 100]`;
-    /// rounded up to 1/256 px).
+    /// Localisation-error radius of every point as given to the encoder
+    /// (the detector's), pixels (`[0, 100]`). The packet carries it plus
+    /// the most that rounding the boundary's points to 1/16 px moves one
+    /// (nothing where every point is on that grid, as integer and
+    /// half-pixel ones are), rounded up to 1/256 px: the radius on the wire
+    /// bounds the true point's distance from the point as sent.
+    /// [`EncodeError::Radius`] if that sum exceeds 100.
     pub radius_px: f32,
 }
 
@@ -193,7 +198,26 @@ impl<'a> FramePacket<'a> {
         points: &[Pixel],
     ) -> Result<(), EncodeError> {
         let n = u16::try_from(points.len()).map_err(|_| EncodeError::TooLarge)?;
-        let r = radius_to_raw(head.radius_px).ok_or(EncodeError::Radius)?;
+        radius_to_raw(head.radius_px).ok_or(EncodeError::Radius)?;
+        // What rounding to 1/16 px moves a point, at most over the
+        // boundary: the radius sent covers it, so that it bounds the true
+        // point's distance from the point as sent. (Each difference is
+        // exact or within 2⁻³⁰ px, the two values being within 1/32 px;
+        // the bound is taken 10⁻⁵ larger, relative and absolute, for the
+        // square root and the sum's rounding; `radius_to_raw` rounds up.)
+        let mut moved = 0.0f32;
+        for p in points {
+            let u = px_to_raw(p.u).ok_or(EncodeError::PointRange)?;
+            let v = px_to_raw(p.v).ok_or(EncodeError::PointRange)?;
+            let (du, dv) = (raw_to_px(u) - p.u, raw_to_px(v) - p.v);
+            moved = crate::math::fmax(moved, du * du + dv * dv);
+        }
+        let shift = if moved > 0.0 {
+            crate::math::sqrt(moved) * (1.0 + 1.0e-5) + 1.0e-5
+        } else {
+            0.0
+        };
+        let r = radius_to_raw(head.radius_px + shift).ok_or(EncodeError::Radius)?;
         self.w.u8(index)?;
         self.w.u8(head.quality)?;
         self.w.u16(r)?;

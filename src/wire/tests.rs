@@ -732,3 +732,75 @@ fn run_fused_judges_the_motion_bounds_it_uses() {
     }
     assert!(paired_absent >= 2, "{paired_absent}");
 }
+
+/// The radius a frame packet carries bounds the true point's distance from
+/// the point as sent: the declared radius plus what the rounding to
+/// 1/16 px moved each point (exactly, in `f64`), for points anywhere on
+/// the pixel grid or off it; points on the 1/16 px grid keep the radius
+/// as declared.
+#[test]
+fn the_radius_sent_covers_the_rounding_of_the_points() {
+    let mut rng = Rng(11);
+    let mut widened = 0;
+    for case in 0..2000 {
+        let r = [0.0f32, 0.25, 0.5, 1.0, 99.9][case % 5];
+        let on_grid = case % 7 == 0;
+        let pts: Vec<Pixel> = (0..20)
+            .map(|i| {
+                let u = (rng.next() * 510.0) as f32;
+                let u = if on_grid {
+                    (u * 16.0).round() / 16.0
+                } else {
+                    u
+                };
+                Pixel::new(
+                    u,
+                    470.0
+                        - i as f32
+                        - if on_grid {
+                            0.0
+                        } else {
+                            rng.next() as f32 * 0.9
+                        },
+                )
+            })
+            .collect();
+        let mut raw = vec![0u8; frame_packet_max(64, 4)];
+        let head = FrameHead {
+            timestamp_us: 1,
+            frame_id: 1,
+            width: 512,
+            height: 480,
+        };
+        let bh = BoundaryHead {
+            quality: 0,
+            radius_px: r,
+        };
+        let n = match encode::frame(&mut raw, IDS.frame, 0, &head, &[(bh, &pts)]) {
+            Ok(n) => n,
+            // (99.9 px plus the rounding can pass the 100 px limit.)
+            Err(encode::EncodeError::Radius) if r > 99.0 => continue,
+            Err(e) => panic!("{e:?}"),
+        };
+        let mut d = Decoder::<64, 2>::new(IDS);
+        run(&mut d, &[vec![0u8], camera_packet(0)].concat(), 9);
+        let out = run(&mut d, &link(&raw[..n]), 9);
+        let [Out::Frame(f, info, 0)] = &out[..] else {
+            panic!("{out:?}")
+        };
+        let sent = f64::from(info.radius_px[0]);
+        for (p, q) in pts.iter().zip(f.boundaries()[0].points()) {
+            let moved = (f64::from(q.u) - f64::from(p.u)).hypot(f64::from(q.v) - f64::from(p.v));
+            assert!(
+                moved + f64::from(r) <= sent,
+                "case {case}: {p:?} sent as {q:?}, radius {r} sent as {sent}"
+            );
+        }
+        if on_grid {
+            assert_eq!(info.radius_px[0], raw_to_radius(radius_to_raw(r).unwrap()));
+        } else {
+            widened += usize::from(sent > f64::from(r) + 1.0 / 256.0);
+        }
+    }
+    assert!(widened > 1000, "{widened}");
+}

@@ -747,7 +747,7 @@ fn the_radius_sent_covers_the_rounding_of_the_points() {
         let on_grid = case % 7 == 0;
         let pts: Vec<Pixel> = (0..20)
             .map(|i| {
-                let u = (rng.next() * 510.0) as f32;
+                let u = rng.next() * 510.0;
                 let u = if on_grid {
                     (u * 16.0).round() / 16.0
                 } else {
@@ -755,13 +755,7 @@ fn the_radius_sent_covers_the_rounding_of_the_points() {
                 };
                 Pixel::new(
                     u,
-                    470.0
-                        - i as f32
-                        - if on_grid {
-                            0.0
-                        } else {
-                            rng.next() as f32 * 0.9
-                        },
+                    470.0 - i as f32 - if on_grid { 0.0 } else { rng.next() * 0.9 },
                 )
             })
             .collect();

@@ -39,6 +39,28 @@ fn pair(
     (fast, slow)
 }
 
+/// A two-view scenario with both edges seen in both frames: its camera,
+/// the two frames' pixel polylines and the motion.
+struct TwoEdges {
+    cam: Camera,
+    p1: Vec<Vec<Pixel>>,
+    p2: Vec<Vec<Pixel>>,
+    m: roadstereo::Motion,
+}
+
+fn two_edges(s: &synth::Scenario, quantised: bool) -> Option<TwoEdges> {
+    let r = s.render();
+    if r.frame1.len() < 2 || r.frame2.len() < 2 {
+        return None;
+    }
+    Some(TwoEdges {
+        cam: s.intrinsics.camera(),
+        p1: synth::Rendered::pixels(&r.frame1, quantised),
+        p2: synth::Rendered::pixels(&r.frame2, quantised),
+        m: r.motion(),
+    })
+}
+
 /// No result of an absent frame-2 boundary's points has a depth: each is
 /// `no_intersection` or flagged before the search.
 fn flagged_without_frame2(s: &Structure<N, B>, k: usize, len: usize) {
@@ -67,14 +89,9 @@ fn an_absent_boundary_keeps_the_numbering_and_the_other_boundarys_results() {
     let (mut pairs, mut searched) = (0usize, 0usize);
     for s in &scs {
         for quantised in [false, true] {
-            let r = s.render();
-            if r.frame1.len() < 2 || r.frame2.len() < 2 {
+            let Some(TwoEdges { cam, p1, p2, m }) = two_edges(s, quantised) else {
                 continue;
-            }
-            let cam = s.intrinsics.camera();
-            let p1 = synth::Rendered::pixels(&r.frame1, quantised);
-            let p2 = synth::Rendered::pixels(&r.frame2, quantised);
-            let m = r.motion();
+            };
             let full1 = frame_with(cam, &[Some(&p1[0]), Some(&p1[1])]);
             let full2 = frame_with(cam, &[Some(&p2[0]), Some(&p2[1])]);
             let (full, _) = pair(&full1, &full2, &m);
@@ -118,12 +135,8 @@ fn an_absent_boundary_keeps_the_numbering_and_the_other_boundarys_results() {
 fn a_kept_frame_with_an_absent_boundary_pairs_on() {
     // The frame kept by `process` has boundary 0 absent: the next pair
     // gives boundary 0 no results and boundary 1 its own.
-    let s = scenarios::random(3);
-    let r = s.render();
-    let cam = s.intrinsics.camera();
-    let p1 = synth::Rendered::pixels(&r.frame1, true);
-    let p2 = synth::Rendered::pixels(&r.frame2, true);
-    let m = r.motion();
+    let TwoEdges { cam, p1, p2, m } =
+        two_edges(&scenarios::random(3), true).expect("both edges in view");
     let mut p = Box::new(Processor::<N, B>::new(Config::DEFAULT));
     let f1 = frame_with(cam, &[None, Some(&p1[1])]);
     assert!(matches!(p.process(&f1, None), Ok(Step::First)));
@@ -247,14 +260,9 @@ fn with_a_budget_that_binds_the_other_boundary_only_moves_its_budget_line() {
     };
     let (mut moved, mut compared) = (0usize, 0usize);
     for s in (0..40).map(scenarios::random) {
-        let r = s.render();
-        if r.frame1.len() < 2 || r.frame2.len() < 2 {
+        let Some(TwoEdges { cam, p1, p2, m }) = two_edges(&s, true) else {
             continue;
-        }
-        let cam = s.intrinsics.camera();
-        let p1 = synth::Rendered::pixels(&r.frame1, true);
-        let p2 = synth::Rendered::pixels(&r.frame2, true);
-        let m = r.motion();
+        };
         let full1 = frame_with(cam, &[Some(&p1[0]), Some(&p1[1])]);
         let full2 = frame_with(cam, &[Some(&p2[0]), Some(&p2[1])]);
         let (unlimited, _) = pair(&full1, &full2, &m);

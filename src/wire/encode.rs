@@ -199,18 +199,25 @@ impl<'a> FramePacket<'a> {
     ) -> Result<(), EncodeError> {
         let n = u16::try_from(points.len()).map_err(|_| EncodeError::TooLarge)?;
         radius_to_raw(head.radius_px).ok_or(EncodeError::Radius)?;
-        // What rounding to 1/16 px moves a point, at most over the
-        // boundary: the radius sent covers it, so that it bounds the true
-        // point's distance from the point as sent. (Each difference is
-        // exact or within 2⁻³⁰ px, the two values being within 1/32 px;
-        // the bound is taken 10⁻⁵ larger, relative and absolute, for the
-        // square root and the sum's rounding; `radius_to_raw` rounds up.)
+        self.w.u8(index)?;
+        self.w.u8(head.quality)?;
+        let radius_at = self.w.at;
+        self.w.u16(0)?;
+        self.w.u16(n)?;
+        // The points, and what rounding them to 1/16 px moves one at most:
+        // the radius sent covers it, so that it bounds the true point's
+        // distance from the point as sent. (Each difference is exact or
+        // within 2⁻³⁰ px, the two values being within 1/32 px; the bound is
+        // taken 10⁻⁵ larger, relative and absolute, for the square root and
+        // the sum's rounding; `radius_to_raw` rounds up.)
         let mut moved = 0.0f32;
         for p in points {
             let u = px_to_raw(p.u).ok_or(EncodeError::PointRange)?;
             let v = px_to_raw(p.v).ok_or(EncodeError::PointRange)?;
             let (du, dv) = (raw_to_px(u) - p.u, raw_to_px(v) - p.v);
             moved = crate::math::fmax(moved, du * du + dv * dv);
+            self.w.u16(u)?;
+            self.w.u16(v)?;
         }
         let shift = if moved > 0.0 {
             crate::math::sqrt(moved) * (1.0 + 1.0e-5) + 1.0e-5
@@ -218,16 +225,7 @@ impl<'a> FramePacket<'a> {
             0.0
         };
         let r = radius_to_raw(head.radius_px + shift).ok_or(EncodeError::Radius)?;
-        self.w.u8(index)?;
-        self.w.u8(head.quality)?;
-        self.w.u16(r)?;
-        self.w.u16(n)?;
-        for p in points {
-            let u = px_to_raw(p.u).ok_or(EncodeError::PointRange)?;
-            let v = px_to_raw(p.v).ok_or(EncodeError::PointRange)?;
-            self.w.u16(u)?;
-            self.w.u16(v)?;
-        }
+        self.w.patch(radius_at, &r.to_le_bytes());
         Ok(())
     }
 

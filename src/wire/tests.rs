@@ -548,6 +548,41 @@ fn a_refused_boundary_leaves_the_packet_as_it_was() {
     }
 }
 
+/// A straight edge on the ground 1 below the camera at `x0` across,
+/// depths 10 to 21, after `n` steps of [`drive_step`]; pixels on the
+/// link's 1/16 px grid, so the link carries them exactly.
+fn drive_edge(n: f32, x0: f32) -> Vec<Pixel> {
+    (0..12)
+        .map(|i| {
+            let (x, z) = (x0 - 0.02 * n, 10.0 + i as f32 - 0.25 * n);
+            let g = |c: f32| (c * 16.0).round() / 16.0;
+            Pixel::new(g(255.5 + 800.0 * x / z), g(239.5 + 800.0 / z))
+        })
+        .collect()
+}
+
+/// The drive's motion a frame: 0.25 forward, 0.02 right.
+fn drive_step() -> crate::Motion {
+    crate::Motion::new([0.02, 0.0, 0.25], [0.0; 3]).unwrap()
+}
+
+/// The motion packet from frame `to − 1` to `to` of [`drive_step`], with
+/// the error bounds given.
+fn drive_motion_packet(counter: u16, to: u32, te: Option<f32>, re: Option<[f32; 3]>) -> Vec<u8> {
+    let step = drive_step();
+    let mut raw = [0u8; 80];
+    let m = MotionFields {
+        from: to - 1,
+        to,
+        translation: step.translation(),
+        rotation: step.angles(),
+        translation_error: te,
+        rotation_error: re,
+    };
+    let n = encode::motion(&mut raw, IDS.motion, counter, &m).unwrap();
+    link(&raw[..n])
+}
+
 /// A drive through the link into a key-frame fusion (`FrameJob::run_fused`)
 /// fuses what the same frames and motions given to `Fusion::step` fuse,
 /// bit for bit; a frame declaring a larger error than the fusion's is
@@ -557,33 +592,8 @@ fn a_refused_boundary_leaves_the_packet_as_it_was() {
 #[test]
 fn frames_from_the_link_fuse_as_the_same_frames_stepped() {
     use crate::fusion::{ChainedMotion, Fusion, FusionConfig, FusionError, KeyReason};
-    use crate::{Config, Motion};
-    // A straight edge on the ground 1 below the camera and 1 to the left,
-    // depths 10 to 21, after n steps of 0.25 forward and 0.02 right;
-    // pixels on the link's 1/16 px grid, so the link carries them exactly.
-    let edge = |n: f32| -> Vec<Pixel> {
-        (0..12)
-            .map(|i| {
-                let (x, z) = (-1.0 - 0.02 * n, 10.0 + i as f32 - 0.25 * n);
-                let g = |c: f32| (c * 16.0).round() / 16.0;
-                Pixel::new(g(255.5 + 800.0 * x / z), g(239.5 + 800.0 / z))
-            })
-            .collect()
-    };
-    let step = Motion::new([0.02, 0.0, 0.25], [0.0; 3]).unwrap();
-    let motion_raw = |counter: u16, from: u32, to: u32| {
-        let mut raw = [0u8; 80];
-        let m = MotionFields {
-            from,
-            to,
-            translation: step.translation(),
-            rotation: step.angles(),
-            translation_error: None,
-            rotation_error: None,
-        };
-        let n = encode::motion(&mut raw, IDS.motion, counter, &m).unwrap();
-        link(&raw[..n])
-    };
+    use crate::Config;
+    let step = drive_step();
     let policy = FusionConfig::new(4, 500).unwrap();
     let mut via_link = Fusion::<64, 2, 128>::new(Config::DEFAULT, policy);
     let mut direct = Fusion::<64, 2, 128>::new(Config::DEFAULT, policy);
@@ -592,10 +602,10 @@ fn frames_from_the_link_fuse_as_the_same_frames_stepped() {
     rx.feed(&camera_packet(0), |_| {});
     let mut retired = 0;
     for id in 0..20u32 {
-        let pts = edge(id as f32);
+        let pts = drive_edge(id as f32, -1.0);
         // Frame 8's motion packet is lost.
         if id > 0 && id != 8 {
-            rx.feed(&motion_raw(id as u16, id - 1, id), |_| {});
+            rx.feed(&drive_motion_packet(id as u16, id, None, None), |_| {});
         }
         // Frame 3 declares 0.75 px, above the fusion's 0.5.
         let r = if id == 3 { 0.75 } else { 0.5 };
@@ -654,30 +664,7 @@ fn frames_from_the_link_fuse_as_the_same_frames_stepped() {
 #[test]
 fn run_fused_judges_the_motion_bounds_it_uses() {
     use crate::fusion::{Fusion, FusionConfig, FusionError, KeyReason};
-    use crate::{Config, Motion};
-    let edge = |n: f32, x0: f32| -> Vec<Pixel> {
-        (0..12)
-            .map(|i| {
-                let (x, z) = (x0 - 0.02 * n, 10.0 + i as f32 - 0.25 * n);
-                let g = |c: f32| (c * 16.0).round() / 16.0;
-                Pixel::new(g(255.5 + 800.0 * x / z), g(239.5 + 800.0 / z))
-            })
-            .collect()
-    };
-    let step = Motion::new([0.02, 0.0, 0.25], [0.0; 3]).unwrap();
-    let motion_raw = |counter: u16, to: u32, te: Option<f32>, re: Option<[f32; 3]>| {
-        let mut raw = [0u8; 80];
-        let m = MotionFields {
-            from: to - 1,
-            to,
-            translation: step.translation(),
-            rotation: step.angles(),
-            translation_error: te,
-            rotation_error: re,
-        };
-        let n = encode::motion(&mut raw, IDS.motion, counter, &m).unwrap();
-        link(&raw[..n])
-    };
+    use crate::Config;
     let base = Config::DEFAULT.with_translation_error(0.01).unwrap();
     let mut f = Fusion::<64, 2, 128>::new(base, FusionConfig::new(4, 500).unwrap());
     let mut rx = super::Receiver::<64, 2>::new(IDS, Config::DEFAULT);
@@ -691,15 +678,19 @@ fn run_fused_judges_the_motion_bounds_it_uses() {
             _ => (Some(0.01), None),
         };
         if id > 0 {
-            rx.feed(&motion_raw(id as u16, id, te, re), |_| {});
+            rx.feed(&drive_motion_packet(id as u16, id, te, re), |_| {});
         }
         let absent = [2, 3, 9].contains(&id);
         let b0 = if absent {
             (99.0, Vec::new())
         } else {
-            (0.5, edge(id as f32, -1.0))
+            (0.5, drive_edge(id as f32, -1.0))
         };
-        let packet = frame_packet(100 + id as u16, id, &[b0, (0.5, edge(id as f32, 1.0))]);
+        let packet = frame_packet(
+            100 + id as u16,
+            id,
+            &[b0, (0.5, drive_edge(id as f32, 1.0))],
+        );
         let before = (f.digest(), f.last_frame(), f.key_id());
         let mut got = None;
         rx.feed(&packet, |e| {

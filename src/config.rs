@@ -90,7 +90,9 @@ impl Config {
     /// The largest accepted work budget per point.
     pub const MAX_WORK_PER_POINT: u32 = 1 << 20;
 
-    /// Checked constructor.
+    /// Checked constructor (the same as [`Config::DEFAULT`] with
+    /// [`Config::with_localisation_error`], [`Config::with_min_angle`] and
+    /// [`Config::with_max_depth`], which name each value).
     ///
     /// * `e1`, `e2`: largest localisation error of a boundary point in frame 1
     ///   and of the boundary in frame 2, pixels (the paper's `e = e₁ + e₂`).
@@ -111,26 +113,65 @@ impl Config {
         min_angle_deg: f32,
         max_depth: f32,
     ) -> Result<Self, ConfigError> {
-        // (NaN fails every comparison.)
-        if !(e1 >= 0.0 && e1 <= 100.0 && e2 >= 0.0 && e2 <= 100.0) {
-            return Err(ConfigError::LocalisationError);
-        }
-        if !(min_angle_deg >= 0.1 && min_angle_deg <= 89.0) {
-            return Err(ConfigError::MinAngle);
-        }
-        if !(max_depth.is_finite() && max_depth > 0.0) {
-            return Err(ConfigError::MaxDepth);
-        }
-        let (s, c) = crate::math::sin_cos(min_angle_deg.to_radians());
-        Ok(Self {
-            e1,
-            e2,
-            cot_twice: 2.0 * c / s,
-            max_depth,
+        // Each value checked by its own `with_`, in the order of the
+        // arguments (the first bad one is the error).
+        let c = Self {
+            e1: 0.0,
+            e2: 0.0,
+            cot_twice: 0.0,
+            max_depth: 1.0,
             translation_error: 0.0,
             rotation_error: [0.0; 3],
             work_per_point: Self::DEFAULT_WORK_PER_POINT,
-        })
+        };
+        let c = match c.with_localisation_error(e1, e2) {
+            Ok(c) => c,
+            Err(e) => return Err(e),
+        };
+        let c = match c.with_min_angle(min_angle_deg) {
+            Ok(c) => c,
+            Err(e) => return Err(e),
+        };
+        c.with_max_depth(max_depth)
+    }
+
+    /// The same configuration with another minimum crossing angle, degrees
+    /// in `[0.1, 89]`: crossings certainly flatter than it (for every
+    /// boundary within `e₂` of the polyline) are [`crate::Status::Grazing`].
+    ///
+    /// ```
+    /// use roadstereo::Config;
+    /// let c = Config::DEFAULT.with_min_angle(15.0)?.with_max_depth(200.0)?;
+    /// assert_eq!(c, Config::new(0.5, 0.5, 15.0, 200.0)?);
+    /// assert!(Config::DEFAULT.with_min_angle(90.0).is_err());
+    /// # Ok::<(), roadstereo::ConfigError>(())
+    /// ```
+    pub const fn with_min_angle(mut self, min_angle_deg: f32) -> Result<Self, ConfigError> {
+        // (NaN fails every comparison.)
+        if !(min_angle_deg >= 0.1 && min_angle_deg <= 89.0) {
+            return Err(ConfigError::MinAngle);
+        }
+        let (s, c) = crate::math::sin_cos(min_angle_deg.to_radians());
+        self.cot_twice = 2.0 * c / s;
+        Ok(self)
+    }
+
+    /// The same configuration with another maximum depth (length units,
+    /// finite and positive): depths beyond it are
+    /// [`crate::Status::BeyondMaxDepth`].
+    ///
+    /// ```
+    /// use roadstereo::Config;
+    /// assert_eq!(Config::DEFAULT.with_max_depth(80.0)?.max_depth(), 80.0);
+    /// assert!(Config::DEFAULT.with_max_depth(f32::INFINITY).is_err());
+    /// # Ok::<(), roadstereo::ConfigError>(())
+    /// ```
+    pub const fn with_max_depth(mut self, max_depth: f32) -> Result<Self, ConfigError> {
+        if !(max_depth.is_finite() && max_depth > 0.0) {
+            return Err(ConfigError::MaxDepth);
+        }
+        self.max_depth = max_depth;
+        Ok(self)
     }
 
     /// The same configuration with other localisation errors `e₁` (frame 1,

@@ -3,11 +3,12 @@
 //! send, seeded fault injection, and the host build of the controller's
 //! receive loop (the reference the firmware is compared with, bit for bit).
 
+use roadstereo::fusion::{Fusion, FusionConfig};
 use roadstereo::wire::encode::{self, BoundaryHead, FrameHead, MotionFields, ResultHead};
 use roadstereo::wire::{
-    cobs_max, frame_packet_max, result_packet_max, DataIds, Event, PacketType, Receiver,
+    cobs_max, frame_packet_max, result_packet_max, DataIds, Event, FrameJob, PacketType, Receiver,
 };
-use roadstereo::{Camera, Config, Pixel, Processor};
+use roadstereo::{Camera, Config, Pixel, Processor, Step};
 
 /// Capacity of the link firmware (`src/bin/link.rs`).
 pub const N: usize = 256;
@@ -237,9 +238,82 @@ pub fn inject(packets: &[LinkPacket], f: &Faults) -> (Vec<u8>, Injected) {
 /// it: every raw output packet (results with 0 instructions, reports, and
 /// the summary at the end), in order.
 pub fn host_outputs(stream: &[u8], chunk: usize) -> Vec<Vec<u8>> {
+    let mut p = Box::new(Processor::<N, B>::new(Config::DEFAULT));
+    receive_loop(stream, chunk, |job, raw, counter| {
+        let step = job.run(&mut p).expect("a job always runs");
+        let head: ResultHead = job.result_head(0);
+        encode::result(
+            raw,
+            DataIds::DEFAULT.result,
+            counter,
+            &head,
+            &step,
+            &job.kept_quality,
+        )
+        .ok()
+    })
+}
+
+/// Map points per boundary of the link firmware's fusion (feature
+/// `link-fused`).
+pub const M: usize = 512;
+
+/// [`host_outputs`] as the link firmware runs it with the feature
+/// `link-fused`: each frame through a key-frame fusion
+/// (`FrameJob::run_fused`), its result the key frame's pair with it (the
+/// head's `kept` id the key frame's; no structure when the frame was not
+/// paired), a frame the fusion refuses no packet; and, per frame run, the
+/// frame's id and the fusion's digest after it (the firmware logs them).
+pub fn host_outputs_fused(stream: &[u8], chunk: usize) -> (Vec<Vec<u8>>, Vec<(u32, u32)>) {
+    let mut f = Box::new(Fusion::<N, B, M>::new(
+        Config::DEFAULT,
+        FusionConfig::DEFAULT,
+    ));
+    let mut key_quality = [0u8; B];
+    let mut digests = Vec::new();
+    let out = receive_loop(stream, chunk, |job, raw, counter| {
+        let key = f.key_id();
+        let step = job.run_fused(&mut f).ok()?;
+        let paired = step.paired.and(key);
+        let quality = if paired.is_some() {
+            key_quality
+        } else {
+            job.info.quality
+        };
+        if step.new_key.is_some() {
+            key_quality = job.info.quality;
+        }
+        digests.push((job.info.frame_id, f.digest()));
+        let mut head: ResultHead = job.result_head(0);
+        head.kept_id = paired.unwrap_or(job.info.frame_id);
+        let result = match paired {
+            Some(_) => Step::Structure(f.structure()),
+            None => Step::First,
+        };
+        encode::result(
+            raw,
+            DataIds::DEFAULT.result,
+            counter,
+            &head,
+            &result,
+            &quality,
+        )
+        .ok()
+    });
+    (out, digests)
+}
+
+/// The receive loop: each frame job to `on_frame`, which writes its
+/// result packet into the buffer with the counter given and returns its
+/// length (`None`: no packet); reports and the summary as the firmware
+/// sends them.
+fn receive_loop(
+    stream: &[u8],
+    chunk: usize,
+    mut on_frame: impl FnMut(&FrameJob<'_, N, B>, &mut [u8], u16) -> Option<usize>,
+) -> Vec<Vec<u8>> {
     let ids = DataIds::DEFAULT;
     let mut rx = Box::new(Receiver::<N, B>::new(ids, Config::DEFAULT));
-    let mut p = Box::new(Processor::<N, B>::new(Config::DEFAULT));
     let mut raw = vec![0u8; result_packet_max(N, B)];
     let (mut results, mut reports) = (0u16, 0u16);
     let mut out = Vec::new();
@@ -247,19 +321,10 @@ pub fn host_outputs(stream: &[u8], chunk: usize) -> Vec<Vec<u8>> {
     for piece in stream.chunks(chunk.max(1)) {
         rx.feed(piece, |ev| match ev {
             Event::Frame(job) => {
-                let step = job.run(&mut p).expect("a job always runs");
-                let head: ResultHead = job.result_head(0);
-                let n = encode::result(
-                    &mut raw,
-                    ids.result,
-                    results,
-                    &head,
-                    &step,
-                    &job.kept_quality,
-                )
-                .expect("result buffer sized by result_packet_max");
-                results = results.wrapping_add(1);
-                out.push(raw[..n].to_vec());
+                if let Some(n) = on_frame(&job, &mut raw, results) {
+                    results = results.wrapping_add(1);
+                    out.push(raw[..n].to_vec());
+                }
             }
             Event::Error(e) => {
                 let n = encode::report(&mut raw, ids.report, reports, &e).expect("report fits");

@@ -8,6 +8,12 @@
 //! The per-frame call is timed alone (the UART polling's instruction count
 //! varies from run to run); the instructions go into the result packet and
 //! the defmt log. `cargo xtask stream FILE.jsonl` drives it.
+//!
+//! With the feature `link-fused` each frame goes into a key-frame fusion
+//! instead ([`roadstereo::wire::FrameJob::run_fused`]): the result packet
+//! is the pair of the key frame with this frame (its `kept` id the key
+//! frame's), and the log line of each frame carries the fusion's digest,
+//! which the stream tool compares with the host's.
 
 #![no_std]
 #![no_main]
@@ -16,9 +22,14 @@ mod fw;
 
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
+#[cfg(feature = "link-fused")]
+use roadstereo::fusion::{Fusion, FusionConfig};
 use roadstereo::link::{write_packet, UartLink};
-use roadstereo::wire::{self, encode, DataIds, Event, Receiver};
-use roadstereo::{Config, Processor, Status, Step};
+use roadstereo::wire::encode::ResultHead;
+use roadstereo::wire::{self, encode, DataIds, Event, FrameJob, Receiver};
+#[cfg(not(feature = "link-fused"))]
+use roadstereo::Processor;
+use roadstereo::{Config, Status, Step};
 use static_cell::ConstStaticCell;
 
 /// Capacity: two boundaries of up to 256 points.
@@ -38,9 +49,24 @@ const BUDGET_INSTRUCTIONS: u32 = 33 * 168_000 / 20;
 /// result bit for bit.
 const WITHIN: bool = cfg!(feature = "link-deadline");
 
+/// Whether each frame goes into a key-frame fusion (feature `link-fused`).
+const FUSED: bool = cfg!(feature = "link-fused");
+
 /// The clock's limit within a deadline: the frame budget less the lateness
-/// README tells a firmware to allow for (40 000 instructions).
-const LIMIT_INSTRUCTIONS: u32 = BUDGET_INSTRUCTIONS - 40_000;
+/// README tells a firmware to allow for (40 000 instructions), and with the
+/// fusion also less the fusion's own work after the matching, which the
+/// deadline does not cut: the demo's limit for its fusion steps (212 000,
+/// `src/bin/bench.rs`, `DRIVE_LIMIT`; at most 74 instructions a key-frame
+/// point on the demo drive, README).
+const LIMIT_INSTRUCTIONS: u32 = if FUSED {
+    212_000
+} else {
+    BUDGET_INSTRUCTIONS - 40_000
+};
+
+/// Points per boundary in the fusion's road map.
+#[cfg(feature = "link-fused")]
+const M: usize = 512;
 
 /// UART0 of the mps2-an386 (CMSDK APB UART), register level. The library
 /// stays free of `unsafe`: the volatile register accesses live here.
@@ -123,8 +149,110 @@ const RAW: usize = wire::result_packet_max(N, B);
 /// laid out at build time: their constructors are `const`.
 static RECEIVER: ConstStaticCell<Receiver<N, B>> =
     ConstStaticCell::new(Receiver::new(DataIds::DEFAULT, Config::DEFAULT));
+#[cfg(not(feature = "link-fused"))]
 static PROCESSOR: ConstStaticCell<Processor<N, B>> =
     ConstStaticCell::new(Processor::new(Config::DEFAULT));
+/// With `link-fused`: the fusion (its processor, key frame and map), its
+/// error model the receiver's base configuration (a frame sent with a
+/// larger radius or motion bounds is refused,
+/// [`roadstereo::fusion::FusionError::ErrorsAboveConfig`]) and the default
+/// policy.
+#[cfg(feature = "link-fused")]
+static FUSION: ConstStaticCell<Fusion<N, B, M>> =
+    ConstStaticCell::new(Fusion::new(Config::DEFAULT, FusionConfig::DEFAULT));
+
+/// What runs the frames: the processor, pairing each frame with the last,
+/// or the fusion, pairing it with its key frame.
+struct Runner {
+    #[cfg(not(feature = "link-fused"))]
+    processor: &'static mut Processor<N, B>,
+    #[cfg(feature = "link-fused")]
+    fusion: &'static mut Fusion<N, B, M>,
+    /// The key frame's boundary qualities (what its pairs' results report).
+    #[cfg(feature = "link-fused")]
+    key_quality: [u8; B],
+}
+
+impl Runner {
+    fn new() -> Self {
+        Runner {
+            #[cfg(not(feature = "link-fused"))]
+            processor: PROCESSOR.take(),
+            #[cfg(feature = "link-fused")]
+            fusion: FUSION.take(),
+            #[cfg(feature = "link-fused")]
+            key_quality: [0; B],
+        }
+    }
+
+    /// The job run (within the clock's limit with `link-deadline`): the
+    /// result packet's head (its instructions the call's, timed alone),
+    /// the step and the kept frame's qualities; `None` when the frame was
+    /// refused.
+    #[cfg(not(feature = "link-fused"))]
+    fn run(&mut self, job: &FrameJob<'_, N, B>) -> Option<(ResultHead, Step<'_, N, B>, [u8; B])> {
+        let (step, instr) = if WITHIN {
+            let (t0, limit) = (fw::ticks(), fw::ticks_of(LIMIT_INSTRUCTIONS));
+            let mut clock = || fw::ticks().saturating_sub(t0) >= limit;
+            fw::measure(|| job.run_within(self.processor, &mut clock))
+        } else {
+            fw::measure(|| job.run(self.processor))
+        };
+        let Ok(step) = step else {
+            defmt::error!("frame {=u32}: processor refused", job.info.frame_id);
+            return None;
+        };
+        Some((job.result_head(instr), step, job.kept_quality))
+    }
+
+    /// [`Self::run`] through the fusion: the head names the key frame the
+    /// frame was paired with (the frame itself, and no structure, when it
+    /// was not paired); the log line gives the fusion's digest after it.
+    #[cfg(feature = "link-fused")]
+    fn run(&mut self, job: &FrameJob<'_, N, B>) -> Option<(ResultHead, Step<'_, N, B>, [u8; B])> {
+        let key = self.fusion.key_id();
+        let (step, instr) = if WITHIN {
+            let (t0, limit) = (fw::ticks(), fw::ticks_of(LIMIT_INSTRUCTIONS));
+            let mut clock = || fw::ticks().saturating_sub(t0) >= limit;
+            fw::measure(|| job.run_fused_within(self.fusion, &mut clock))
+        } else {
+            fw::measure(|| job.run_fused(self.fusion))
+        };
+        let step = match step {
+            Ok(s) => s,
+            Err(e) => {
+                defmt::error!("frame {=u32}: fusion refused: {}", job.info.frame_id, e);
+                return None;
+            }
+        };
+        let paired = step.paired.and(key);
+        let quality = if paired.is_some() {
+            self.key_quality
+        } else {
+            job.info.quality
+        };
+        if step.new_key.is_some() {
+            self.key_quality = job.info.quality;
+        }
+        let c = self.fusion.key().map(|k| k.counts()).unwrap_or_default();
+        defmt::info!(
+            "fused frame={=u32} key={=u32} paired={=bool} consistent={=u32} inconsistent={=u32} fusion_digest={=u32:08x}",
+            job.info.frame_id,
+            paired.unwrap_or(job.info.frame_id),
+            paired.is_some(),
+            c.consistent,
+            c.inconsistent,
+            self.fusion.digest()
+        );
+        let mut head = job.result_head(instr);
+        head.kept_id = paired.unwrap_or(job.info.frame_id);
+        let result = match paired {
+            Some(_) => Step::Structure(self.fusion.structure()),
+            None => Step::First,
+        };
+        Some((head, result, quality))
+    }
+}
 
 #[entry]
 fn main() -> ! {
@@ -136,17 +264,18 @@ fn main() -> ! {
     let mut tx = Uart0;
     let ids = DataIds::DEFAULT;
     let rx: &'static mut Receiver<N, B> = RECEIVER.take();
-    let processor: &'static mut Processor<N, B> = PROCESSOR.take();
+    let mut runner = Runner::new();
     let mut raw = [0u8; RAW];
     let mut framed = [0u8; wire::cobs_max(RAW)];
     let (mut results, mut reports) = (0u16, 0u16);
     defmt::info!(
-        "roadstereo link: UART0, capacity {=usize} x {=usize}, budget {=u32} instructions/frame, within a deadline {=bool} (limit {=u32})",
+        "roadstereo link: UART0, capacity {=usize} x {=usize}, budget {=u32} instructions/frame, within a deadline {=bool} (limit {=u32}), fused {=bool}",
         B,
         N,
         BUDGET_INSTRUCTIONS,
         WITHIN,
-        LIMIT_INSTRUCTIONS
+        LIMIT_INSTRUCTIONS,
+        FUSED
     );
     defmt::info!(
         "sizes receiver={=usize} uart_link={=usize} result_buffers={=usize}",
@@ -158,23 +287,16 @@ fn main() -> ! {
         let mut end = false;
         let polled = link.poll(rx, |ev| match ev {
             Event::Frame(job) => {
-                let (step, instr) = if WITHIN {
-                    let (t0, limit) = (fw::ticks(), fw::ticks_of(LIMIT_INSTRUCTIONS));
-                    let mut clock = || fw::ticks().saturating_sub(t0) >= limit;
-                    fw::measure(|| job.run_within(processor, &mut clock))
-                } else {
-                    fw::measure(|| job.run(processor))
-                };
-                let Ok(step) = step else {
-                    defmt::error!("frame {=u32}: processor refused", job.info.frame_id);
+                let Some((head, step, quality)) = runner.run(&job) else {
                     return;
                 };
+                let instr = head.instructions;
                 if let Step::Structure(s) = &step {
                     let c = s.status_counts();
                     defmt::info!(
                         "frame={=u32} kept={=u32} points={=u32} ok={=u32} instr={=u32} budget_permille={=u32} digest={=u32:08x}",
                         job.info.frame_id,
-                        job.kept_id,
+                        head.kept_id,
                         c.total() as u32,
                         c.get(Status::Ok) as u32,
                         instr,
@@ -182,8 +304,7 @@ fn main() -> ! {
                         s.digest()
                     );
                 }
-                let head = job.result_head(instr);
-                match encode::result(&mut raw, ids.result, results, &head, &step, &job.kept_quality) {
+                match encode::result(&mut raw, ids.result, results, &head, &step, &quality) {
                     Ok(n) => {
                         results = results.wrapping_add(1);
                         if write_packet(&mut tx, raw.get(..n).unwrap_or(&[]), &mut framed).is_err() {

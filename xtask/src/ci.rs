@@ -68,6 +68,9 @@ const CARGO_CHECKS: &[(&str, &[&str])] = &[
     ("host_tests", &["clippy", "--all-targets", "--", "-D", "warnings"]),
     // The firmware binaries.
     ("", &["clippy", "--release", "--target", THUMB, "--features", "firmware", "--bins", "--", "-D", "warnings"]),
+    // ... the link firmware's fused and deadline modes (`cargo xtask stream
+    // --fused --within` builds the same),
+    ("", &["clippy", "--release", "--target", THUMB, "--features", "firmware link-deadline link-fused", "--bin", "link", "--", "-D", "warnings"]),
     // ... and for the second board (its own target dir, as `Board` builds it).
     ("", &["clippy", "--release", "--target", THUMB, "--features", "board-f405", "--bins", "--target-dir", "target/f405", "--", "-D", "warnings"]),
 ];
@@ -115,10 +118,16 @@ pub fn ci() -> Result<(), String> {
         "--seed",
         "1",
     ];
-    for within in [false, true] {
+    // Then the same through the key-frame fusion (feature `link-fused`):
+    // every packet and the fusion's digest after every frame the host's,
+    // and within a deadline every frame within the budget.
+    for (within, fused) in [(false, false), (true, false), (false, true), (true, true)] {
         let mut args: Vec<String> = faulty.iter().map(|a| a.to_string()).collect();
         if within {
             args.push("--within".into());
+        }
+        if fused {
+            args.push("--fused".into());
         }
         stream(&args)?;
     }

@@ -9,6 +9,14 @@
 //! point, or `over_budget` where the deadline cut the frame, and every
 //! frame within the frame budget; every other packet bit for bit.
 //!
+//! With `--fused` the firmware runs each frame through a key-frame fusion
+//! (its feature `link-fused`), the host too: every packet bit for bit and
+//! the fusion's digest after every frame (from the firmware's log) the
+//! host's. With both, a pair the clock cut does not count towards the
+//! key-frame policy, so the key frames may differ from the host's after
+//! one: a result of another pair than the host's is counted, not a
+//! divergence, and the digests are not compared; the rest as `--within`.
+//!
 //! FILE is replay JSON Lines, or with `--drive` the firmware drive format
 //! (`src/bin/data/drive.bin`). `cargo xtask stream` builds the firmware and
 //! calls this. Exit code 1 on any divergence.
@@ -34,6 +42,7 @@ struct Args {
     radius: f32,
     frames: Option<usize>,
     within: bool,
+    fused: bool,
 }
 
 fn args() -> Result<Args, String> {
@@ -45,6 +54,7 @@ fn args() -> Result<Args, String> {
         radius: 0.5,
         frames: None,
         within: false,
+        fused: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(x) = it.next() {
@@ -53,6 +63,7 @@ fn args() -> Result<Args, String> {
             "--elf" => a.elf = val("--elf")?,
             "--drive" => a.drive = true,
             "--within" => a.within = true,
+            "--fused" => a.fused = true,
             "--corrupt" => {
                 a.faults.corrupt = val("--corrupt")?
                     .parse()
@@ -91,7 +102,7 @@ fn args() -> Result<Args, String> {
         }
     }
     if a.elf.is_empty() || a.file.is_empty() {
-        return Err("usage: stream --elf ELF [--drive] FILE [--corrupt P] [--drop P] [--duplicate P] [--seed S] [--radius PX] [--frames K] [--within]".into());
+        return Err("usage: stream --elf ELF [--drive] FILE [--corrupt P] [--drop P] [--duplicate P] [--seed S] [--radius PX] [--frames K] [--within] [--fused]".into());
     }
     Ok(a)
 }
@@ -227,10 +238,17 @@ fn main() -> ExitCode {
     );
     // The host reference on the same bytes, and the clean run (no faults)
     // for the pairs the faulty run shares with it.
-    let host = link::host_outputs(&stream, 61);
+    let outputs = |s: &[u8]| {
+        if a.fused {
+            link::host_outputs_fused(s, 61)
+        } else {
+            (link::host_outputs(s, 61), Vec::new())
+        }
+    };
+    let (host, host_digests) = outputs(&stream);
     let (clean_stream, _) = link::inject(&packets, &Faults::default());
-    let clean = link::host_outputs(&clean_stream, 61);
-    let (fw_bytes, _log, secs) = match run_qemu(&a.elf, &stream) {
+    let (clean, _) = outputs(&clean_stream);
+    let (fw_bytes, log, secs) = match run_qemu(&a.elf, &stream) {
         Ok(x) => x,
         Err(e) => {
             eprintln!("stream: {e}");
@@ -248,6 +266,26 @@ fn main() -> ExitCode {
         .collect();
 
     let mut divergences = Vec::new();
+    // With the fusion: its digest after every frame, as the firmware
+    // logged it, against the host's (not within a deadline, see above).
+    if a.fused && !a.within {
+        let fw_digests = fused_digests(&log);
+        if fw_digests != host_digests {
+            let at = fw_digests
+                .iter()
+                .zip(&host_digests)
+                .position(|(f, h)| f != h)
+                .unwrap_or(fw_digests.len().min(host_digests.len()));
+            divergences.push(format!(
+                "the fusion's digests differ from the host's from frame run {at} ({} logged, {} on the host)",
+                fw_digests.len(),
+                host_digests.len()
+            ));
+        }
+    }
+    // Within a deadline with the fusion: results of another pair than the
+    // host's (the key frames differ after a cut).
+    let mut other_pairs = 0usize;
     if fw.len() != host.len() {
         divergences.push(format!(
             "firmware sent {} packets, host {}",
@@ -271,7 +309,9 @@ fn main() -> ExitCode {
         }
         let both_results = link::type_of(f) == Some(PacketType::Result)
             && link::type_of(h) == Some(PacketType::Result);
-        if a.within && both_results {
+        if a.within && a.fused && both_results && pair_of(f) != pair_of(h) {
+            other_pairs += 1;
+        } else if a.within && both_results {
             match within_matches(f, h) {
                 Ok((flagged, looser, cut)) => {
                     cut_frames += usize::from(cut);
@@ -414,8 +454,13 @@ fn main() -> ExitCode {
         let fw_ok: u64 = rows.iter().map(|r| u64::from(r.ok)).sum();
         println!();
         println!(
-            "stream: within a deadline: the clock cut {cut_frames} of {compared} frames; {cut_points} points `over_budget` that were not without a deadline, {looser_sticks} sticks left looser; `ok` points {fw_ok} against {host_ok} without a deadline; the costliest frame {worst} instructions, {:.1} % of the budget {BUDGET_INSTRUCTIONS}",
-            f64::from(worst) * 100.0 / BUDGET_INSTRUCTIONS as f64
+            "stream: within a deadline: the clock cut {cut_frames} of {compared} frames; {cut_points} points `over_budget` that were not without a deadline, {looser_sticks} sticks left looser; `ok` points {fw_ok} against {host_ok} without a deadline; the costliest frame {worst} instructions, {:.1} % of the budget {BUDGET_INSTRUCTIONS}{}",
+            f64::from(worst) * 100.0 / BUDGET_INSTRUCTIONS as f64,
+            if a.fused {
+                format!("; {other_pairs} results of another pair than the host's (key frames differ after a cut)")
+            } else {
+                String::new()
+            }
         );
         if u64::from(worst) > BUDGET_INSTRUCTIONS {
             divergences.push(format!(
@@ -429,9 +474,11 @@ fn main() -> ExitCode {
             fw.len(),
             compared,
             if a.within {
-                "each result the host's or `over_budget` point for point, the rest bit for bit"
+                "each result the host's or `over_budget` point for point, the rest bit for bit".to_string()
+            } else if a.fused {
+                format!("bit for bit, and the fusion's digest after each of {} frames run", host_digests.len())
             } else {
-                "bit for bit"
+                "bit for bit".to_string()
             }
         );
         ExitCode::SUCCESS
@@ -441,6 +488,31 @@ fn main() -> ExitCode {
         }
         ExitCode::FAILURE
     }
+}
+
+/// The `(kept, frame)` ids and whether there is a structure, of a result
+/// packet.
+fn pair_of(raw: &[u8]) -> Option<(u32, u32, bool)> {
+    let c = check(raw).ok()?;
+    let v = ResultView::parse(c.payload).ok()?;
+    Some((v.kept_id, v.frame_id, v.structure))
+}
+
+/// The fusion's digest after each frame run, from the link firmware's
+/// log lines `fused frame=F ... fusion_digest=D` (feature `link-fused`).
+fn fused_digests(log: &str) -> Vec<(u32, u32)> {
+    let field = |line: &str, name: &str| -> Option<String> {
+        let at = line.find(name)? + name.len();
+        Some(line[at..].split_whitespace().next()?.to_string())
+    };
+    log.lines()
+        .filter(|l| l.contains("fused frame="))
+        .filter_map(|l| {
+            let frame = field(l, "fused frame=")?.parse().ok()?;
+            let digest = u32::from_str_radix(&field(l, "fusion_digest=")?, 16).ok()?;
+            Some((frame, digest))
+        })
+        .collect()
 }
 
 /// A result's fields for the table (the view borrows the packet).

@@ -25,6 +25,18 @@ pub enum EncodeError {
     Radius,
     /// More than 255 boundaries, or more than 65 535 points or bytes.
     TooLarge,
+    /// Point `index` of a boundary whose rows are in order (strictly
+    /// monotone, as [`crate::Frame::push_boundary`] asks) rounds, to the
+    /// sixteenth of a pixel, onto the row of the point before it (rows
+    /// 1/32 px apart can): the receiver would refuse the boundary
+    /// ([`crate::BoundaryError::Unordered`] or `Duplicate`), so it is not
+    /// sent. Send rows at least 1/16 px apart. (Rounding cannot reverse
+    /// the order, only merge rows; points out of order as given are sent
+    /// as they are, for the receiver to name.)
+    Unordered {
+        /// The point's index in its boundary.
+        index: u16,
+    },
 }
 
 impl core::error::Error for EncodeError {}
@@ -36,6 +48,12 @@ impl fmt::Display for EncodeError {
             Self::PointRange => "point outside [-1, 4078.875] px or not finite",
             Self::Radius => "error radius outside [0, 100] px",
             Self::TooLarge => "too many boundaries, points or bytes for the format",
+            Self::Unordered { index } => {
+                return write!(
+                    f,
+                    "point {index}, rounded to 1/16 px, lands on the row of the point before"
+                );
+            }
         })
     }
 }
@@ -211,9 +229,28 @@ impl<'a> FramePacket<'a> {
         // taken 10⁻⁵ larger, relative and absolute, for the square root and
         // the sum's rounding; `radius_to_raw` rounds up.)
         let mut moved = 0.0f32;
-        for p in points {
+        // The row order the receiver checks (`Boundary`'s): rows strictly
+        // monotone. Where the points as given keep it, the rounded rows
+        // must too (rounding is monotone, but rows 1/32 px apart can round
+        // together); points out of order as given are sent as they are,
+        // for the receiver to name. The rows before, given and rounded, and
+        // the direction of the given ones (`None`: not yet known, or no
+        // longer checked once the given rows break the order).
+        let mut last: Option<(f32, u16)> = None;
+        let mut rising: Option<Option<bool>> = Some(None);
+        for (index, p) in points.iter().enumerate() {
             let u = px_to_raw(p.u).ok_or(EncodeError::PointRange)?;
             let v = px_to_raw(p.v).ok_or(EncodeError::PointRange)?;
+            if let (Some((pv, prev)), Some(dir)) = (last, rising) {
+                let up = p.v > pv;
+                rising = (p.v != pv && dir.is_none_or(|d| d == up)).then_some(Some(up));
+                if rising.is_some() && v == prev {
+                    // (`n` fits 16 bits, so does the index.)
+                    let index = u16::try_from(index).unwrap_or(u16::MAX);
+                    return Err(EncodeError::Unordered { index });
+                }
+            }
+            last = Some((p.v, v));
             let (du, dv) = (raw_to_px(u) - p.u, raw_to_px(v) - p.v);
             moved = crate::math::fmax(moved, du * du + dv * dv);
             self.w.u16(u)?;

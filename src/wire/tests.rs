@@ -521,6 +521,17 @@ fn a_refused_boundary_leaves_the_packet_as_it_was() {
     let mut bad_first = line(12, 300.0);
     bad_first[0] = Pixel::new(-3.0, 200.0);
     let big = line(60, 300.0);
+    // Rows 0.03 px apart, valid for `Frame`, round to one row, and a point
+    // 0.01 px from the one before rounds onto it: both refused, as the
+    // receiver would refuse them, at the point that breaks the order.
+    let mut merged = line(25, 300.0);
+    merged[10] = Pixel::new(merged[10].u, merged[9].v - 0.03);
+    let mut same = line(25, 300.0);
+    same[4] = Pixel::new(same[3].u + 0.01, same[3].v - 0.01);
+    for pts in [&merged, &same] {
+        let mut f = Frame::<64, 1>::new(cam());
+        f.push_boundary(pts).unwrap();
+    }
     // (A roomy buffer: refused for a point or the radius; a buffer of the
     // good packet's size: refused for want of room part way through.)
     type Refused<'a> = &'a [(BoundaryHead, &'a [Pixel], EncodeError)];
@@ -531,6 +542,8 @@ fn a_refused_boundary_leaves_the_packet_as_it_was() {
                 (bh(5, 1.0), &bad_late, EncodeError::PointRange),
                 (bh(6, 1.0), &bad_first, EncodeError::PointRange),
                 (bh(7, 1000.0), &p2, EncodeError::Radius),
+                (bh(9, 1.0), &merged, EncodeError::Unordered { index: 10 }),
+                (bh(10, 1.0), &same, EncodeError::Unordered { index: 4 }),
             ],
         ),
         (n, &[(bh(8, 1.0), &big, EncodeError::BufferTooSmall)]),

@@ -833,9 +833,18 @@ fn bad_inputs_are_typed_errors_and_change_nothing() {
     let chained = |from: u32| ChainedMotion { from, motion: step };
     let mut f = Box::new(HostFusion::new(Config::DEFAULT, FusionConfig::DEFAULT));
     let mut twin = Box::new(HostFusion::new(Config::DEFAULT, FusionConfig::DEFAULT));
-    // No key frame yet: constraints have nothing to act on.
-    assert_eq!(f.constrain(0, 0, 0, 1.0, 2.0), Err(FusionError::NoKeyFrame));
+    // No key frame yet: constraints have nothing to act on (a reference
+    // from another fusion's key frame, as no other can be had).
+    let mut other = Box::new(HostFusion::new(Config::DEFAULT, FusionConfig::DEFAULT));
+    other.step(0, &edge_frame(cam, 0.0, 24), None).expect("key");
+    let foreign = other.key_ref().expect("a key frame");
+    assert_eq!((foreign.id(), foreign.serial()), (0, 1));
+    assert_eq!(
+        f.constrain(foreign, 0, 0, 1.0, 2.0),
+        Err(FusionError::NoKeyFrame)
+    );
     assert_eq!(f.key_id(), None);
+    assert_eq!(f.key_ref(), None);
     // A first frame without points is accepted but is no key frame.
     let s = f
         .step(0, &edge_frame(cam, 0.0, 0), None)
@@ -867,20 +876,23 @@ fn bad_inputs_are_typed_errors_and_change_nothing() {
             Err(FusionError::RepeatedFrame(1))
         );
         assert_eq!(f.key_id(), Some(1));
+        let key = f.key_ref().expect("key frame 1");
+        assert_eq!((key.id(), key.serial()), (1, 1));
         assert_eq!(
-            f.constrain(1, 3, 0, 1.0, 2.0),
+            f.constrain(key, 3, 0, 1.0, 2.0),
             Err(FusionError::NoSuchPoint)
         );
         assert_eq!(
-            f.constrain(1, 0, 99, 1.0, 2.0),
+            f.constrain(key, 0, 99, 1.0, 2.0),
             Err(FusionError::NoSuchPoint)
         );
-        // A range for another key frame's pixels is refused.
+        // A range for another key frame's pixels is refused (its id 0,
+        // and another fusion's: the same serial).
         assert_eq!(
-            f.constrain(0, 0, 0, 1.0, 2.0),
+            f.constrain(foreign, 0, 0, 1.0, 2.0),
             Err(FusionError::KeyMismatch {
-                expected: 1,
-                given: 0
+                expected: key,
+                given: foreign
             })
         );
         for (n, r) in [
@@ -889,7 +901,7 @@ fn bad_inputs_are_typed_errors_and_change_nothing() {
             (3.0, 2.0),
             (-1.0, 2.0),
         ] {
-            assert_eq!(f.constrain(1, 0, 0, n, r), Err(FusionError::InvalidRange));
+            assert_eq!(f.constrain(key, 0, 0, n, r), Err(FusionError::InvalidRange));
         }
         assert_eq!(f.digest(), before, "a rejected input changed the state");
     }
@@ -948,6 +960,7 @@ fn a_failed_constraint_after_a_retire_changes_nothing() {
     let policy = FusionConfig::new(2, 0).expect("policy");
     let mut f = Box::new(HostFusion::new(Config::DEFAULT, policy));
     f.step(0, &edge_frame(cam, 0.0, 24), None).expect("key");
+    let old = f.key_ref().expect("key frame 0");
     let mut retired = None;
     for id in 1..=2u32 {
         let m = ChainedMotion {
@@ -965,19 +978,21 @@ fn a_failed_constraint_after_a_retire_changes_nothing() {
     // Constraints go to the new key frame (frame 2) while `key` still
     // shows the retired one: a range meant for key 0 is refused.
     assert_eq!(f.key_id(), Some(2));
+    let new = f.key_ref().expect("key frame 2");
+    assert_eq!((new.id(), new.serial()), (2, 2));
     for (key, b, i, near, far, e) in [
-        (2, 0, 999, 1.0, 2.0, FusionError::NoSuchPoint),
-        (2, 3, 0, 1.0, 2.0, FusionError::NoSuchPoint),
-        (2, 0, 0, 3.0, 2.0, FusionError::InvalidRange),
+        (new, 0, 999, 1.0, 2.0, FusionError::NoSuchPoint),
+        (new, 3, 0, 1.0, 2.0, FusionError::NoSuchPoint),
+        (new, 0, 0, 3.0, 2.0, FusionError::InvalidRange),
         (
-            0,
+            old,
             0,
             0,
             1.0,
             2.0,
             FusionError::KeyMismatch {
-                expected: 2,
-                given: 0,
+                expected: new,
+                given: old,
             },
         ),
     ] {
@@ -987,10 +1002,75 @@ fn a_failed_constraint_after_a_retire_changes_nothing() {
     }
     // A good one is on the new key frame (frame 2), which starts then.
     let p = f
-        .constrain(2, 0, 0, 1.0, 100.0)
+        .constrain(new, 0, 0, 1.0, 100.0)
         .expect("a point of frame 2");
     assert_eq!(p.pairs, 1);
     assert_eq!(f.key().map(|k| (k.id(), k.partners())), Some((2, 0)));
+}
+
+/// Found by an adversarial review: constraints named key frames by frame
+/// id alone, and frame ids need not be unique over a drive (a front end
+/// that restarts its ids, a fusion reset after a broken chain): a return
+/// meant for an earlier key frame 5 landed on a later key frame 5. The
+/// reference now carries the key frame's place among those the fusion
+/// started, which a reset does not restart.
+#[test]
+fn a_return_for_a_key_frame_of_the_same_id_is_refused() {
+    let cam = synth::Intrinsics::default().camera();
+    let step = Motion::new([0.05, 0.0, 0.25], [0.0; 3]).expect("motion");
+    let chained = |from: u32| ChainedMotion { from, motion: step };
+    // One partner a key frame: each frame retires the key frame before it.
+    let policy = FusionConfig::new(1, 0).expect("policy");
+    let mut f = Box::new(HostFusion::new(Config::DEFAULT, policy));
+    f.step(5, &edge_frame(cam, 0.0, 24), None).expect("key 5");
+    let first = f.key_ref().expect("key frame 5");
+    f.step(6, &edge_frame(cam, 1.0, 24), Some(&chained(5)))
+        .expect("retires 5");
+    f.step(5, &edge_frame(cam, 2.0, 24), Some(&chained(6)))
+        .expect("retires 6, id 5 again");
+    let second = f.key_ref().expect("key frame 5 again");
+    assert_eq!((first.id(), second.id()), (5, 5));
+    assert_ne!(first, second);
+    let (view, digest) = (key_view(&f), f.digest());
+    assert_eq!(
+        f.constrain(first, 0, 0, 1.0, 100.0),
+        Err(FusionError::KeyMismatch {
+            expected: second,
+            given: first
+        })
+    );
+    assert_eq!((key_view(&f), f.digest()), (view, digest));
+    // After a reset the ids start again; the serials do not.
+    f.reset();
+    f.step(5, &edge_frame(cam, 0.0, 24), None)
+        .expect("key 5, anew");
+    let third = f.key_ref().expect("key frame 5 after the reset");
+    assert_eq!(third.id(), 5);
+    for stale in [first, second] {
+        assert_eq!(
+            f.constrain(stale, 0, 0, 1.0, 100.0),
+            Err(FusionError::KeyMismatch {
+                expected: third,
+                given: stale
+            })
+        );
+    }
+    let p = f
+        .constrain(third, 0, 0, 1.0, 100.0)
+        .expect("this key frame's");
+    assert_eq!(p.pairs, 1);
+    assert_eq!(
+        FusionError::KeyMismatch {
+            expected: third,
+            given: first
+        }
+        .to_string(),
+        format!(
+            "the constraint is for key frame 5 (key frame {} of the fusion), the key frame is 5 ({})",
+            first.serial(),
+            third.serial()
+        )
+    );
 }
 
 /// Found by an adversarial review: a range constraint whose far end
@@ -1025,13 +1105,14 @@ fn ranges_past_the_depth_codes_stay_out_of_the_map() {
     let mut f = Box::new(HostFusion::new(Config::DEFAULT, policy));
     f.step(0, &edge(0.0), None).expect("key");
     let k = f.key().expect("key").len(0) - 1;
+    let key = f.key_ref().expect("key");
     let digest = f.digest();
     assert_eq!(
-        f.constrain(0, 0, k, 1.0, f32::MAX),
+        f.constrain(key, 0, k, 1.0, f32::MAX),
         Err(FusionError::InvalidRange)
     );
     assert_eq!(f.digest(), digest);
-    let p = f.constrain(0, 0, k, 1.0, 1.0e30).expect("a valid range");
+    let p = f.constrain(key, 0, k, 1.0, 1.0e30).expect("a valid range");
     assert_eq!(p.status, FusedStatus::Single);
     let mut unbounded = 0;
     for id in 1..=2u32 {
@@ -1628,6 +1709,8 @@ fn range_constraints_narrow_or_flag() {
         f.step(j as u32, &input.frame(&d.spec.intrinsics, j), m.as_ref())
             .expect("step");
     }
+    let key = f.key_ref().expect("key frame 0");
+    assert_eq!(key.id(), 0);
     let (mut narrowed, mut flagged, mut tried) = (0, 0, 0);
     for b in 0..B {
         let n = f.key().map_or(0, |k| k.len(b));
@@ -1641,9 +1724,9 @@ fn range_constraints_narrow_or_flag() {
             let z = d.z_true(0, b, i);
             let r = z * (1.0 + f64::from(x * x + y * y)).sqrt();
             let q = if i % 10 == 0 {
-                f.constrain(0, b, i, (r * 0.99) as f32, (r * 1.01) as f32)
+                f.constrain(key, b, i, (r * 0.99) as f32, (r * 1.01) as f32)
             } else {
-                f.constrain(0, b, i, (r * 1.3) as f32, (r * 1.35) as f32)
+                f.constrain(key, b, i, (r * 1.3) as f32, (r * 1.35) as f32)
             }
             .expect("constraint");
             if i % 10 == 0 {

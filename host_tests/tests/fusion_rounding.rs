@@ -102,6 +102,7 @@ fn a_range_return_holding_the_truth_keeps_it() {
     frame.push_boundary(&det).unwrap();
     let mut fusion = Fusion::<16, 2, 8>::new(Config::DEFAULT, FusionConfig::DEFAULT);
     fusion.step(0, &frame, None).unwrap();
+    let key = fusion.key_ref().unwrap();
     let mut fails = 0;
     for (i, p) in det.iter().enumerate() {
         let (ut, vt) = (p.u as f64 - 0.5, p.v as f64);
@@ -121,7 +122,7 @@ fn a_range_return_holding_the_truth_keeps_it() {
             f32::from_bits(r32.to_bits() + 1)
         };
         assert!(near as f64 <= r && r <= far as f64);
-        let fp = fusion.constrain(0, 0, i, near, far).unwrap();
+        let fp = fusion.constrain(key, 0, i, near, far).unwrap();
         let iv = fp.interval.unwrap();
         let ok = iv.z_near as f64 <= z_true && z_true <= iv.z_far as f64;
         println!(
@@ -169,7 +170,9 @@ fn a_constrained_point_and_two_exact_pairs_keep_the_truth() {
     let r = norm(q[i]);
     let (near, far) = ((r * (1.0 - 1e-5)) as f32, (r * (1.0 + 1e-5)) as f32);
     assert!((near as f64) < r && r < far as f64);
-    let c = fusion.constrain(0, 0, i, near, far).unwrap();
+    let c = fusion
+        .constrain(fusion.key_ref().unwrap(), 0, i, near, far)
+        .unwrap();
     println!(
         "constrain(0, {i}, {near}, {far}) -> {:?}; true depth {}",
         c, q[i][2]
@@ -769,7 +772,8 @@ fn tiny_ranges_keep_the_truth() {
                 let d = f32::from_bits(bits);
                 let (x, y) = ((u as f64 - 319.5) / 800.0, (v as f64 - 239.5) / 800.0);
                 let z = d as f64 / (1.0 + x * x + y * y).sqrt();
-                let iv = fusion.constrain(1, 0, 0, d, d).unwrap().interval.unwrap();
+                let key = fusion.key_ref().unwrap();
+                let iv = fusion.constrain(key, 0, 0, d, d).unwrap().interval.unwrap();
                 total += 1;
                 if !(iv.z_near as f64 <= z && z <= iv.z_far as f64) {
                     misses += 1;

@@ -200,17 +200,19 @@ fn main() -> ! {
                 black_box(e);
             }
         }
-        black_box(
-            fusion
-                .constrain(
-                    black_box(0),
-                    black_box(0),
-                    black_box(3),
-                    black_box(1.0),
-                    black_box(2.0),
-                )
-                .ok(),
-        );
+        if let Some(key) = fusion.key_ref() {
+            black_box(
+                fusion
+                    .constrain(
+                        black_box(key),
+                        black_box(0),
+                        black_box(3),
+                        black_box(1.0),
+                        black_box(2.0),
+                    )
+                    .ok(),
+            );
+        }
         if let Some(k) = fusion.key() {
             black_box((k.counts(), k.point(black_box(0), black_box(1)), k.len(0)));
             for p in k.points(black_box(1)) {

@@ -307,10 +307,10 @@ pub enum FusionError {
     /// ([`Fusion::key_id`]): it was meant for a key frame that has
     /// retired, or not yet started.
     KeyMismatch {
-        /// The id of the key frame constraints go to now.
-        expected: u32,
-        /// The id the constraint named.
-        given: u32,
+        /// The key frame constraints go to now.
+        expected: KeyRef,
+        /// The key frame the constraint named.
+        given: KeyRef,
     },
     /// The key frame has no such boundary point.
     NoSuchPoint,
@@ -338,7 +338,8 @@ impl fmt::Display for FusionError {
             Self::NoKeyFrame => f.write_str("there is no key frame"),
             Self::KeyMismatch { expected, given } => write!(
                 f,
-                "the constraint is for key frame {given}, the key frame is {expected}"
+                "the constraint is for key frame {} (key frame {} of the fusion), the key frame is {} ({})",
+                given.id, given.serial, expected.id, expected.serial
             ),
             Self::NoSuchPoint => f.write_str("the key frame has no such point"),
             Self::InvalidRange => {
@@ -404,6 +405,35 @@ pub struct Fusion<const N: usize, const B: usize, const M: usize> {
     map: RoadMap<B, M>,
     /// The rounding of the last pair's composed motion (`Chain::config`).
     pair_rounding: Rounding,
+    /// Key frames started over the fusion's life ([`KeyRef`]; a reset
+    /// does not restart it).
+    keys_started: u32,
+}
+
+/// One key frame of a fusion's life, as [`Fusion::constrain`] names it:
+/// its frame id and the number of key frames the fusion had started when
+/// it started, which [`Fusion::reset`] does not restart. Frame ids need
+/// not be unique over a drive (a front end that restarts its ids, a fusion
+/// reset after a broken chain): a range measured for one key frame is
+/// never put on a later key frame with the same id.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct KeyRef {
+    id: u32,
+    serial: u32,
+}
+
+impl KeyRef {
+    /// The key frame's id, as given to [`Fusion::step`].
+    pub fn id(&self) -> u32 {
+        self.id
+    }
+
+    /// The key frame's place among the key frames the fusion started, from
+    /// 1 (wrapping after `u32::MAX`).
+    pub fn serial(&self) -> u32 {
+        self.serial
+    }
 }
 
 impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
@@ -423,6 +453,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             pending: None,
             map: RoadMap::new(config.tilt_sc, scale),
             pair_rounding: Rounding::NONE,
+            keys_started: 0,
         }
     }
 
@@ -588,7 +619,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             // The processor keeps this frame: the new key frame. Its fusion
             // starts with the next frame; until then `key` shows the
             // retired one's final state.
-            self.pending = Some((id, KeyFrame::lens_of(frame)));
+            self.begin_key(id, frame);
             self.chain = Chain::IDENTITY;
             self.due = self.config.max_partners <= 1;
             return Ok(out);
@@ -690,12 +721,19 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             return None;
         }
         let _ = self.processor.process(frame, None);
-        self.pending = Some((id, KeyFrame::lens_of(frame)));
+        self.begin_key(id, frame);
         if !show_retired {
             self.settle();
         }
         self.has_key = true;
         Some(reason)
+    }
+
+    /// Frame `id`, which the processor keeps, is the new key frame; its
+    /// fusion starts with the next step ([`Self::settle`]).
+    fn begin_key(&mut self, id: u32, frame: &Frame<N, B>) {
+        self.pending = Some((id, KeyFrame::lens_of(frame)));
+        self.keys_started = self.keys_started.wrapping_add(1);
     }
 
     /// Start the fusion of a key frame the processor keeps.
@@ -738,19 +776,20 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// detected pixel's ray alone missed the truth by about `|x| e₁/f`
     /// of the depth, found by an adversarial review.)
     ///
-    /// `key` names the key frame the range belongs to (its frame id, as
-    /// given to [`Fusion::step`]); it must be the one constraints go to,
-    /// [`Fusion::key_id`], the processor's kept frame, else
+    /// `key` names the key frame the range belongs to ([`Fusion::key_ref`]
+    /// when the range was asked for); it must be the one constraints go
+    /// to now, the processor's kept frame, else
     /// [`FusionError::KeyMismatch`]: right after a step that retired a key
     /// frame that is the **new** one, whose fusion starts with it
     /// ([`Fusion::key`] shows the new key frame from then on, not the
     /// retired one's final state), so a range measured for the retired
-    /// one's pixels is refused rather than put on another point. An error
+    /// one's pixels is refused rather than put on another point, also when
+    /// the new key frame has the same frame id ([`KeyRef`]). An error
     /// leaves everything as it was, [`Fusion::key`] included. The checks,
     /// in order: the range, a key frame, the key, the point.
     pub fn constrain(
         &mut self,
-        key: u32,
+        key: KeyRef,
         boundary: usize,
         index: usize,
         near: f32,
@@ -759,7 +798,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         if !(near.is_finite() && far.is_finite() && 0.0 <= near && near <= far) {
             return Err(FusionError::InvalidRange);
         }
-        let current = self.key_id().ok_or(FusionError::NoKeyFrame)?;
+        let current = self.key_ref().ok_or(FusionError::NoKeyFrame)?;
         if key != current {
             return Err(FusionError::KeyMismatch {
                 expected: current,
@@ -829,6 +868,17 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             return None;
         }
         Some(self.pending.map_or(self.key.id(), |(id, _)| id))
+    }
+
+    /// The key frame [`Fusion::constrain`] addresses, as it names it: its
+    /// id ([`Fusion::key_id`]) and its place among the key frames the
+    /// fusion started. Take it when asking another sensor for a range, and
+    /// give it back with the range.
+    pub fn key_ref(&self) -> Option<KeyRef> {
+        Some(KeyRef {
+            id: self.key_id()?,
+            serial: self.keys_started,
+        })
     }
 
     /// The current key frame's fusion, if there is a key frame. Right

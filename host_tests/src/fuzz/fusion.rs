@@ -37,10 +37,10 @@
 
 use roadstereo::fusion::{
     ChainedMotion, FusedStatus, Fusion, FusionConfig, FusionConfigError, FusionError, FusionStep,
-    MAX_PARTNERS,
+    KeyRef, MAX_PARTNERS,
 };
 use roadstereo::map::MAP_BATCHES;
-use roadstereo::Frame;
+use roadstereo::{Camera, Config, Frame, Pixel};
 
 use super::frame::{self, ConfigIn, FrameIn, MotionIn, Pose, Scene, IDENTITY};
 use super::{Outcome, Source};
@@ -484,7 +484,13 @@ fn run_case<const N: usize, const B: usize, const M: usize>(case: &Case) -> Outc
     let mut shadow = f.clone();
     // The model: the last accepted frame, the points that entered the map.
     let mut last: Option<u32> = None;
-    let mut model_key: Option<u32> = None;
+    // (The model's key frame: its id and serial, the key frames started
+    // so far, which a reset does not restart; and the last key frame's
+    // reference before it, a stale one to offer.)
+    let mut model_key: Option<(u32, u32)> = None;
+    let mut started = 0u32;
+    let (mut last_seen, mut stale): (Option<KeyRef>, Option<KeyRef>) = (None, None);
+    let foreign = foreign_key();
     let mut entered: u64 = 0;
     // Frames without points paired with the key frame: each may take a
     // partner's place beyond `max_partners` (it cannot be the last
@@ -588,9 +594,15 @@ fn run_case<const N: usize, const B: usize, const M: usize>(case: &Case) -> Outc
                             blank_paired = 0;
                         }
                         if s.new_key.is_some() {
-                            model_key = Some(*id);
+                            started = started.wrapping_add(1);
+                            model_key = Some((*id, started));
                         } else if f.key().is_none() {
                             model_key = None;
+                        }
+                        let now = f.key_ref();
+                        if now.is_some() && now != last_seen {
+                            stale = last_seen.or(stale);
+                            last_seen = now;
                         }
                     }
                 }
@@ -602,9 +614,16 @@ fn run_case<const N: usize, const B: usize, const M: usize>(case: &Case) -> Outc
                 far,
                 times,
             } => {
+                // The reference the caller holds: the key frame's now, or
+                // on one call in five the one before (a return for a key
+                // frame that has retired, maybe with the same id after a
+                // reset), or without either another fusion's.
+                let key = match (n % 5 == 4, f.key_ref(), stale) {
+                    (true, _, Some(old)) => old,
+                    (_, Some(now), _) => now,
+                    (_, None, old) => old.unwrap_or(foreign),
+                };
                 for rep in 0..*times {
-                    // (One call in five names a key frame one off.)
-                    let key = model_key.unwrap_or(0).wrapping_add(u32::from(n % 5 == 4));
                     constrain(
                         &mut f,
                         &mut shadow,
@@ -630,11 +649,28 @@ fn run_case<const N: usize, const B: usize, const M: usize>(case: &Case) -> Outc
     out
 }
 
+/// A key frame's reference from another fusion (frame 0, the first key
+/// frame it started): what a caller holding none of this fusion's could
+/// give.
+fn foreign_key() -> KeyRef {
+    let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).expect("camera");
+    let mut frame = Frame::<4, 1>::new(cam);
+    frame
+        .push_boundary(&[Pixel::new(100.0, 400.0), Pixel::new(120.0, 380.0)])
+        .expect("boundary");
+    let mut other = Box::new(Fusion::<4, 1, 4>::new(
+        Config::DEFAULT,
+        FusionConfig::DEFAULT,
+    ));
+    other.step(0, &frame, None).expect("key frame");
+    other.key_ref().expect("key frame")
+}
+
 /// One [`Fusion::constrain`] on `f` and, when it succeeds, on the shadow.
 fn constrain<const N: usize, const B: usize, const M: usize>(
     f: &mut Fusion<N, B, M>,
     shadow: &mut Fusion<N, B, M>,
-    (model_key, key): (Option<u32>, u32),
+    (model_key, key): (Option<(u32, u32)>, KeyRef),
     (boundary, index, near, far): (usize, usize, f32, f32),
     check_whole: bool,
     features: &mut u128,
@@ -643,15 +679,17 @@ fn constrain<const N: usize, const B: usize, const M: usize>(
     let valid = near.is_finite() && far.is_finite() && 0.0 <= near && near <= far;
     let kept = f.processor().previous().filter(|_| f.key().is_some());
     // (The model's key frame: the last step that started one.)
+    let current = f.key_ref();
     assert_eq!(
-        f.key_id(),
+        current.map(|k| (k.id(), k.serial())),
         model_key.filter(|_| kept.is_some()),
-        "{at}: key_id"
+        "{at}: key_ref"
     );
+    assert_eq!(f.key_id(), current.map(|k| k.id()), "{at}: key_id");
     let want = if !valid {
         Some(FusionError::InvalidRange)
     } else {
-        match (kept, model_key) {
+        match (kept, current) {
             (None, _) | (_, None) => Some(FusionError::NoKeyFrame),
             (Some(_), Some(current)) if current != key => Some(FusionError::KeyMismatch {
                 expected: current,

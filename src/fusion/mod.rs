@@ -483,6 +483,13 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// (ignored for the first frame, or the first after
     /// [`Fusion::reset`]).
     ///
+    /// The ids are what chains the motions: a motion "from `k`" is taken
+    /// from the last accepted frame when that frame's id is `k`, whatever
+    /// frame the caller meant by it. A front end that restarts its frame
+    /// ids (or reuses one) resets the fusion first; a frame refused as
+    /// [`FusionError::RepeatedFrame`] is not a new frame to chain from.
+    /// (Range returns are safe either way: [`KeyRef`].)
+    ///
     /// Errors (nothing changes): [`FusionError::MissingMotion`],
     /// [`FusionError::BrokenChain`] when the motion does not start at the
     /// last accepted frame, [`FusionError::RepeatedFrame`].

@@ -822,7 +822,13 @@ fn compensate_all_certified<const BOUNDED: bool>(
     // and the compensation's loop stays lean. (In that loop until settled,
     // as before, the representative window measured 675.9 instructions a
     // point against 673.7, every other window dearer too.)
-    let keys = slots.iter().zip(margins.iter()).take(n);
+    // (Both cut to `n`, rather than the pairs taken to `n`: one count
+    // for the loop, not the zip's and the take's.)
+    let (slots, margins) = (
+        slots.get(..n).unwrap_or_default(),
+        margins.get(..n).unwrap_or_default(),
+    );
+    let keys = slots.iter().zip(margins);
     order.push_until_settled::<BOUNDED>(keys.map(|(slot, &e)| (slot.z_far, e)));
 }
 
@@ -860,7 +866,9 @@ fn frame2_keys<'a, const N: usize>(
         match keying.pencil {
             Pencil::Half { foe, side, min_t } => {
                 let ks = keying.key_scale;
-                let keys = b2.iter().map(|p| half_key(p.arr(), (foe, side, min_t), ks));
+                let keys = b2
+                    .iter()
+                    .map(move |p| half_key(p.arr(), (foe, side, min_t), ks));
                 if checking {
                     builder.push_all(keys);
                 } else {

@@ -509,23 +509,28 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             // Step 1, with each point's key margin where the fold index
             // wants it, and whether the keys are strictly ordered.
             let mut order = KeyOrder::NEW;
+            // (How many points step 1's key order took: the fold test's
+            // lead, [`crate::fold::step`].)
+            let mut pushed = 0usize;
             let margins = index.margins_mut();
             match (pair.certified_r1, keying.pencil) {
                 (Some(r1), Pencil::Half { foe, side, min_t }) => {
                     let ks = keying.key_scale;
                     let key = |p| half_key(p, (foe, side, min_t), ks);
                     let points = (&mut *slots, b1, &mut margins[..]);
+                    let order = (&mut order, &mut pushed);
                     if checking {
-                        step1_certified::<D, false>(&pair, r1, points, &mut order, key, &mut guard);
+                        step1_certified::<D, false>(&pair, r1, points, order, key, &mut guard);
                     } else {
-                        step1_certified::<D, true>(&pair, r1, points, &mut order, key, &mut guard);
+                        step1_certified::<D, true>(&pair, r1, points, order, key, &mut guard);
                     }
                     r1_max = if slots.is_empty() { 0.0 } else { r1 };
                 }
                 (Some(r1), _) => {
                     let key = |p| keying.key(p);
                     let points = (&mut *slots, b1, &mut margins[..]);
-                    step1_certified::<D, false>(&pair, r1, points, &mut order, key, &mut guard);
+                    let order = (&mut order, &mut pushed);
+                    step1_certified::<D, false>(&pair, r1, points, order, key, &mut guard);
                     r1_max = if slots.is_empty() { 0.0 } else { r1 };
                 }
                 (None, _) => {
@@ -568,7 +573,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             crate::fold::step(
                 index,
                 slots,
-                (&order, keying.period, orient, bounded),
+                (&order, pushed, keying.period, orient, bounded),
                 config.work_per_point,
                 &mut work,
                 &mut guard,
@@ -580,7 +585,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 crate::fold::step(
                     index,
                     slots,
-                    (&order, keying.period, orient, bounded),
+                    (&order, pushed, keying.period, orient, bounded),
                     config.work_per_point,
                     &mut work,
                     &mut guard,
@@ -755,12 +760,13 @@ fn step1_certified<D: Deadline, const BOUNDED: bool>(
     pair: &Pair,
     r1: f32,
     (slots, b1, margins): (&mut [PointResult], &[Pixel], &mut [f32]),
-    order: &mut KeyOrder,
+    (order, pushed): (&mut KeyOrder, &mut usize),
     key: impl Fn([f32; 2]) -> (f32, f32),
     guard: &mut Guard<'_, D>,
 ) {
     if crate::deadline::never::<D>() {
-        return compensate_all_certified::<BOUNDED>(pair, r1, (slots, b1, margins), order, key);
+        *pushed += compensate_all_certified::<BOUNDED>(pair, r1, (slots, b1, margins), order, key);
+        return;
     }
     let mut parts = slots
         .chunks_mut(CHUNK)
@@ -778,7 +784,7 @@ fn step1_certified<D: Deadline, const BOUNDED: bool>(
             }
             return;
         }
-        compensate_all_certified::<BOUNDED>(pair, r1, (s, b, m), order, &key);
+        *pushed += compensate_all_certified::<BOUNDED>(pair, r1, (s, b, m), order, &key);
         first = false;
     }
 }
@@ -791,6 +797,7 @@ fn step1_certified<D: Deadline, const BOUNDED: bool>(
 /// [`KeyOrder::strict`] as it is), in a pass over the written keys after
 /// the compensation's. `BOUNDED`: `key` gives [`NO_KEY`] or a key at most
 /// 1 in magnitude ([`half_key`]; [`KeyOrder::push_until_settled`]).
+/// Returns how many points the key order took.
 #[inline(always)]
 fn compensate_all_certified<const BOUNDED: bool>(
     pair: &Pair,
@@ -798,7 +805,7 @@ fn compensate_all_certified<const BOUNDED: bool>(
     (slots, b1, margins): (&mut [PointResult], &[Pixel], &mut [f32]),
     order: &mut KeyOrder,
     key: impl Fn([f32; 2]) -> (f32, f32),
-) {
+) -> usize {
     let stretch = pair.geom.frame_stretch().unwrap_or(0.0);
     let one = |((slot, &p1), m): ((&mut PointResult, &Pixel), &mut f32)| {
         let c = pair.geom.compensate_certified(p1, stretch);
@@ -829,7 +836,7 @@ fn compensate_all_certified<const BOUNDED: bool>(
         margins.get(..n).unwrap_or_default(),
     );
     let keys = slots.iter().zip(margins);
-    order.push_until_settled::<BOUNDED>(keys.map(|(slot, &e)| (slot.z_far, e)));
+    order.push_until_settled::<BOUNDED>(keys.map(|(slot, &e)| (slot.z_far, e)))
 }
 
 /// Step 3: index the frame-2 polyline; with `W' < 0` and the FOE near, the

@@ -46,7 +46,8 @@ use crate::structure::{PointResult, Status, FOLD_WINDOW};
 
 /// Step 2 for one boundary's points in `slots` (step 1's results: a point
 /// still to be matched holds its raw key in `z_far`, its margin in the
-/// index's margins), whose key order step 1 tracked in `order`, keys of
+/// index's margins), whose key order step 1 tracked in `order` (`pushed`:
+/// how many points it took, [`KeyOrder::push_until_settled`]), keys of
 /// the given `period` and likely orientation `orient` (`bounded`: every
 /// point is still to be matched, its key [`NO_KEY`] or finite with a finite
 /// margin ≥ 0, half-plane keys of a certified step 1); each point brings
@@ -56,7 +57,7 @@ use crate::structure::{PointResult, Status, FOLD_WINDOW};
 pub(crate) fn step<const N: usize, D: Deadline>(
     index: &mut Index<N>,
     slots: &mut [PointResult],
-    (order, period, orient, bounded): (&KeyOrder, f32, f32, bool),
+    (order, pushed, period, orient, bounded): (&KeyOrder, usize, f32, f32, bool),
     allowance: u32,
     work: &mut Work,
     guard: &mut Guard<'_, D>,
@@ -70,9 +71,17 @@ pub(crate) fn step<const N: usize, D: Deadline>(
     if period <= 0.0 {
         let margins = index.margins();
         let hulls = if bounded {
-            by_hulls::<true>(slots, margins, || guard.check())
+            // The points before the one that settled the order are keyed
+            // and their widened keys strictly ordered one way (bounded
+            // keys: all are valid, each keyed with a finite margin ≥ 0).
+            let lead = if order.settled() {
+                pushed.saturating_sub(1)
+            } else {
+                0
+            };
+            by_hulls::<true>(slots, margins, lead, || guard.check())
         } else {
-            by_hulls::<false>(slots, margins, || guard.check())
+            by_hulls::<false>(slots, margins, 0, || guard.check())
         };
         match hulls {
             Hulls::Decided => {
@@ -169,6 +178,7 @@ enum Hulls {
 fn by_hulls<const BOUNDED: bool>(
     slots: &mut [PointResult],
     margins: &[f32],
+    lead: usize,
     expired: impl FnMut() -> bool,
 ) -> Hulls {
     let valid = |r: &PointResult| r.status == Status::NoIntersection;
@@ -178,7 +188,7 @@ fn by_hulls<const BOUNDED: bool>(
     let hulls = folds_by_hulls::<_, BOUNDED>(
         slots,
         margins,
-        FOLD_WINDOW,
+        (FOLD_WINDOW, lead),
         (valid, |r| r.z_far),
         (mark, unmark),
         expired,
@@ -208,7 +218,12 @@ fn by_hulls<const BOUNDED: bool>(
 /// pass marks only those that do). `BOUNDED`: the caller knows every item
 /// valid and its key [`NO_KEY`] or finite with a finite margin `≥ 0`
 /// (then an item passes those checks exactly when its key is not
-/// `NO_KEY`, which is all the forward pass asks).
+/// `NO_KEY`, which is all the forward pass asks); with it, `lead` (else
+/// ignored): items `0 .. lead` are keyed and their widened keys strictly
+/// ordered one way (each wholly above the one before, or each wholly
+/// below: step 1's key order, [`KeyOrder::push_until_settled`]), so the
+/// forward pass marks none of them and its hull there is that of the
+/// lead's first and last vertices before the window, where it starts.
 ///
 /// Vertex `i` folds when its widened key `[k − e, k + e]` meets the
 /// interval of a segment `j ≤ i − w − 1` or `j ≥ i + w` (segment `j` from
@@ -230,7 +245,7 @@ fn by_hulls<const BOUNDED: bool>(
 fn folds_by_hulls<T, const BOUNDED: bool>(
     items: &mut [T],
     margins: &[f32],
-    w: usize,
+    (w, lead): (usize, usize),
     (valid, key): (impl Fn(&T) -> bool, impl Fn(&T) -> f32),
     (mut mark, mut unmark): (impl FnMut(&mut T), impl FnMut(&mut T)),
     mut expired: impl FnMut() -> bool,
@@ -252,39 +267,59 @@ fn folds_by_hulls<T, const BOUNDED: bool>(
     // ≥ 0, `k + e` finite: then `k − e ≤ k + e`, the low end perhaps −∞,
     // as the index computes it too), the hull of vertices 0 ..= i − w, the
     // test from i = w + 1 on.
-    let mut hull = (f32::INFINITY, f32::NEG_INFINITY);
-    for i in 0..n {
-        if i % CHUNK == CHUNK - 1 && expired() {
-            return Hulls::Stopped;
-        }
-        let e = margins.get(i).copied().unwrap_or(f32::NAN);
-        let checked = if BOUNDED {
-            // (Every item valid, each key NO_KEY or finite with a finite
-            // margin ≥ 0: the test below, asked that way.)
-            items.get(i).map(&key).filter(|&k| k != NO_KEY)
-        } else {
-            // (A NaN fails.)
-            // (`k + e` finite with `e ≥ 0`: both finite, and no overflow.)
-            let checked = items.get(i).filter(|&it| valid(it)).map(&key);
-            checked.filter(|k| e >= 0.0 && (k + e).is_finite())
-        };
-        let Some(wi) = checked else {
-            // Undo: every item before `i` was valid, so those that are
-            // no longer are the ones marked here.
-            for it in items.iter_mut().take(i).filter(|it| !valid(it)) {
-                unmark(it);
+    // From item `from` on, with the hull of items `0 ..= from − w − 1`
+    // (the loop written twice below: the plain pass from 0, as it was, and
+    // the pass after a lead, which knows `from > w + 1`).
+    macro_rules! forward {
+        ($from:expr, $hull:expr) => {
+            let mut hull = $hull;
+            for i in $from..n {
+                if i % CHUNK == CHUNK - 1 && expired() {
+                    return Hulls::Stopped;
+                }
+                let e = margins.get(i).copied().unwrap_or(f32::NAN);
+                let checked = if BOUNDED {
+                    // (Every item valid, each key NO_KEY or finite with a
+                    // finite margin ≥ 0: the test below, asked that way.)
+                    items.get(i).map(&key).filter(|&k| k != NO_KEY)
+                } else {
+                    // (A NaN fails.)
+                    // (`k + e` finite with `e ≥ 0`: both finite, and no
+                    // overflow.)
+                    let checked = items.get(i).filter(|&it| valid(it)).map(&key);
+                    checked.filter(|k| e >= 0.0 && (k + e).is_finite())
+                };
+                let Some(wi) = checked else {
+                    // Undo: every item before `i` was valid, so those
+                    // that are no longer are the ones marked here.
+                    for it in items.iter_mut().take(i).filter(|it| !valid(it)) {
+                        unmark(it);
+                    }
+                    return Hulls::Undecided;
+                };
+                let wi = (wi - e, wi + e);
+                if let Some(v) = i.checked_sub(w) {
+                    hull = join(hull, widened(items, v));
+                }
+                if i > w && meets(wi, hull) {
+                    if let Some(it) = items.get_mut(i) {
+                        mark(it);
+                    }
+                }
             }
-            return Hulls::Undecided;
         };
-        let wi = (wi - e, wi + e);
-        if let Some(v) = i.checked_sub(w) {
-            hull = join(hull, widened(items, v));
-        }
-        if i > w && meets(wi, hull) {
-            if let Some(it) = items.get_mut(i) {
-                mark(it);
-            }
-        }
+    }
+    let none = (f32::INFINITY, f32::NEG_INFINITY);
+    if BOUNDED && lead > w.saturating_add(1) && lead <= n {
+        // A strictly ordered lead: its item `i > w` lies wholly beyond the
+        // hull of items `0 ..= i − w` (each widened key is non-empty, so
+        // both ends move strictly one way), which `fmin` and `fmax` make
+        // from the first and the last of them, bit for bit; the pass
+        // starts after the lead with that hull.
+        let first = join(none, widened(items, 0));
+        forward!(lead, join(first, widened(items, lead - 1 - w)));
+    } else {
+        forward!(0, none);
     }
     // Backward: the hull of vertices i + w ..= n − 1, tested for
     // i + w ≤ n − 2, that is i < n − w − 1: it starts as vertex n − 1 alone
@@ -323,7 +358,7 @@ mod tests {
     #[test]
     fn folds_by_hulls_equals_brute_force() {
         let mut rng = Rng(0xf01d_0003);
-        let (w, mut taken, mut cuts) = (4, 0, 0);
+        let (w, mut taken, mut cuts, mut leads) = (4, 0, 0, 0);
         for case in 0..3000 {
             let shape = case % 5;
             let n = 1 + (rng.next() * (CAP - 1) as f32) as usize;
@@ -352,15 +387,39 @@ mod tests {
                 asked > q
             };
             let mut cut = items.clone();
-            let stopped =
-                folds_by_hulls::<_, false>(&mut cut, &margins, w, (valid, |it| it.0), marks, clock);
+            let stopped = folds_by_hulls::<_, false>(
+                &mut cut,
+                &margins,
+                (w, 0),
+                (valid, |it| it.0),
+                marks,
+                clock,
+            );
             // The items here are valid but where the key is NO_KEY, their
             // keys small and margins ≥ 0: the bounded test is the same.
             let mut bounded = items.clone();
             let took_bounded = folds_by_hulls::<_, true>(
                 &mut bounded,
                 &margins,
-                w,
+                (w, 0),
+                (valid, |it| it.0),
+                marks,
+                || false,
+            );
+            // With the lead step 1's key order gives (`step`): the same.
+            let mut order = KeyOrder::NEW;
+            let pushed = order.push_until_settled::<true>(ks.iter().copied());
+            let lead = if order.settled() {
+                pushed.saturating_sub(1)
+            } else {
+                0
+            };
+            leads += usize::from(lead > w + 1 && lead < n);
+            let mut led = items.clone();
+            let took_led = folds_by_hulls::<_, true>(
+                &mut led,
+                &margins,
+                (w, lead),
                 (valid, |it| it.0),
                 marks,
                 || false,
@@ -368,13 +427,15 @@ mod tests {
             let took = folds_by_hulls::<_, false>(
                 &mut items,
                 &margins,
-                w,
+                (w, 0),
                 (valid, |it| it.0),
                 marks,
                 || false,
             );
             assert_eq!(took, took_bounded, "case {case}: bounded");
             assert_eq!(items, bounded, "case {case}: bounded");
+            assert_eq!(took, took_led, "case {case}: lead {lead}");
+            assert_eq!(items, led, "case {case}: lead {lead}");
             let took = took == Hulls::Decided;
             let brute = |i: usize, (k, e): (f32, f32)| {
                 ivs.iter().enumerate().any(|(j, iv)| {
@@ -416,6 +477,7 @@ mod tests {
         }
         assert!(taken > 2000, "{taken} cases taken");
         assert!(cuts > 500, "{cuts} cases stopped");
+        assert!(leads > 300, "{leads} cases with a lead");
         // A window past every vertex (no run on either side): nothing
         // folds, and no index arithmetic overflows.
         let mut items: Vec<(f32, u32)> = (0..5).map(|i| ((i % 2) as f32, 0)).collect();
@@ -428,7 +490,7 @@ mod tests {
             let r = folds_by_hulls::<_, false>(
                 &mut items,
                 &[0.5; 5],
-                w,
+                (w, 0),
                 (valid, |it| it.0),
                 marks,
                 || false,

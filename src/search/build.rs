@@ -512,21 +512,26 @@ impl KeyOrder {
     /// tests only it. `BOUNDED`: every key is [`NO_KEY`] or finite and at
     /// most 2 in magnitude (half-plane keys, [`crate::pencil::half_key`]),
     /// so that a key is finite with the one before exactly when it is not
-    /// `NO_KEY`: that loop asks so.
+    /// `NO_KEY`: that loop asks so. Returns how many of `keys` were
+    /// pushed: once settled, the last of them settled it, and those
+    /// before it since the first push were all keyed and their widened
+    /// keys strictly ordered one way (the fold test's lead,
+    /// `crate::fold`).
     #[inline(always)]
     pub(crate) fn push_until_settled<const BOUNDED: bool>(
         &mut self,
-        keys: impl Iterator<Item = (f32, f32)>,
-    ) {
+        keys: impl ExactSizeIterator<Item = (f32, f32)>,
+    ) -> usize {
         let mut keys = keys;
+        let all = keys.len();
         while !self.settled() && (self.first || (self.up && self.down)) {
             let Some((k, e)) = keys.next() else {
-                return;
+                return all;
             };
             self.push(k, e);
         }
         if self.settled() {
-            return;
+            return all - keys.len();
         }
         // Every pair keyed so far, one direction left: `push` with the
         // other's test dropped (it stays false), a loop for each. (One
@@ -584,6 +589,7 @@ impl KeyOrder {
             (self.up, self.down) = (false, false);
         }
         (self.prev, self.plo, self.phi) = (prev, plo, phi);
+        all - keys.len()
     }
 
     /// Whether [`Self::strict`] is false whatever vertices come next (one

@@ -283,19 +283,27 @@ impl Keying {
 /// reaches of the principal point ([`Keying::choose`]), so `q − foe` is
 /// finite there; an infinite `q` would give a NaN key, not `NO_KEY`.
 #[inline(always)]
-pub(crate) fn half_key(
+pub(crate) fn half_key(q: [f32; 2], pencil: ([f32; 2], f32, f32), key_scale: f32) -> (f32, f32) {
+    half_key_or_none(q, pencil, key_scale).unwrap_or((NO_KEY, 0.0))
+}
+
+/// [`half_key`], `None` where it gives [`NO_KEY`] (and 0): a caller that
+/// leaves the unkeyed vertices to a path of their own asks where the key
+/// is made, not of the key again.
+#[inline(always)]
+pub(crate) fn half_key_or_none(
     q: [f32; 2],
     (foe, side, min_t): ([f32; 2], f32, f32),
     key_scale: f32,
-) -> (f32, f32) {
+) -> Option<(f32, f32)> {
     let d = sub(q, foe);
     let t = side * d[1];
     // NaN fails the test too.
     if t >= min_t {
         let inv = 1.0 / (d[0].abs() + t);
-        (d[0] * inv, key_scale * inv + ULP20)
+        Some((d[0] * inv, key_scale * inv + ULP20))
     } else {
-        (NO_KEY, 0.0)
+        None
     }
 }
 

@@ -82,7 +82,7 @@ use crate::depth::{interval, Band, PointErrors};
 use crate::epipolar::PairGeometry;
 use crate::matching::{Outcome, Radial, Walker};
 use crate::motion::Motion;
-use crate::pencil::{half_key, Keying, Pencil, NO_KEY};
+use crate::pencil::{half_key, half_key_or_none, Keying, Pencil, NO_KEY};
 use crate::search::{
     expired, run_start_in, BlockSkip, Blocks, Builder, Flow, Index, KeyOrder, LazyBlocks, Lean,
     OutOfWork, Query, Tick, Unkeyed, Visitor, Work, CHUNK, CLIP_UNITS,
@@ -873,12 +873,13 @@ fn frame2_keys<'a, const N: usize>(
         match keying.pencil {
             Pencil::Half { foe, side, min_t } => {
                 let ks = keying.key_scale;
-                let keys = b2
-                    .iter()
-                    .map(move |p| half_key(p.arr(), (foe, side, min_t), ks));
+                let pencil = (foe, side, min_t);
                 if checking {
-                    builder.push_all(keys);
+                    builder.push_all(b2.iter().map(move |p| half_key(p.arr(), pencil, ks)));
                 } else {
+                    let keys = b2
+                        .iter()
+                        .map(move |p| half_key_or_none(p.arr(), pencil, ks));
                     builder.push_all_bounded(keys);
                 }
             }

@@ -142,13 +142,11 @@ pub(super) fn counted_search<const N: usize, D: Deadline>(
             stopped = true;
             break;
         }
-        let keys = part
-            .iter()
-            .map(|p| half_key(p.arr(), (foe, side, min_t), ks));
+        let pencil = (foe, side, min_t);
         if checking {
-            builder.push_all(keys);
+            builder.push_all(part.iter().map(|p| half_key(p.arr(), pencil, ks)));
         } else {
-            builder.push_all_bounded(keys);
+            builder.push_all_bounded(part.iter().map(|p| half_key_or_none(p.arr(), pencil, ks)));
         }
     }
     let mut ask = || guard.check();

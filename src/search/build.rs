@@ -634,23 +634,28 @@ impl<const N: usize> Builder<'_, N> {
         self.push_run::<false>(|m| {
             let (raw, e) = keys.next()?;
             *m = e;
-            Some(raw)
+            Some(Some(raw))
         });
     }
 
-    /// [`Self::push_all`] for keys that are [`NO_KEY`] or finite and at
-    /// most 2 in magnitude (half-plane keys, [`crate::pencil::half_key`],
-    /// are at most 1; any bound far below `f32::MAX / 2` would do):
-    /// then a key and the one before sum to a finite value exactly when the
-    /// key is not `NO_KEY`, the lean loop's test, asked that way (the same
-    /// index).
+    /// [`Self::push_all`] for keys that are `None` where there is none
+    /// ([`NO_KEY`], margin 0) or finite and at most 2 in magnitude
+    /// (half-plane keys, [`crate::pencil::half_key_or_none`], are at most
+    /// 1; any bound far below `f32::MAX / 2` would do): then a key and the
+    /// one before sum to a finite value exactly when there is a key, the
+    /// lean loop's test, asked where the key is made (the same index).
     #[inline(always)]
-    pub(crate) fn push_all_bounded(&mut self, keys: impl Iterator<Item = (f32, f32)>) {
+    pub(crate) fn push_all_bounded(&mut self, keys: impl Iterator<Item = Option<(f32, f32)>>) {
         let mut keys = keys;
-        self.push_run::<true>(|m| {
-            let (raw, e) = keys.next()?;
-            *m = e;
-            Some(raw)
+        self.push_run::<true>(|m| match keys.next()? {
+            Some((raw, e)) => {
+                *m = e;
+                Some(Some(raw))
+            }
+            None => {
+                *m = 0.0;
+                Some(None)
+            }
         });
     }
 
@@ -659,7 +664,7 @@ impl<const N: usize> Builder<'_, N> {
     #[inline(always)]
     pub(crate) fn push_all_stored(&mut self, keys: impl Iterator<Item = f32>) {
         let mut keys = keys;
-        self.push_run::<false>(|_| keys.next());
+        self.push_run::<false>(|_| keys.next().map(Some));
     }
 
     /// Push vertices while `next` gives their raw keys, each with its
@@ -671,18 +676,22 @@ impl<const N: usize> Builder<'_, N> {
     /// from the first vertex it cannot take on, [`Self::push_stored`]. A
     /// polyline may come in parts (a caller's deadline asked between them):
     /// a part that follows a finite key goes on in the lean loop, with the
-    /// same values one call would give. `BOUNDED`: every key `next` gives
-    /// is [`NO_KEY`] or finite and at most 2 in magnitude
-    /// ([`Self::push_all_bounded`]).
+    /// same values one call would give. `next` gives `None` at the end,
+    /// `Some(None)` for a vertex without a key (a raw [`NO_KEY`]).
+    /// `BOUNDED`: every key `next` gives is finite and at most 2 in
+    /// magnitude ([`Self::push_all_bounded`]).
     #[inline(always)]
-    fn push_run<const BOUNDED: bool>(&mut self, mut next: impl FnMut(&mut f32) -> Option<f32>) {
+    fn push_run<const BOUNDED: bool>(
+        &mut self,
+        mut next: impl FnMut(&mut f32) -> Option<Option<f32>>,
+    ) {
         let mut pending = None;
         if self.period <= 0.0 {
             if self.n == 0 {
                 let Some(raw) = self.index.margin.first_mut().and_then(&mut next) else {
                     return;
                 };
-                self.push_stored(raw);
+                self.push_stored(raw.unwrap_or(NO_KEY));
             }
             // The last vertex's oriented key and margin (`push_stored`
             // keeps the key in the order tracker, the lean loop below too).
@@ -703,16 +712,17 @@ impl<const N: usize> Builder<'_, N> {
                 .get_mut(n0.saturating_sub(1)..)
                 .unwrap_or_default();
             for (m, g) in margins.iter_mut().zip(segs.iter_mut()) {
-                let Some(raw) = next(m) else {
+                let Some(key) = next(m) else {
+                    break;
+                };
+                let Some(raw) = key else {
+                    pending = Some(NO_KEY);
                     break;
                 };
                 let k = o * raw;
-                // (Bounded keys: `prev` is at most 2 in magnitude too.)
-                let leave = if BOUNDED {
-                    raw == NO_KEY
-                } else {
-                    !(k + prev).is_finite()
-                };
+                // (Bounded keys: `prev` is at most 2 in magnitude too, and
+                // the sum finite.)
+                let leave = !BOUNDED && !(k + prev).is_finite();
                 if leave {
                     pending = Some(raw);
                     break;
@@ -757,9 +767,9 @@ impl<const N: usize> Builder<'_, N> {
     }
 
     /// The rest of [`Self::push_run`], one [`Self::push_stored`] at a time.
-    fn push_rest(&mut self, mut next: impl FnMut(&mut f32) -> Option<f32>) {
+    fn push_rest(&mut self, mut next: impl FnMut(&mut f32) -> Option<Option<f32>>) {
         while let Some(raw) = self.index.margin.get_mut(self.n).and_then(&mut next) {
-            self.push_stored(raw);
+            self.push_stored(raw.unwrap_or(NO_KEY));
         }
     }
 

@@ -130,10 +130,14 @@ impl<const N: usize> Index<N> {
             }
             self.orient = orient;
         }
-        // The unkeyed segments and the outliers aside ([`outliers`]).
-        let Some(aside) = outliers(seg, wide, tick) else {
+        // The unkeyed segments and the outliers aside ([`outliers`]),
+        // listed in the index's own list (not a list returned and copied:
+        // two copies of its 100 bytes).
+        let aside = &mut self.aside;
+        if !outliers(seg, wide, tick, aside) {
+            aside.clear();
             return false;
-        };
+        }
         for &(j, _, _) in aside.iter() {
             if let Some(g) = seg.get_mut(usize::from(j)) {
                 (g.lo, g.hi) = (f32::INFINITY, f32::NEG_INFINITY);
@@ -151,7 +155,6 @@ impl<const N: usize> Index<N> {
             Some(&(j, _, _)) => usize::from(j),
             None => s,
         };
-        self.aside = aside;
         let Some(seg) = self.seg.get_mut(..s) else {
             return true;
         };
@@ -369,15 +372,16 @@ fn build_levels<const W: usize>(
 /// any choice gives the same results. (An empty interval, `(∞, −∞)`, or a
 /// missing neighbour leaves the neighbours' hull as it is; with neither
 /// there is no hull, `hi = −∞`: intervals are never otherwise inverted,
-/// and a non-empty one has `hi > −∞`.) `None` when `tick`'s clock stopped
-/// the pass.
+/// and a non-empty one has `hi > −∞`.) Listed in `aside` (cleared first);
+/// `false` when `tick`'s clock stopped the pass.
 #[inline(always)]
 pub(super) fn outliers(
     seg: &[Seg],
     wide: f32,
     tick: &mut Tick<'_>,
-) -> Option<heapless::Vec<Aside, MAX_ASIDE>> {
-    let mut aside = heapless::Vec::<Aside, MAX_ASIDE>::new();
+    aside: &mut heapless::Vec<Aside, MAX_ASIDE>,
+) -> bool {
+    aside.clear();
     // Segment `j` (interval `g`) between the intervals `b` two places
     // before and `a` two places after. The reach first (most segments fail
     // it; a NaN fails), then whether the ends and the hull are those of
@@ -437,7 +441,7 @@ pub(super) fn outliers(
         Some(t) => {
             for (k, w) in seg.windows(5).enumerate() {
                 if (k + 2) % CHUNK == CHUNK - 1 && t() {
-                    return None;
+                    return false;
                 }
                 window(k, w);
             }
@@ -445,13 +449,13 @@ pub(super) fn outliers(
     }
     for j in tail..s {
         if j % CHUNK == CHUNK - 1 && expired(tick) {
-            return None;
+            return false;
         }
         if let Some(g) = seg.get(j) {
             test(j, g, ends(j.checked_sub(2)), ends(Some(j + 2)));
         }
     }
-    Some(aside)
+    true
 }
 
 /// Whether the widened keys of a polyline's vertices, in order, each lie

@@ -877,10 +877,7 @@ fn frame2_keys<'a, const N: usize>(
                 if checking {
                     builder.push_all(b2.iter().map(move |p| half_key(p.arr(), pencil, ks)));
                 } else {
-                    let keys = b2
-                        .iter()
-                        .map(move |p| half_key_or_none(p.arr(), pencil, ks));
-                    builder.push_all_bounded(keys);
+                    builder.push_all_bounded(b2, move |p| half_key_or_none(p.arr(), pencil, ks));
                 }
             }
             _ => builder.push_all(b2.iter().map(|p| keying.key(p.arr()))),

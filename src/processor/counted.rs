@@ -146,7 +146,7 @@ pub(super) fn counted_search<const N: usize, D: Deadline>(
         if checking {
             builder.push_all(part.iter().map(|p| half_key(p.arr(), pencil, ks)));
         } else {
-            builder.push_all_bounded(part.iter().map(|p| half_key_or_none(p.arr(), pencil, ks)));
+            builder.push_all_bounded(part, |p| half_key_or_none(p.arr(), pencil, ks));
         }
     }
     let mut ask = || guard.check();

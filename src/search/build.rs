@@ -642,25 +642,98 @@ impl<const N: usize> Builder<'_, N> {
         });
     }
 
-    /// [`Self::push_all`] for keys that are `None` where there is none
-    /// ([`NO_KEY`], margin 0) or finite and at most 2 in magnitude
-    /// (half-plane keys, [`crate::pencil::half_key_or_none`], are at most
-    /// 1; any bound far below `f32::MAX / 2` would do): then a key and the
-    /// one before sum to a finite value exactly when there is a key, the
-    /// lean loop's test, asked where the key is made (the same index).
+    /// [`Self::push_all`] for the keys `key` gives the points `pts`, `None`
+    /// where there is none ([`NO_KEY`], margin 0), otherwise finite and at
+    /// most 2 in magnitude (half-plane keys,
+    /// [`crate::pencil::half_key_or_none`], are at most 1; any bound far
+    /// below `f32::MAX / 2` would do): then a key and the one before sum to
+    /// a finite value exactly when there is a key, the lean loop's test,
+    /// asked where the key is made (the same index). [`Self::push_run`]
+    /// with its lean loop over the points, the margins and the segments
+    /// together: one count for the three.
     #[inline(always)]
-    pub(crate) fn push_all_bounded(&mut self, keys: impl Iterator<Item = Option<(f32, f32)>>) {
-        let mut keys = keys;
-        self.push_run::<true>(|m| match keys.next()? {
-            Some((raw, e)) => {
+    pub(crate) fn push_all_bounded<P>(
+        &mut self,
+        pts: &[P],
+        key: impl Fn(&P) -> Option<(f32, f32)>,
+    ) {
+        let mut rest = pts;
+        // The next point's key through `push_run`'s `next`.
+        let next_of = |rest: &mut &[P], m: &mut f32| {
+            let (p, tail) = rest.split_first()?;
+            *rest = tail;
+            Some(key(p).map(|(raw, e)| {
                 *m = e;
-                Some(Some(raw))
-            }
-            None => {
+                raw
+            }))
+        };
+        let unkeyed = |m: &mut f32, raw: Option<f32>| {
+            if raw.is_none() {
                 *m = 0.0;
-                Some(None)
             }
-        });
+            raw
+        };
+        if self.period <= 0.0 {
+            if self.n == 0 {
+                let first = self.index.margin.first_mut();
+                let Some(raw) = first.and_then(|m| next_of(&mut rest, m).map(|r| unkeyed(m, r)))
+                else {
+                    return;
+                };
+                self.push_stored(raw.unwrap_or(NO_KEY));
+            }
+            let n0 = self.n;
+            let k = self.order.prev;
+            let last = n0.checked_sub(1).and_then(|i| self.index.margin.get(i));
+            let (Some(&e), true) = (last, k.is_finite()) else {
+                return self.push_rest(|m| next_of(&mut rest, m).map(|r| unkeyed(m, r)));
+            };
+            let o = self.o;
+            let (mut prev, mut plo, mut phi) = (k, k - e, k + e);
+            let (mut run, mut sum) = (self.run, self.sum);
+            let margins = self.index.margin.get_mut(n0..).unwrap_or_default();
+            let segs = self
+                .index
+                .seg
+                .get_mut(n0.saturating_sub(1)..)
+                .unwrap_or_default();
+            let (mut taken, mut pending) = (0usize, false);
+            for ((m, g), p) in margins.iter_mut().zip(segs.iter_mut()).zip(rest) {
+                let Some((raw, e)) = key(p) else {
+                    *m = 0.0;
+                    pending = true;
+                    break;
+                };
+                *m = e;
+                let k = o * raw;
+                let (vlo, vhi) = (k - e, k + e);
+                g.lo = fmin(plo, vlo);
+                g.hi = fmax(phi, vhi);
+                sum += g.hi - g.lo;
+                run = fmax(run, g.hi);
+                g.pm = run;
+                (prev, plo, phi) = (k, vlo, vhi);
+                taken += 1;
+            }
+            if taken > 0 {
+                self.order = KeyOrder {
+                    prev,
+                    plo,
+                    phi,
+                    first: false,
+                    up: false,
+                    down: false,
+                    odd: self.order.odd,
+                };
+                (self.n, self.run, self.sum, self.last) = (n0 + taken, run, sum, prev);
+            }
+            rest = rest.get(taken..).unwrap_or_default();
+            if pending {
+                rest = rest.get(1..).unwrap_or_default();
+                self.push_stored(NO_KEY);
+            }
+        }
+        self.push_rest(|m| next_of(&mut rest, m).map(|r| unkeyed(m, r)));
     }
 
     /// [`Self::push_stored`] for every raw key `keys` gives, in order

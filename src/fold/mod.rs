@@ -478,6 +478,46 @@ mod tests {
         assert!(taken > 2000, "{taken} cases taken");
         assert!(cuts > 500, "{cuts} cases stopped");
         assert!(leads > 300, "{leads} cases with a lead");
+        // A long rising lead, then keys falling back into the lead's first
+        // intervals (only the hull of the whole lead, from its first
+        // vertex, meets them): with the lead as without it.
+        for back in [0.0f32, 0.05, 0.15, 0.3, 0.55, 0.9] {
+            let e = 0.01;
+            let mut ks: Vec<(f32, f32)> = (0..40).map(|i| (0.025 * i as f32, e)).collect();
+            ks.extend((0..12).map(|i| (back + 0.002 * i as f32, e)));
+            let margins: Vec<f32> = ks.iter().map(|k| k.1).collect();
+            let items: Vec<(f32, u32)> = ks.iter().map(|k| (k.0, 0)).collect();
+            let valid = |it: &(f32, u32)| it.0.is_finite() && it.1 == 0;
+            let marks = (
+                |it: &mut (f32, u32)| it.1 += 1,
+                |it: &mut (f32, u32)| it.1 -= 1,
+            );
+            let mut order = KeyOrder::NEW;
+            let pushed = order.push_until_settled::<true>(ks.iter().copied());
+            assert!(
+                order.settled() && pushed == 41,
+                "back {back}: lead {pushed}"
+            );
+            let (mut plain, mut led) = (items.clone(), items);
+            let got = folds_by_hulls::<_, true>(
+                &mut plain,
+                &margins,
+                (w, 0),
+                (valid, |it| it.0),
+                marks,
+                || false,
+            );
+            let got_led = folds_by_hulls::<_, true>(
+                &mut led,
+                &margins,
+                (w, pushed - 1),
+                (valid, |it| it.0),
+                marks,
+                || false,
+            );
+            assert_eq!((got, &led), (got_led, &plain), "back {back}");
+            assert!(plain.iter().any(|it| it.1 > 0), "back {back}: some fold");
+        }
         // A window past every vertex (no run on either side): nothing
         // folds, and no index arithmetic overflows.
         let mut items: Vec<(f32, u32)> = (0..5).map(|i| ((i % 2) as f32, 0)).collect();

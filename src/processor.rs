@@ -266,8 +266,11 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     /// allowance between two questions (what it leaves still carries
     /// over), so the point in progress when the time is up ends within a
     /// bounded cost; so a point may also come out with a looser stick
-    /// (still holding the truth) than [`Self::process`] gives it, or `Ok`
-    /// where that call ran out of budget. The call returns at most about
+    /// (still holding the truth) than [`Self::process`] gives it, or
+    /// another result where that call ran out of budget (`Ok`, or `Folded`
+    /// where the fold test's pass the clock stopped had found the point
+    /// folding before an unkeyed point sent that call to the index, which
+    /// ran out: a review's find). The call returns at most about
     /// 35 000 instructions after the clock's yes (README, "Within a
     /// deadline": allow 40 000, about 60 000 estimated Cortex-M4F cycles
     /// for a cycle counter).

@@ -73,7 +73,10 @@ pub(crate) fn step<const N: usize, D: Deadline>(
         let hulls = if bounded {
             // The points before the one that settled the order are keyed
             // and their widened keys strictly ordered one way (bounded
-            // keys: all are valid, each keyed with a finite margin ≥ 0).
+            // keys: all are valid, each keyed with a finite margin ≥ 0),
+            // where there are two or more of them (a lead of 1 may be an
+            // unkeyed point 0; `by_hulls` takes a lead longer than the
+            // window + 1 only).
             let lead = if order.settled() {
                 pushed.saturating_sub(1)
             } else {

@@ -581,6 +581,13 @@ fn within_matches(f: &[u8], h: &[u8]) -> Result<(u64, u64, bool), String> {
                 flagged += 1;
                 continue;
             }
+            // Where the host's budget ran out, the deadline's cap on a
+            // point's search (or a fold pass the clock stopped) may have
+            // let the firmware finish it: any result (`process_within`'s
+            // docs).
+            if q.status == Status::OverBudget {
+                continue;
+            }
             // [X, Y, Z, z_near, z_far]: the same point, a stick holding
             // the host's.
             if let (Status::Ok, Status::Ok, Some(a), Some(b)) =

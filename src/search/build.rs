@@ -635,7 +635,7 @@ impl<const N: usize> Builder<'_, N> {
     #[inline(always)]
     pub(crate) fn push_all(&mut self, keys: impl Iterator<Item = (f32, f32)>) {
         let mut keys = keys;
-        self.push_run::<false>(|m| {
+        self.push_run(|m| {
             let (raw, e) = keys.next()?;
             *m = e;
             Some(Some(raw))
@@ -741,7 +741,7 @@ impl<const N: usize> Builder<'_, N> {
     #[inline(always)]
     pub(crate) fn push_all_stored(&mut self, keys: impl Iterator<Item = f32>) {
         let mut keys = keys;
-        self.push_run::<false>(|_| keys.next().map(Some));
+        self.push_run(|_| keys.next().map(Some));
     }
 
     /// Push vertices while `next` gives their raw keys, each with its
@@ -754,14 +754,10 @@ impl<const N: usize> Builder<'_, N> {
     /// polyline may come in parts (a caller's deadline asked between them):
     /// a part that follows a finite key goes on in the lean loop, with the
     /// same values one call would give. `next` gives `None` at the end,
-    /// `Some(None)` for a vertex without a key (a raw [`NO_KEY`]).
-    /// `BOUNDED`: every key `next` gives is finite and at most 2 in
-    /// magnitude ([`Self::push_all_bounded`]).
+    /// `Some(None)` for a vertex without a key (a raw [`NO_KEY`]). (Keys
+    /// known bounded take [`Self::push_all_bounded`]'s loop instead.)
     #[inline(always)]
-    fn push_run<const BOUNDED: bool>(
-        &mut self,
-        mut next: impl FnMut(&mut f32) -> Option<Option<f32>>,
-    ) {
+    fn push_run(&mut self, mut next: impl FnMut(&mut f32) -> Option<Option<f32>>) {
         let mut pending = None;
         if self.period <= 0.0 {
             if self.n == 0 {
@@ -797,10 +793,7 @@ impl<const N: usize> Builder<'_, N> {
                     break;
                 };
                 let k = o * raw;
-                // (Bounded keys: `prev` is at most 2 in magnitude too, and
-                // the sum finite.)
-                let leave = !BOUNDED && !(k + prev).is_finite();
-                if leave {
+                if !(k + prev).is_finite() {
                     pending = Some(raw);
                     break;
                 }

@@ -250,7 +250,8 @@ pub fn host_outputs(stream: &[u8], chunk: usize) -> Vec<Vec<u8>> {
             &step,
             &job.kept_quality,
         )
-        .ok()
+        .map(Some)
+        .expect("result buffer sized by result_packet_max")
     })
 }
 
@@ -298,7 +299,8 @@ pub fn host_outputs_fused(stream: &[u8], chunk: usize) -> (Vec<Vec<u8>>, Vec<(u3
             &result,
             &quality,
         )
-        .ok()
+        .map(Some)
+        .expect("result buffer sized by result_packet_max")
     });
     (out, digests)
 }

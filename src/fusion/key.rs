@@ -198,9 +198,13 @@ pub(crate) const SEEN_ANY: u16 = 0;
 /// The same for a partner shown to see none of the ray worth having.
 pub(crate) const SEEN_NONE: u16 = u16::MAX;
 
-/// The state of one point (16 bytes).
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+/// The state of one point (16 bytes). An unmatched cell (no interval:
+/// the majority byte 0) has every count 0 and `rival` `[0, 0]`, but may
+/// hold anything in `near` and `far`: a fresh key frame's first pair
+/// leaves them as the previous key frame had them ([`Cell::unmatch`],
+/// [`first_pair`]). Nothing reads them before [`Cell::add`] writes them,
+/// and `Debug` and the digest show such a cell as [`Cell::EMPTY`].
+#[derive(Clone, Copy)]
 pub(crate) struct Cell {
     near: f32,
     far: f32,
@@ -221,6 +225,18 @@ pub(crate) struct Cell {
     counts: u32,
 }
 
+impl fmt::Debug for Cell {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let c = self.shown();
+        f.debug_struct("Cell")
+            .field("near", &c.near)
+            .field("far", &c.far)
+            .field("rival", &c.rival)
+            .field("counts", &c.counts)
+            .finish()
+    }
+}
+
 /// The pair counts of a [`Cell`], packed.
 const fn pack(major: u8, rival_n: u8, others: u8) -> u32 {
     major as u32 | (rival_n as u32) << 8 | (others as u32) << 16
@@ -233,6 +249,25 @@ impl Cell {
         rival: [0; 2],
         counts: 0,
     };
+
+    /// Make the cell unmatched: no interval, no pairs, `rival` `[0, 0]`;
+    /// its ends are left as they are (unread while it is unmatched).
+    #[inline(always)]
+    fn unmatch(&mut self) {
+        self.rival = [0; 2];
+        self.counts = 0;
+    }
+
+    /// The cell as its state reads: an unmatched cell as [`Cell::EMPTY`]
+    /// (its ends are not its state).
+    #[inline]
+    fn shown(&self) -> &Cell {
+        if self.major() == 0 {
+            &Cell::EMPTY
+        } else {
+            self
+        }
+    }
 
     /// Pairs in the majority.
     #[inline(always)]
@@ -509,7 +544,8 @@ fn sight_exact(p: Pixel, sight: &Sight, scale: &DepthScale) -> u16 {
 /// The first pair of a fresh key frame on one boundary ([`KeyFrame::fuse`]):
 /// every cell written, an `Ok` point's as what [`Cell::add`] makes of an
 /// empty cell (its stick, one agreeing pair: admitted when `min` is 1),
-/// any other as [`Cell::EMPTY`].
+/// any other unmatched ([`Cell::unmatch`]: as [`Cell::EMPTY`] but for its
+/// unread ends).
 fn first_pair(
     cells: &mut [Cell],
     results: &[PointResult],
@@ -519,22 +555,24 @@ fn first_pair(
 ) {
     let mut matched = 0u32;
     let n = cells.len().min(results.len());
+    // (An unmatched cell is 8 bytes written, its ends left: most points
+    // of a pair are flagged.)
     for (c, r) in cells.iter_mut().zip(results) {
-        *c = if r.status == Status::Ok {
+        if r.status == Status::Ok {
             matched += 1;
-            Cell {
+            *c = Cell {
                 near: r.z_near,
                 far: r.z_far,
+                rival: [0; 2],
                 counts: pack(1, 0, 0),
-                ..Cell::EMPTY
-            }
+            };
         } else {
-            Cell::EMPTY
-        };
+            c.unmatch();
+        }
     }
-    // (A boundary without results: its cells empty too.)
+    // (A boundary without results: its cells unmatched too.)
     for c in cells.iter_mut().skip(n) {
-        *c = Cell::EMPTY;
+        c.unmatch();
     }
     out.matched += matched;
     if min == 1 {
@@ -940,7 +978,7 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
             eat(0xCE11_0000 | self.len(k) as u32);
             if let Some(cells) = self.cells.get(k) {
                 for c in cells.iter().take(self.len(k)) {
-                    let c = if self.fresh { &Cell::EMPTY } else { c };
+                    let c = if self.fresh { &Cell::EMPTY } else { c.shown() };
                     for w in c.words() {
                         eat(w);
                     }
@@ -1133,6 +1171,70 @@ mod tests {
         assert_eq!(st, [u, s1, u]);
         assert_eq!(k.admission(0), (1, 0));
         assert!(!format!("{k:?}").contains("7.5"));
+    }
+
+    /// A pair's structure of one boundary: point `i`'s result `Ok` with
+    /// the stick `sticks[i]` where it is `Some`, flagged `Grazing` (its
+    /// ends `junk`) where it is not.
+    fn pair_of(sticks: &[Option<(f32, f32)>], junk: f32) -> Structure<4, 1> {
+        let mut s = Structure::<4, 1>::EMPTY;
+        s.count = 1;
+        let b = &mut s.slots[0].points;
+        b.set_len(sticks.len());
+        for (i, (r, st)) in b.as_mut_slice().iter_mut().zip(sticks).enumerate() {
+            let mut p = PointResult::flagged(Pixel::new(i as f32, 0.0), Status::Grazing);
+            (p.z_near, p.z_far) = (junk, junk + 1.0);
+            if let &Some((near, far)) = st {
+                (p.status, p.z_near, p.z_far) = (Status::Ok, near, far);
+            }
+            *r = p;
+        }
+        s
+    }
+
+    #[test]
+    fn a_first_pair_over_old_cells_shows_and_fuses_none_of_them() {
+        extern crate std;
+        use std::format;
+        // Key frame 1's three points with intervals; then key frame 2,
+        // whose first pair matches only point 1 (the flagged results'
+        // ends junk): its unmatched cells keep key frame 1's ends.
+        let mut k = KeyFrame::<4, 1>::new(sc(), 1);
+        k.start(1, [3]);
+        for i in 0..3 {
+            k.constrain(0, i, (7.0, 7.5 + i as f32), false);
+        }
+        k.start(2, [3]);
+        // The same key frame 2 in cells that never held anything.
+        let mut clean = KeyFrame::<4, 1>::new(sc(), 1);
+        clean.start(2, [3]);
+        let pairs = [
+            pair_of(&[None, Some((3.0, 4.0)), None], 1.0e30),
+            pair_of(&[Some((2.0, 3.0)), Some((3.5, 5.0)), None], -5.0),
+        ];
+        for s in &pairs {
+            let (a, b) = (k.fuse(s), clean.fuse(s));
+            assert_eq!(a, b);
+            let st: [FusedStatus; 3] = core::array::from_fn(|i| k.point(0, i).unwrap().status);
+            let st_clean: [FusedStatus; 3] =
+                core::array::from_fn(|i| clean.point(0, i).unwrap().status);
+            assert_eq!(st, st_clean);
+            let (mut h, mut h_clean) = (0u32, 0u32);
+            k.digest_into(&mut |w| h = h.rotate_left(5) ^ w);
+            clean.digest_into(&mut |w| h_clean = h_clean.rotate_left(5) ^ w);
+            assert_eq!(h, h_clean, "the digest reads an unmatched cell as empty");
+            let shown = format!("{k:?}");
+            assert!(!shown.contains("7.5") && !shown.contains("8.5"), "{shown}");
+            assert_eq!(shown, format!("{clean:?}"));
+        }
+        // Point 0's interval is its one stick (not cut by the old ends),
+        // point 1's the intersection, point 2 unmatched.
+        let iv = |i| k.point(0, i).unwrap().interval.map(|v| (v.z_near, v.z_far));
+        assert_eq!(iv(0), Some((2.0, 3.0)));
+        assert_eq!(iv(1), Some((3.5, 4.0)));
+        assert_eq!(iv(2), None);
+        assert_eq!(k.point(0, 1).unwrap().status, FusedStatus::Consistent);
+        assert_eq!(k.admission(0), clean.admission(0));
     }
 
     #[test]

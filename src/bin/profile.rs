@@ -5,7 +5,9 @@
 //!
 //! Window `k` (from 0) is the code between the entries into `marker(2k + 1)`
 //! and `marker(2k + 2)`; after it the firmware logs
-//! `profile window=k name=… points=… digest=…`, outside the window.
+//! `profile window=k name=… points=… digest=…`, outside the window. With
+//! feature `profile-fusion` (`cargo xtask profile --fusion`) one window
+//! more: a whole step of the demo drive's fusion ([`fusion`]).
 
 #![no_std]
 #![no_main]
@@ -78,6 +80,12 @@ fn main() -> ! {
         ok &= window(processor, k, name, data);
     }
     ok &= wire_window(WINDOWS.len());
+    // (Only with `profile-fusion`: a second monomorphisation moves the
+    // other windows' code, `cargo xtask profile --help`.)
+    #[cfg(feature = "profile-fusion")]
+    {
+        ok &= fusion::window(WINDOWS.len() + 1);
+    }
     fw::exit(ok)
 }
 
@@ -142,4 +150,72 @@ fn wire_window(k: usize) -> bool {
         ok
     );
     ok
+}
+
+/// The window over a step of the demo's fusion (feature `profile-fusion`,
+/// `cargo xtask profile --fusion`).
+#[cfg(feature = "profile-fusion")]
+mod fusion {
+    use super::{black_box, fw, marker, ConstStaticCell};
+    use roadstereo::fusion::{ChainedMotion, Fusion, FusionConfig};
+    use roadstereo::{Config, Frame};
+
+    /// The demo drive (the bench's fusion demo) and its policy.
+    static DRIVE: &[u8] = include_bytes!("data/drive.bin");
+    const POLICY: FusionConfig = match FusionConfig::DEFAULT.with_tilt(23f32.to_radians()) {
+        Ok(p) => p,
+        Err(_) => panic!("the demo's tilt is within 90 degrees"),
+    };
+    /// The step of the demo's fusion traced: frame 13, the bench's costliest
+    /// step with the fusion (the first partner of key frame 12).
+    const FUSION_FRAME: u32 = 13;
+    static FUSION: ConstStaticCell<Fusion<256, 2, 512>> =
+        ConstStaticCell::new(Fusion::new(Config::DEFAULT, POLICY));
+
+    /// The bench's fusion over the demo drive (`Fusion<256, 2, 512>`), frames
+    /// before [`FUSION_FRAME`] outside the window, that frame's whole step
+    /// (the matching, the fusion and the map) inside it; the digest is the
+    /// fusion's.
+    pub fn window(k: usize) -> bool {
+        let fusion: &'static mut Fusion<256, 2, 512> = FUSION.take();
+        let Ok(mut drive) = fw::Drive::new(DRIVE) else {
+            return false;
+        };
+        let mut frame = Frame::<256, 2>::new(drive.camera);
+        let mut ok = true;
+        for i in 0..=FUSION_FRAME.min(drive.frames.saturating_sub(1)) {
+            let Ok(motion) = drive.next_frame(&mut frame) else {
+                return false;
+            };
+            let chained = motion.map(|m| ChainedMotion {
+                from: i.wrapping_sub(1),
+                motion: m,
+            });
+            if i == FUSION_FRAME {
+                let tag = 2 * k as u32 + 1;
+                marker(tag);
+                ok = fusion
+                    .step(black_box(i), black_box(&frame), chained.as_ref())
+                    .is_ok();
+                marker(tag + 1);
+            } else if fusion.step(i, &frame, chained.as_ref()).is_err() {
+                return false;
+            }
+        }
+        let points: usize = fusion
+            .structure()
+            .boundaries()
+            .iter()
+            .map(|b| b.points().len())
+            .sum();
+        defmt::info!(
+            "profile window={=usize} name={=str} points={=usize} digest={=u32:08x} ok={=bool}",
+            k,
+            "fusion_13",
+            points,
+            fusion.digest(),
+            ok
+        );
+        ok
+    }
 }

@@ -3,7 +3,7 @@
 
 use crate::bench::{bench, bench_args};
 use crate::demo::demo_on_both_boards;
-use crate::profile::{profile, CYCLES_PER_POINT};
+use crate::profile::{profile, ProfileArgs};
 use crate::setup::setup_toolchain;
 use crate::stream::stream;
 use crate::util::{root, run, THUMB};
@@ -71,6 +71,8 @@ const CARGO_CHECKS: &[(&str, &[&str])] = &[
     // ... the link firmware's fused and deadline modes (`cargo xtask stream
     // --fused --within` builds the same),
     ("", &["clippy", "--release", "--target", THUMB, "--features", "firmware link-deadline link-fused", "--bin", "link", "--", "-D", "warnings"]),
+    // ... the profile firmware's fusion window (`cargo xtask profile --fusion`),
+    ("", &["clippy", "--release", "--target", THUMB, "--features", "profile-fusion", "--bin", "profile", "--", "-D", "warnings"]),
     // ... and for the second board (its own target dir, as `Board` builds it).
     ("", &["clippy", "--release", "--target", THUMB, "--features", "board-f405", "--bins", "--target-dir", "target/f405", "--", "-D", "warnings"]),
 ];
@@ -135,6 +137,6 @@ pub fn ci() -> Result<(), String> {
     // The profiler too, so it cannot rot (about ten seconds), with its
     // cycles budget; it runs even when a bench budget is missed, so both
     // verdicts are printed.
-    let profile = profile(CYCLES_PER_POINT);
+    let profile = profile(ProfileArgs::DEFAULT);
     bench.and(profile)
 }

@@ -28,7 +28,7 @@ use std::process::Command;
 
 use crate::cycles::{Class, Model, Tally, SUMMARY};
 use crate::disasm::{disassemble, Disassembly};
-use crate::firmware::{build_firmware, field, num, records};
+use crate::firmware::{build_firmware, build_firmware_with, field, num, records, Board};
 use crate::setup::setup_emulator;
 use crate::util::root;
 
@@ -79,20 +79,40 @@ pub const CYCLES_CEILING: f64 = 953.3;
 /// The window the budget applies to (`src/bin/profile.rs`).
 pub const REPRESENTATIVE: &str = "representative";
 
-pub const PROFILE_USAGE: &str = "usage: cargo xtask profile [--cycles-per-point 718]
+pub const PROFILE_USAGE: &str = "usage: cargo xtask profile [--cycles-per-point 718] [--fusion]
   traces every window of the profile firmware (src/bin/profile.rs) and reports instructions and
   estimated Cortex-M4F cycles (xtask/src/cycles.rs) per function, per source line and per window;
   budget, owned by open issue 11 (printed as not met, not enforced until the issue lands): the
   `representative` window (the bench's N = 256 pair) at most cycles-per-point (718) estimated
   cycles per point; hard (exit code 1): that window's estimate at most 953.3 cycles per point,
-  the figure issue 11 says must not rise";
+  the figure issue 11 says must not rise.
+  --fusion: the firmware with feature profile-fusion, one window more, `fusion_13`: the bench's
+  demo fusion step of frame 13 whole (the matching, the fusion and the map). A second
+  monomorphisation lays the other windows' code out anew (the representative's estimate moves by
+  a few cycles a point), so the budgets are not checked in that build: a tool, not a figure.";
+
+/// What `cargo xtask profile` was asked for.
+pub struct ProfileArgs {
+    budget: f64,
+    fusion: bool,
+}
+
+impl ProfileArgs {
+    /// The default run: the budget of issue 11, without the fusion window.
+    pub const DEFAULT: Self = Self {
+        budget: CYCLES_PER_POINT,
+        fusion: false,
+    };
+}
 
 /// The budget from the command line.
-pub fn profile_args(args: &[String]) -> Result<f64, String> {
+pub fn profile_args(args: &[String]) -> Result<ProfileArgs, String> {
     let mut budget = CYCLES_PER_POINT;
+    let mut fusion = false;
     let mut it = args.iter();
     while let Some(a) = it.next() {
         match a.as_str() {
+            "--fusion" => fusion = true,
             "--cycles-per-point" => {
                 budget = it
                     .next()
@@ -102,16 +122,21 @@ pub fn profile_args(args: &[String]) -> Result<f64, String> {
             _ => return Err(PROFILE_USAGE.into()),
         }
     }
-    Ok(budget)
+    Ok(ProfileArgs { budget, fusion })
 }
 
 /// `cargo xtask profile`: trace the firmware, map its disassembly, count
 /// each window, print each window's summary and tables, the table of all
 /// windows and the cycle model, write the annotated disassembly, and check
 /// the representative window's cycles per point against `budget`.
-pub fn profile(budget: f64) -> Result<(), String> {
+pub fn profile(args: ProfileArgs) -> Result<(), String> {
+    let ProfileArgs { budget, fusion } = args;
     setup_emulator()?;
-    let elf = build_firmware("profile")?;
+    let elf = if fusion {
+        build_firmware_with("profile", Board::Mps2, "profile-fusion")?
+    } else {
+        build_firmware("profile")?
+    };
     let dir = root().join("target").join("profile");
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let (log, trace_path) = trace(&elf, &dir)?;
@@ -130,6 +155,10 @@ pub fn profile(budget: f64) -> Result<(), String> {
     window_table(&windows);
     println!("\n{SUMMARY}");
     annotate(&dis, &windows, &funcs, &dir.join("annotated.txt"))?;
+    if fusion {
+        println!("\nxtask: built with profile-fusion (--fusion): the budgets are not checked in this build");
+        return Ok(());
+    }
     cycles_budget(&windows, budget)
 }
 

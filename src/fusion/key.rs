@@ -201,9 +201,13 @@ pub(crate) const SEEN_NONE: u16 = u16::MAX;
 /// The state of one point (16 bytes). An unmatched cell (no interval:
 /// the majority byte 0) has every count 0 and `rival` `[0, 0]`, but may
 /// hold anything in `near` and `far`: a fresh key frame's first pair
-/// leaves them as the previous key frame had them ([`Cell::unmatch`],
-/// [`first_pair`]). Nothing reads them before [`Cell::add`] writes them,
-/// and `Debug` and the digest show such a cell as [`Cell::EMPTY`].
+/// without the sight check leaves them as an earlier key frame (or one
+/// before a reset) had them ([`Cell::unmatch`], [`first_pair`]). So
+/// every reader of the ends asks for an interval first ([`Cell::add`]
+/// writes them when there is none; [`Cell::interval`], [`Cell::hull_near`]
+/// and the map's [`Cell::admitted`] test come before [`Cell::ends`]), and
+/// `Debug` and the digest show such a cell as [`Cell::EMPTY`]
+/// ([`Cell::shown`]; [`Cell::words`] gives the raw bits).
 #[derive(Clone, Copy)]
 pub(crate) struct Cell {
     near: f32,
@@ -438,7 +442,9 @@ impl Cell {
         (u32::from(min_pairs.max(1))..=0xFF).contains(&self.counts)
     }
 
-    /// The fused interval's ends (meaningful when there is one).
+    /// The fused interval's ends: meaningful only when there is one (an
+    /// unmatched cell's are whatever an earlier key frame left, [`Cell`];
+    /// callers ask first).
     #[inline]
     pub(crate) fn ends(&self) -> (f32, f32) {
         (self.near, self.far)
@@ -461,7 +467,8 @@ impl Cell {
         }
     }
 
-    /// The bits, for digests.
+    /// The bits, for digests (raw: an unmatched cell's ends too, so the
+    /// digest takes [`Cell::shown`]'s).
     pub(crate) fn words(&self) -> [u32; 4] {
         [
             self.near.to_bits(),
@@ -725,8 +732,9 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
     /// Fuse one pair's reconstruction (the key frame against a later
     /// frame): every `Ok` point's stick into its cell. The first pair of a
     /// fresh key frame writes every cell instead: an `Ok` point's stick as
-    /// its one agreeing pair, any other point empty (what fusing it into
-    /// cleared cells gives, without clearing them first).
+    /// its one agreeing pair, any other point unmatched, its ends left
+    /// ([`first_pair`]): what fusing it into cleared cells gives, without
+    /// clearing them first.
     ///
     /// Work: one pass over the structure's points (at most `B·N`), `O(1)`
     /// each.

@@ -25,7 +25,7 @@ use core::hint::black_box;
 
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
-use roadstereo::fusion::{ChainedMotion, Fusion, FusionConfig};
+use roadstereo::fusion::{Fusion, FusionConfig};
 use roadstereo::{Config, Frame, Motion, Processor, Status, Structure};
 use static_cell::ConstStaticCell;
 
@@ -155,10 +155,7 @@ const CAP: usize = 512;
 static DRIVE: &[u8] = include_bytes!("data/drive.bin");
 
 /// The fusion policy of the demo drive (its camera is tilted 23° down).
-const POLICY: FusionConfig = match FusionConfig::DEFAULT.with_tilt(23f32.to_radians()) {
-    Ok(p) => p,
-    Err(_) => panic!("the demo's tilt is within 90 degrees"),
-};
+const POLICY: FusionConfig = fw::DEMO_POLICY;
 
 /// The processor of the bench pairs and the fusion of the demo drive, in
 /// statics (their constructors are `const`), as a firmware keeps them.
@@ -183,10 +180,7 @@ fn fusion_bench() -> bool {
         let Ok(motion) = drive.next_frame(&mut frame) else {
             return false;
         };
-        let chained = motion.map(|m| ChainedMotion {
-            from: i.wrapping_sub(1),
-            motion: m,
-        });
+        let chained = fw::chained(i, motion);
         let mut copy = fusion.processor().clone();
         // The stack of one step, on a copy (a retiring frame and the next).
         if i == 8 || i == 9 {
@@ -223,12 +217,7 @@ fn fusion_bench() -> bool {
         } else {
             composed
         };
-        let points: usize = fusion
-            .structure()
-            .boundaries()
-            .iter()
-            .map(|b| b.points().len())
-            .sum();
+        let points = fw::point_count(fusion.structure());
         let same =
             step.paired.is_none() || copy.structure().digest() == fusion.structure().digest();
         let own = step_instr.saturating_sub(matching);
@@ -275,10 +264,7 @@ fn fusion_sighted(fusion: &mut Fusion<256, 2, 512>) -> bool {
         let Ok(motion) = drive.next_frame(&mut frame) else {
             return false;
         };
-        let chained = motion.map(|m| ChainedMotion {
-            from: i.wrapping_sub(1),
-            motion: m,
-        });
+        let chained = fw::chained(i, motion);
         // The stack of one step with the check on, on a copy (as
         // `fusion_bench`'s: a retiring frame and the next).
         if i == 8 || i == 9 {
@@ -320,10 +306,7 @@ fn fusion_counted(fusion: &mut Fusion<256, 2, 512>) -> bool {
         let Ok(motion) = drive.next_frame(&mut frame) else {
             return false;
         };
-        let chained = motion.map(|m| ChainedMotion {
-            from: i.wrapping_sub(1),
-            motion: m,
-        });
+        let chained = fw::chained(i, motion);
         let (result, instr) = fw::measure(|| fusion.step(black_box(i), &frame, chained.as_ref()));
         let Ok(step) = result else {
             return false;
@@ -363,10 +346,7 @@ fn fusion_within(fusion: &mut Fusion<256, 2, 512>) -> bool {
         let Ok(motion) = drive.next_frame(&mut frame) else {
             return false;
         };
-        let chained = motion.map(|m| ChainedMotion {
-            from: i.wrapping_sub(1),
-            motion: m,
-        });
+        let chained = fw::chained(i, motion);
         let t0 = fw::ticks();
         let mut clock = || fw::ticks().saturating_sub(t0) >= budget;
         let (result, instr) =
@@ -485,12 +465,7 @@ impl Measured {
     /// The call's outcome and instructions with the processor's output
     /// counted.
     fn of(processor: &Processor<CAP, 2>, (processed, instr): (bool, u32)) -> Self {
-        let points: usize = processor
-            .structure()
-            .boundaries()
-            .iter()
-            .map(|b| b.points().len())
-            .sum();
+        let points = fw::point_count(processor.structure());
         let ok = processor.structure().status_counts().get(Status::Ok);
         Measured {
             processed,

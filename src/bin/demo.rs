@@ -19,7 +19,7 @@ mod fw;
 
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
-use roadstereo::fusion::{ChainedMotion, FusedStatus, Fusion, FusionConfig, FusionStep, KeyFrame};
+use roadstereo::fusion::{FusedStatus, Fusion, FusionConfig, FusionStep, KeyFrame};
 use roadstereo::{Config, Frame, Status};
 use static_cell::ConstStaticCell;
 
@@ -31,11 +31,8 @@ static DRIVE: &[u8] = include_bytes!("data/drive.bin");
 const BUDGET_INSTRUCTIONS: u32 = 33 * 168_000 / 20;
 
 /// The fusion policy: the drive's camera is tilted 23° down (the map's
-/// vehicle frame). Checked at build time.
-const POLICY: FusionConfig = match FusionConfig::DEFAULT.with_tilt(23f32.to_radians()) {
-    Ok(p) => p,
-    Err(_) => panic!("the demo's tilt is within 90 degrees"),
-};
+/// vehicle frame).
+const POLICY: FusionConfig = fw::DEMO_POLICY;
 
 /// The fusion (its processor, key frame and map) in a static,
 /// laid out at build time: its constructor is `const`.
@@ -73,10 +70,7 @@ fn main() -> ! {
                 fw::exit(false)
             }
         };
-        let chained = motion.map(|m| ChainedMotion {
-            from: i.wrapping_sub(1),
-            motion: m,
-        });
+        let chained = fw::chained(i, motion);
         let (result, instr) = fw::measure(|| fusion.step(i, &frame, chained.as_ref()));
         let Ok(step) = result else {
             defmt::error!("frame {=u32}: rejected", i);

@@ -157,20 +157,16 @@ fn wire_window(k: usize) -> bool {
 #[cfg(feature = "profile-fusion")]
 mod fusion {
     use super::{black_box, fw, marker, ConstStaticCell};
-    use roadstereo::fusion::{ChainedMotion, Fusion, FusionConfig};
+    use roadstereo::fusion::Fusion;
     use roadstereo::{Config, Frame};
 
-    /// The demo drive (the bench's fusion demo) and its policy.
+    /// The demo drive (the bench's fusion demo).
     static DRIVE: &[u8] = include_bytes!("data/drive.bin");
-    const POLICY: FusionConfig = match FusionConfig::DEFAULT.with_tilt(23f32.to_radians()) {
-        Ok(p) => p,
-        Err(_) => panic!("the demo's tilt is within 90 degrees"),
-    };
     /// The step of the demo's fusion traced: frame 13, the bench's costliest
     /// step with the fusion (the first partner of key frame 12).
     const FUSION_FRAME: u32 = 13;
     static FUSION: ConstStaticCell<Fusion<256, 2, 512>> =
-        ConstStaticCell::new(Fusion::new(Config::DEFAULT, POLICY));
+        ConstStaticCell::new(Fusion::new(Config::DEFAULT, fw::DEMO_POLICY));
 
     /// The bench's fusion over the demo drive (`Fusion<256, 2, 512>`), frames
     /// before [`FUSION_FRAME`] outside the window, that frame's whole step
@@ -187,10 +183,7 @@ mod fusion {
             let Ok(motion) = drive.next_frame(&mut frame) else {
                 return false;
             };
-            let chained = motion.map(|m| ChainedMotion {
-                from: i.wrapping_sub(1),
-                motion: m,
-            });
+            let chained = fw::chained(i, motion);
             if i == FUSION_FRAME {
                 let tag = 2 * k as u32 + 1;
                 marker(tag);
@@ -202,12 +195,7 @@ mod fusion {
                 return false;
             }
         }
-        let points: usize = fusion
-            .structure()
-            .boundaries()
-            .iter()
-            .map(|b| b.points().len())
-            .sum();
+        let points = fw::point_count(fusion.structure());
         defmt::info!(
             "profile window={=usize} name={=str} points={=usize} digest={=u32:08x} ok={=bool}",
             k,

@@ -16,7 +16,8 @@ use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m::peripheral::{syst::SystClkSource, SYST};
 use cortex_m_rt::{exception, ExceptionFrame};
 use cortex_m_semihosting::debug;
-use roadstereo::{Camera, Frame, Motion, Pixel};
+use roadstereo::fusion::{ChainedMotion, FusionConfig};
+use roadstereo::{Camera, Frame, Motion, Pixel, Structure};
 
 /// Exit QEMU with success or failure (the process exit code is the verdict).
 pub fn exit(ok: bool) -> ! {
@@ -221,4 +222,26 @@ unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
 fn panic(_: &core::panic::PanicInfo) -> ! {
     defmt::error!("panic");
     exit(false)
+}
+
+/// The demo drive's fusion policy (the demo, the bench and the profile's
+/// fusion window): the drive's camera is tilted 23° down (the map's
+/// vehicle frame). Checked at build time.
+pub const DEMO_POLICY: FusionConfig = match FusionConfig::DEFAULT.with_tilt(23f32.to_radians()) {
+    Ok(p) => p,
+    Err(_) => panic!("the demo's tilt is within 90 degrees"),
+};
+
+/// Frame `i`'s motion from the drive data as the fusion takes it: from
+/// frame `i − 1`.
+pub fn chained(i: u32, motion: Option<Motion>) -> Option<ChainedMotion> {
+    motion.map(|m| ChainedMotion {
+        from: i.wrapping_sub(1),
+        motion: m,
+    })
+}
+
+/// The points of a structure, over its boundaries.
+pub fn point_count<const N: usize, const B: usize>(s: &Structure<N, B>) -> usize {
+    s.boundaries().iter().map(|b| b.points().len()).sum()
 }

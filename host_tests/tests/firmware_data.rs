@@ -167,7 +167,7 @@ fn adversarial_base_is_the_representative_pair() {
 /// the bench's `FOUND`, stored as found): each decodes as the firmware
 /// reads it, two frames of two boundaries of the N the bench runs it at,
 /// every boundary accepted by `Frame::push_boundary` (with the file's
-/// camera; the frame 1 of `rev_e4`, `rev_f1`, `rev_g1` and `rev_h1` has
+/// camera; the frame 1 of `rev_e4`, `rev_f1`, `rev_g1`, `rev_h1` and `rev_x3` has
 /// its own too, `CAMERA1`, which the bench checks as it loads it), the motion by `Motion::new`; and the bench's
 /// table names every file.
 #[test]
@@ -186,6 +186,7 @@ fn found_pairs_pass_validation() {
         ("rev_f1", 64),
         ("rev_g1", 512),
         ("rev_h1", 512),
+        ("rev_x3", 64),
     ];
     for (name, n) in found {
         assert!(

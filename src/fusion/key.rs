@@ -1152,15 +1152,22 @@ mod tests {
         assert_eq!(p.status, FusedStatus::Inconsistent);
     }
 
-    #[test]
-    fn a_fresh_key_frame_shows_none_of_the_previous_ones_cells() {
-        extern crate std;
-        use std::format;
+    /// Key frame 1 of one boundary with three points, each given an
+    /// interval `[7, 7.5 + i]` by a range constraint.
+    fn three_constrained() -> KeyFrame<4, 1> {
         let mut k = KeyFrame::<4, 1>::new(sc(), 1);
         k.start(1, [3]);
         for i in 0..3 {
             k.constrain(0, i, (7.0, 7.5 + i as f32), false);
         }
+        k
+    }
+
+    #[test]
+    fn a_fresh_key_frame_shows_none_of_the_previous_ones_cells() {
+        extern crate std;
+        use std::format;
+        let mut k = three_constrained();
         assert_eq!(k.point(0, 2).unwrap().status, FusedStatus::Single);
         // The next key frame: its cells are not cleared, but nothing sees
         // the old ones, neither the readers nor `Debug`.
@@ -1207,11 +1214,7 @@ mod tests {
         // Key frame 1's three points with intervals; then key frame 2,
         // whose first pair matches only point 1 (the flagged results'
         // ends junk): its unmatched cells keep key frame 1's ends.
-        let mut k = KeyFrame::<4, 1>::new(sc(), 1);
-        k.start(1, [3]);
-        for i in 0..3 {
-            k.constrain(0, i, (7.0, 7.5 + i as f32), false);
-        }
+        let mut k = three_constrained();
         k.start(2, [3]);
         // The same key frame 2 in cells that never held anything.
         let mut clean = KeyFrame::<4, 1>::new(sc(), 1);

@@ -205,11 +205,18 @@ impl Radial {
     /// band for certain.
     #[inline(always)]
     fn rejects(&self, a: [f32; 2], b: [f32; 2], (lo, hi): (f32, f32)) -> bool {
-        let d = match self.by_row(a[1], b[1], (lo, hi)) {
-            Row::Rejects => return true,
-            Row::Keeps => return false,
-            Row::Undecided(d) => d,
-        };
+        match self.by_row(a[1], b[1], (lo, hi)) {
+            Row::Rejects => true,
+            Row::Keeps => false,
+            Row::Undecided(d) => self.rejects_exact(a, b, d),
+        }
+    }
+
+    /// The second part of [`Self::rejects`], where [`Self::by_row`] said
+    /// [`Row::Undecided`] with the key distance `d`: the exact distance
+    /// from the FOE to the segment `a → b` decides.
+    #[inline(always)]
+    fn rejects_exact(&self, a: [f32; 2], b: [f32; 2], d: f32) -> bool {
         // The squared distance from the FOE to the segment.
         let ua = [a[0] - self.foe[0], a[1] - self.foe[1]];
         let ab = [b[0] - a[0], b[1] - a[1]];
@@ -398,6 +405,29 @@ impl<'a> Visitor<'a> for Walker<'a> {
                 return (Flow::Continue, RADIAL_UNITS);
             }
         }
+        self.take(j)
+    }
+
+    /// (The general visit made [`Radial::by_row`] with this walker's test
+    /// and segment `j`'s end rows: only its undecided segments are left to
+    /// the exact distance, as in [`Radial::rejects`].)
+    #[inline(always)]
+    fn segment_after_row(&mut self, j: usize, _: (f32, f32), row: Row) -> (Flow, u32) {
+        if let (Some(rad), Some(a), Some(b), Row::Undecided(d)) =
+            (self.radial, self.boundary.get(j), self.boundary.get(j + 1), row)
+        {
+            if rad.rejects_exact(a.arr(), b.arr(), d) {
+                return (Flow::Continue, RADIAL_UNITS);
+            }
+        }
+        self.take(j)
+    }
+}
+
+impl Walker<'_> {
+    /// Segment `j` taken by the walk (past the radial test): its clip.
+    #[inline(always)]
+    fn take(&mut self, j: usize) -> (Flow, u32) {
         let (Some(c0), Some(c1)) = (self.vertex(j), self.vertex(j + 1)) else {
             return (Flow::Continue, 0);
         };

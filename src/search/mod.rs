@@ -254,6 +254,22 @@ pub(crate) trait Visitor<'b> {
     fn radial(&self) -> Option<(crate::matching::Radial, &'b [crate::camera::Pixel])> {
         None
     }
+
+    /// [`Self::segment`] for a segment whose [`crate::matching::Radial::by_row`]
+    /// the general visit has made with this visitor's [`Self::radial`]
+    /// test and the segment's two end rows, and which it did not reject:
+    /// `row` is what the test said ([`crate::matching::Row::Keeps`] or
+    /// [`crate::matching::Row::Undecided`]), so that the visitor need not
+    /// make it again. The same outcome and units as [`Self::segment`].
+    #[inline(always)]
+    fn segment_after_row(
+        &mut self,
+        j: usize,
+        interval: (f32, f32),
+        _row: crate::matching::Row,
+    ) -> (Flow, u32) {
+        self.segment(j, interval)
+    }
 }
 
 /// How segments with an unkeyable end count.

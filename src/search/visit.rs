@@ -531,17 +531,25 @@ impl<const N: usize> Index<N> {
                         // the run's own here: `fmin(∞, l) = l`, `fmax(−∞,
                         // h) = h` for every `l`, `h`, NaN included.)
                         if hits(g.lo, g.hi) && !skipped(j) {
+                            let mut row = None;
                             if let Some((rad, b2)) = quick {
                                 if let (Some(a), Some(b)) = (b2.get(j), b2.get(j + 1)) {
                                     let (va, vb) = (a.v, b.v);
-                                    if rad.by_row(va, vb, (g.lo, g.hi)) == Row::Rejects {
+                                    let r = rad.by_row(va, vb, (g.lo, g.hi));
+                                    if r == Row::Rejects {
                                         work.spend(RADIAL_UNITS)?;
                                         j += 1;
                                         continue;
                                     }
+                                    row = Some(r);
                                 }
                             }
-                            let (flow, units) = visit.segment(j, (g.lo, g.hi));
+                            // (The visitor told what `by_row` said, which it
+                            // would make again.)
+                            let (flow, units) = match row {
+                                Some(r) => visit.segment_after_row(j, (g.lo, g.hi), r),
+                                None => visit.segment(j, (g.lo, g.hi)),
+                            };
                             work.spend(units)?;
                             if flow == Flow::Stop {
                                 return Ok(());

@@ -172,6 +172,16 @@ pub(crate) struct Radial {
 }
 
 impl Radial {
+    /// A test that is never made (a place holder where there is none).
+    pub(crate) const NONE: Radial = Radial {
+        foe: [0.0; 2],
+        side: 0.0,
+        own: (0.0, 0.0),
+        c0sq: 0.0,
+        h: 0.0,
+        m2: 0.0,
+    };
+
     /// The test for `band` (`None` unless it narrows towards the FOE),
     /// with the FOE, the point's own key interval and the FOE-near radius.
     pub(crate) fn new(

@@ -460,13 +460,22 @@ impl<const N: usize> Index<N> {
         let run = (j, top, everything);
         // One copy (every non-periodic query, most periodic ones): its test
         // without the loop over the copies (the same test).
-        if let ([(cl, ch)], false) = (copies, everything) {
+        // (The merge counts the credit in a copy, which lives in a
+        // register: not stored back at every unit.)
+        let mut w = *work;
+        // (Without `skip`: only the fold test's queries have one, and
+        // those come here with several copies; the loop over one copy is
+        // the same test.)
+        let r = if let ([(cl, ch)], false, None) = (copies, everything, skip) {
             let (cl, ch) = (*cl, *ch);
             let meets = |l: f32, h: f32| l <= ch && h >= cl;
-            return self.merge(run, meets, with_near, (skip, rad), work, visit);
-        }
-        let meets = |l: f32, h: f32| copies.iter().any(|&(cl, ch)| l <= ch && h >= cl);
-        self.merge(run, meets, with_near, (skip, rad), work, visit)
+            self.merge(run, meets, with_near, (None, rad), &mut w, visit)
+        } else {
+            let meets = |l: f32, h: f32| copies.iter().any(|&(cl, ch)| l <= ch && h >= cl);
+            self.merge(run, meets, with_near, (skip, rad), &mut w, visit)
+        };
+        *work = w;
+        r
     }
 
     /// The merge of [`Self::visit_general`], from run start `j` to where the
@@ -497,6 +506,12 @@ impl<const N: usize> Index<N> {
         // The visitor's cheap rejection, if it has one (the band walk's
         // `Radial`): made here for the run's segments, the same units.
         let quick = visit.radial();
+        // (Its polyline empty without one: no segment has both ends there.)
+        let (qrad, qb) = match quick {
+            Some((r, b)) => (r, b),
+            None => (Radial::NONE, &[][..]),
+        };
+        let segs = self.seg.get(..s.min(N)).unwrap_or(&[]);
         loop {
             let next_aside = self
                 .aside
@@ -512,7 +527,7 @@ impl<const N: usize> Index<N> {
             let g = loop {
                 // The run's next segment, while its suffix minimum is not
                 // past the query.
-                let g = self.seg.get(j).copied().filter(|g| j < s && g.sm <= top);
+                let g = segs.get(j).copied().filter(|g| g.sm <= top);
                 // A loose index: skip the blocks of the run no copy meets
                 // (the aside and near entries in them keep their own
                 // streams, which the merge still takes in index order).
@@ -532,17 +547,14 @@ impl<const N: usize> Index<N> {
                         // h) = h` for every `l`, `h`, NaN included.)
                         if hits(g.lo, g.hi) && !skipped(j) {
                             let mut row = None;
-                            if let Some((rad, b2)) = quick {
-                                if let (Some(a), Some(b)) = (b2.get(j), b2.get(j + 1)) {
-                                    let (va, vb) = (a.v, b.v);
-                                    let r = rad.by_row(va, vb, (g.lo, g.hi));
-                                    if r == Row::Rejects {
-                                        work.spend(RADIAL_UNITS)?;
-                                        j += 1;
-                                        continue;
-                                    }
-                                    row = Some(r);
+                            if let Some([a, b]) = qb.get(j..j + 2) {
+                                let r = qrad.by_row(a.v, b.v, (g.lo, g.hi));
+                                if r == Row::Rejects {
+                                    work.spend(RADIAL_UNITS)?;
+                                    j += 1;
+                                    continue;
                                 }
+                                row = Some(r);
                             }
                             // (The visitor told what `by_row` said, which it
                             // would make again.)

@@ -501,8 +501,12 @@ impl<const N: usize> Index<N> {
         let near: &[u16] = if with_near { &self.near } else { &[] };
         let (mut ia, mut inear) = (0usize, 0usize);
         // A loose index's skips (the same test at every step), and the
-        // radial test's (whatever the query: it rejects on its own).
-        let skips = (self.levels > 0 && !everything) || rad.is_some();
+        // radial test's (whatever the query: it rejects on its own). (Tried
+        // at every aligned step of a query: without levels and without a
+        // radial test a skip passes over nothing, so only `everything`,
+        // whose test of a loose index's empty blocks would skip them, is
+        // left out; the one-copy merge has no test here then.)
+        let skips = !everything || rad.is_some();
         // The visitor's cheap rejection, if it has one (the band walk's
         // `Radial`): made here for the run's segments, the same units.
         let quick = visit.radial();

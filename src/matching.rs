@@ -311,8 +311,29 @@ impl Radial {
     /// infinite `NO_KEY`. (An independent review found no counterexample
     /// with finite or infinite ends: 3 M random tests with coordinates up to
     /// 10³⁰, `c₀` from 10⁻³⁰ to 10³⁰, key distances about `|h|` and 1.)
+    /// (The radial levels' walk makes it through [`Self::rejects_block_with`].)
+    #[cfg_attr(not(test), allow(dead_code))]
     #[inline(always)]
-    pub(crate) fn rejects_block(&self, hull: (f32, f32), (v_min, v_max): (f32, f32)) -> bool {
+    pub(crate) fn rejects_block(&self, hull: (f32, f32), rows: (f32, f32)) -> bool {
+        self.rejects_block_with(hull, rows, self.block_c0sq())
+    }
+
+    /// The `c₀²` that [`Self::rejects_block`] compares with (`10⁻⁵`
+    /// larger), for [`Self::rejects_block_with`].
+    #[inline(always)]
+    pub(crate) fn block_c0sq(&self) -> f32 {
+        self.c0sq * 1.000_01
+    }
+
+    /// [`Self::rejects_block`] with its `c₀²` ([`Self::block_c0sq`]) made
+    /// once for the blocks of several levels.
+    #[inline(always)]
+    pub(crate) fn rejects_block_with(
+        &self,
+        hull: (f32, f32),
+        (v_min, v_max): (f32, f32),
+        c0sq: f32,
+    ) -> bool {
         let Some(d) = self.key_distance(hull) else {
             return false;
         };
@@ -324,7 +345,7 @@ impl Radial {
             return false;
         }
         let t2 = t * t;
-        t2 >= self.m2 && d * d * t2 > self.c0sq * 1.000_01
+        t2 >= self.m2 && d * d * t2 > c0sq
     }
 }
 

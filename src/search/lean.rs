@@ -333,6 +333,17 @@ impl<const N: usize> Index<N> {
         copies_in((self.period, (self.kmin, self.kmax)), ql, qh, out)
     }
 
+    /// [`Self::run_start`] out of line (the general visit: its probes
+    /// inlined there cost their set-up at every query).
+    #[inline(never)]
+    pub(super) fn run_start_out_of_line(
+        &self,
+        t: f32,
+        work: &mut Work,
+    ) -> Result<usize, OutOfWork> {
+        self.run_start(t, work)
+    }
+
     /// The first segment `a` with `pm[a] ≥ t` ([`run_start_in`] from the
     /// hint).
     #[inline(always)]

@@ -450,7 +450,7 @@ impl<const N: usize> Index<N> {
             top = f32::INFINITY;
         } else {
             for &(cl, ch) in copies {
-                j = j.min(self.run_start(cl, work)?);
+                j = j.min(self.run_start_out_of_line(cl, work)?);
                 top = fmax(top, ch);
             }
             if j < s {

@@ -214,7 +214,7 @@ impl Radial {
     /// Whether the segment `a → b` with key interval `(lo, hi)` misses the
     /// band for certain.
     #[inline(always)]
-    fn rejects(&self, a: [f32; 2], b: [f32; 2], (lo, hi): (f32, f32)) -> bool {
+    pub(crate) fn rejects(&self, a: [f32; 2], b: [f32; 2], (lo, hi): (f32, f32)) -> bool {
         match self.by_row(a[1], b[1], (lo, hi)) {
             Row::Rejects => true,
             Row::Keeps => false,
@@ -439,18 +439,10 @@ impl<'a> Visitor<'a> for Walker<'a> {
         self.take(j)
     }
 
-    /// (The general visit made [`Radial::by_row`] with this walker's test
-    /// and segment `j`'s end rows: only its undecided segments are left to
-    /// the exact distance, as in [`Radial::rejects`].)
+    /// (The general visit made [`Radial::rejects`] with this walker's test
+    /// and segment `j`'s ends, and it kept the segment: the clip alone.)
     #[inline(always)]
-    fn segment_after_row(&mut self, j: usize, _: (f32, f32), row: Row) -> (Flow, u32) {
-        if let (Some(rad), Some(a), Some(b), Row::Undecided(d)) =
-            (self.radial, self.boundary.get(j), self.boundary.get(j + 1), row)
-        {
-            if rad.rejects_exact(a.arr(), b.arr(), d) {
-                return (Flow::Continue, RADIAL_UNITS);
-            }
-        }
+    fn segment_kept(&mut self, j: usize, _: (f32, f32)) -> (Flow, u32) {
         self.take(j)
     }
 }

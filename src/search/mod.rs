@@ -255,19 +255,14 @@ pub(crate) trait Visitor<'b> {
         None
     }
 
-    /// [`Self::segment`] for a segment whose [`crate::matching::Radial::by_row`]
-    /// the general visit has made with this visitor's [`Self::radial`]
-    /// test and the segment's two end rows, and which it did not reject:
-    /// `row` is what the test said ([`crate::matching::Row::Keeps`] or
-    /// [`crate::matching::Row::Undecided`]), so that the visitor need not
-    /// make it again. The same outcome and units as [`Self::segment`].
+    /// [`Self::segment`] for a segment whose whole radial test
+    /// ([`crate::matching::Radial::rejects`]: `by_row`, then the exact
+    /// distance where that is undecided) the general visit has made with
+    /// this visitor's [`Self::radial`] test, its interval and its two end
+    /// vertices, and which the test kept: the visitor need not make it
+    /// again. The same outcome and units as [`Self::segment`].
     #[inline(always)]
-    fn segment_after_row(
-        &mut self,
-        j: usize,
-        interval: (f32, f32),
-        _row: crate::matching::Row,
-    ) -> (Flow, u32) {
+    fn segment_kept(&mut self, j: usize, interval: (f32, f32)) -> (Flow, u32) {
         self.segment(j, interval)
     }
 }

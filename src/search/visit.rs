@@ -3,7 +3,7 @@
 //! test's queries built on them.
 
 use super::*;
-use crate::matching::{Radial, Row, RADIAL_UNITS};
+use crate::matching::{Radial, RADIAL_UNITS};
 
 impl<const N: usize> Index<N> {
     /// Whether vertex `i`, whose raw key is `key`, may lie on a ray that
@@ -550,21 +550,22 @@ impl<const N: usize> Index<N> {
                         // the run's own here: `fmin(∞, l) = l`, `fmax(−∞,
                         // h) = h` for every `l`, `h`, NaN included.)
                         if hits(g.lo, g.hi) && !skipped(j) {
-                            let mut row = None;
+                            // The visitor's whole radial test, here: the
+                            // segments it rejects cost no call, and those it
+                            // keeps go to the visitor past it.
+                            let mut kept = false;
                             if let Some([a, b]) = qb.get(j..j + 2) {
-                                let r = qrad.by_row(a.v, b.v, (g.lo, g.hi));
-                                if r == Row::Rejects {
+                                if qrad.rejects(a.arr(), b.arr(), (g.lo, g.hi)) {
                                     work.spend(RADIAL_UNITS)?;
                                     j += 1;
                                     continue;
                                 }
-                                row = Some(r);
+                                kept = true;
                             }
-                            // (The visitor told what `by_row` said, which it
-                            // would make again.)
-                            let (flow, units) = match row {
-                                Some(r) => visit.segment_after_row(j, (g.lo, g.hi), r),
-                                None => visit.segment(j, (g.lo, g.hi)),
+                            let (flow, units) = if kept {
+                                visit.segment_kept(j, (g.lo, g.hi))
+                            } else {
+                                visit.segment(j, (g.lo, g.hi))
                             };
                             work.spend(units)?;
                             if flow == Flow::Stop {

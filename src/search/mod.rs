@@ -246,10 +246,10 @@ pub(crate) trait Visitor<'b> {
     /// The band walk's [`crate::matching::Radial`] test and its polyline,
     /// if the visitor makes that test first for every segment it is
     /// offered (rejecting for [`crate::matching::RADIAL_UNITS`] and
-    /// nothing else): the general visit then makes the test's first part
-    /// itself ([`crate::matching::Radial::by_row`]) and offers only the
-    /// segments it does not reject. The same units and outcome, without
-    /// the call.
+    /// nothing else): the general visit then makes the test itself
+    /// ([`crate::matching::Radial::rejects`]) for the run's segments and
+    /// offers only those it keeps, through [`Self::segment_kept`]. The
+    /// same units and outcome, without the call.
     #[inline(always)]
     fn radial(&self) -> Option<(crate::matching::Radial, &'b [crate::camera::Pixel])> {
         None

@@ -311,24 +311,10 @@ impl Radial {
     /// infinite `NO_KEY`. (An independent review found no counterexample
     /// with finite or infinite ends: 3 M random tests with coordinates up to
     /// 10³⁰, `c₀` from 10⁻³⁰ to 10³⁰, key distances about `|h|` and 1.)
-    /// (The radial levels' walk makes it through [`Self::rejects_block_with`].)
-    #[cfg_attr(not(test), allow(dead_code))]
+    /// `c0sq` is [`Self::block_c0sq`], passed in so that a walk over
+    /// several levels makes it once.
     #[inline(always)]
-    pub(crate) fn rejects_block(&self, hull: (f32, f32), rows: (f32, f32)) -> bool {
-        self.rejects_block_with(hull, rows, self.block_c0sq())
-    }
-
-    /// The `c₀²` that [`Self::rejects_block`] compares with (`10⁻⁵`
-    /// larger), for [`Self::rejects_block_with`].
-    #[inline(always)]
-    pub(crate) fn block_c0sq(&self) -> f32 {
-        self.c0sq * 1.000_01
-    }
-
-    /// [`Self::rejects_block`] with its `c₀²` ([`Self::block_c0sq`]) made
-    /// once for the blocks of several levels.
-    #[inline(always)]
-    pub(crate) fn rejects_block_with(
+    pub(crate) fn rejects_block(
         &self,
         hull: (f32, f32),
         (v_min, v_max): (f32, f32),
@@ -346,6 +332,13 @@ impl Radial {
         }
         let t2 = t * t;
         t2 >= self.m2 && d * d * t2 > c0sq
+    }
+
+    /// The `c₀²` that [`Self::rejects_block`] compares with: `10⁻⁵`
+    /// larger than the segments' test's.
+    #[inline(always)]
+    pub(crate) fn block_c0sq(&self) -> f32 {
+        self.c0sq * 1.000_01
     }
 }
 
@@ -638,7 +631,7 @@ mod tests {
                 rows = (fmin(rows.0, fmin(va, vb)), fmax(rows.1, fmax(va, vb)));
             }
             blocks += 1;
-            if !rad.rejects_block(hull, rows) {
+            if !rad.rejects_block(hull, rows, rad.block_c0sq()) {
                 continue;
             }
             passed += 1;

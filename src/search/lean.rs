@@ -311,7 +311,7 @@ impl<const N: usize> Index<N> {
                 break;
             };
             // A larger block holds this one: stop at the first kept.
-            if !rad.rejects_block_with((lo, hi), (v0, v1), c0sq) {
+            if !rad.rejects_block((lo, hi), (v0, v1), c0sq) {
                 break;
             }
             skip = size;

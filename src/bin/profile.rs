@@ -57,6 +57,12 @@ static WINDOWS: &[(&str, &[u8])] = &[
         "back_spiral",
         include_bytes!("data/adv_back_spiral_256.bin"),
     ),
+    // The same member at 2 × 512, where its points' runs mostly merge the
+    // aside list in (`Index::visit_run_aside`), not the general visit.
+    (
+        "back_spiral_512",
+        include_bytes!("data/adv_back_spiral_512.bin"),
+    ),
 ];
 
 /// Capacity: the bench's, so the per-frame code is the bench's too.

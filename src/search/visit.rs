@@ -328,11 +328,17 @@ impl<const N: usize> Index<N> {
     ) -> Result<(), OutOfWork> {
         let s = self.segments.min(N);
         let meets = |l: f32, h: f32| l <= qh && h >= ql;
+        // The credit in a local copy (written back at every return).
+        let mut credit = *work;
+        let mut r = Ok(());
         while let Some(g) = self.seg.get(j).filter(|_| j < s) {
             if g.sm > qh {
                 break;
             }
-            work.spend(1)?;
+            if let Err(e) = credit.spend(1) {
+                r = Err(e);
+                break;
+            }
             let k = self.block_skip(j, meets, if RAD { rad.as_ref() } else { None });
             if k > 0 {
                 j += k;
@@ -340,21 +346,26 @@ impl<const N: usize> Index<N> {
             }
             if meets(g.lo, g.hi) && !(j >= skip0 && j <= skip1) {
                 let (flow, units) = visit.segment(j, (g.lo, g.hi));
-                work.spend(units)?;
+                if let Err(e) = credit.spend(units) {
+                    r = Err(e);
+                    break;
+                }
                 if flow == Flow::Stop {
                     break;
                 }
             }
             j += 1;
         }
-        Ok(())
+        *work = credit;
+        r
     }
 
     /// [`Self::visit`] for one oriented interval through a run and the aside
     /// list, merged in index order (the block tree skips the run's blocks
     /// the query misses). Each step advances the run or the list; every
-    /// segment looked at and every skip costs one unit. `RAD`: whether
-    /// `rad` may hold a radial test.
+    /// segment looked at and every skip costs one unit, and so does the
+    /// step that finds both at their ends. `RAD`: whether `rad` may hold a
+    /// radial test.
     #[inline(never)]
     fn visit_run_aside<'b, const RAD: bool>(
         &mut self,
@@ -367,43 +378,86 @@ impl<const N: usize> Index<N> {
         if a < self.segments {
             self.hint = a;
         }
+        // The credit in a local while the lists are merged (written back
+        // at every return, as [`Work::spend`] leaves it: 0 when short).
+        let mut credit = work.credit;
+        let r = self.merge_aside::<RAD>(a, (ql, qh), ((skip0, skip1), rad), &mut credit, visit);
+        work.credit = credit;
+        r
+    }
+
+    /// The merge of [`Self::visit_run_aside`] from run start `j`, the
+    /// credit in `credit`. The run's stretch before the list's next entry
+    /// is walked in a loop of its own (the list's next index is read once
+    /// a stretch, not once a step; the same steps, units and offers in the
+    /// same order as one loop over both). Bounded: every step advances the
+    /// run (a skip by at least one) or the list.
+    #[inline(always)]
+    fn merge_aside<'b, const RAD: bool>(
+        &self,
+        mut j: usize,
+        (ql, qh): (f32, f32),
+        ((skip0, skip1), rad): ((usize, usize), Option<Radial>),
+        credit: &mut u32,
+        visit: &mut impl Visitor<'b>,
+    ) -> Result<(), OutOfWork> {
         let s = self.segments.min(N);
         let meets = |l: f32, h: f32| l <= qh && h >= ql;
-        let (mut j, mut ia) = (a, 0usize);
+        let skipped = |k: usize| k >= skip0 && k <= skip1;
+        let spend = |c: &mut u32, units: u32| match c.checked_sub(units) {
+            Some(left) => {
+                *c = left;
+                Ok(())
+            }
+            None => {
+                *c = 0;
+                Err(OutOfWork)
+            }
+        };
+        let mut ia = 0usize;
         loop {
             let aside_next = self
                 .aside
                 .get(ia)
                 .map_or(usize::MAX, |&(k, _, _)| usize::from(k));
-            work.spend(1)?;
-            let (k, l, h) = match self.seg.get(j) {
-                // The run's segment, unless the list's entry comes first.
-                Some(g) if j < s && g.sm <= qh && aside_next >= j => {
-                    let skip = if self.levels > 0 || RAD {
-                        self.block_skip(j, meets, if RAD { rad.as_ref() } else { None })
-                    } else {
-                        0
-                    };
-                    if skip > 0 {
-                        j += skip;
-                        continue;
-                    }
-                    j += 1;
-                    (j - 1, g.lo, g.hi)
+            // The run's segments up to the entry's index (a run segment
+            // with the entry's index comes first).
+            loop {
+                spend(credit, 1)?;
+                let Some(g) = self
+                    .seg
+                    .get(j)
+                    .filter(|g| j < s && g.sm <= qh && aside_next >= j)
+                else {
+                    break;
+                };
+                let skip = if self.levels > 0 || RAD {
+                    self.block_skip(j, meets, if RAD { rad.as_ref() } else { None })
+                } else {
+                    0
+                };
+                if skip > 0 {
+                    j += skip;
+                    continue;
                 }
-                // The list's entry (before the run's next segment, or past
-                // the run's end), or the end of both.
-                _ => {
-                    let Some(&(_, l, h)) = self.aside.get(ia) else {
+                if meets(g.lo, g.hi) && !skipped(j) {
+                    let (flow, units) = visit.segment(j, (g.lo, g.hi));
+                    spend(credit, units)?;
+                    if flow == Flow::Stop {
                         return Ok(());
-                    };
-                    ia += 1;
-                    (aside_next, l, h)
+                    }
                 }
+                j += 1;
+            }
+            // The list's entry (before the run's next segment, or past the
+            // run's end), its unit spent above; or the end of both.
+            let Some(&(_, l, h)) = self.aside.get(ia) else {
+                return Ok(());
             };
-            if meets(l, h) && !(k >= skip0 && k <= skip1) {
-                let (flow, units) = visit.segment(k, (l, h));
-                work.spend(units)?;
+            ia += 1;
+            if meets(l, h) && !skipped(aside_next) {
+                let (flow, units) = visit.segment(aside_next, (l, h));
+                spend(credit, units)?;
                 if flow == Flow::Stop {
                     return Ok(());
                 }

@@ -328,17 +328,11 @@ impl<const N: usize> Index<N> {
     ) -> Result<(), OutOfWork> {
         let s = self.segments.min(N);
         let meets = |l: f32, h: f32| l <= qh && h >= ql;
-        // The credit in a local copy (written back at every return).
-        let mut credit = *work;
-        let mut r = Ok(());
         while let Some(g) = self.seg.get(j).filter(|_| j < s) {
             if g.sm > qh {
                 break;
             }
-            if let Err(e) = credit.spend(1) {
-                r = Err(e);
-                break;
-            }
+            work.spend(1)?;
             let k = self.block_skip(j, meets, if RAD { rad.as_ref() } else { None });
             if k > 0 {
                 j += k;
@@ -346,18 +340,14 @@ impl<const N: usize> Index<N> {
             }
             if meets(g.lo, g.hi) && !(j >= skip0 && j <= skip1) {
                 let (flow, units) = visit.segment(j, (g.lo, g.hi));
-                if let Err(e) = credit.spend(units) {
-                    r = Err(e);
-                    break;
-                }
+                work.spend(units)?;
                 if flow == Flow::Stop {
                     break;
                 }
             }
             j += 1;
         }
-        *work = credit;
-        r
+        Ok(())
     }
 
     /// [`Self::visit`] for one oriented interval through a run and the aside

@@ -164,6 +164,16 @@ impl Ray {
     }
 }
 
+/// Work units a segment offered to [`partners`]' visitor costs on top of
+/// the look: both its ends compensated again (step 1's arithmetic, a
+/// division and a key each) and the ray's crossing, about 270 instructions
+/// with the look, so at four units a unit costs about 70, under the band
+/// path's (`docs/VEHICLE.md`, "Worst case": `C_U`). At one (a unit about
+/// 140 instructions) a partners query's capped stretch between two of the
+/// clock's questions reached 22 077 instructions at 2 × 512, and an eighth
+/// review's pair was 47 616 late with it (README allows 40 000).
+const PARTNER_UNITS: u32 = 3;
+
 /// The frame-1 visitor of [`partners`]: the compensated vertex `j` is
 /// `at(slots[j].pixel1)` (step 1's arithmetic again; `None` where step 1
 /// flagged the point).
@@ -184,21 +194,21 @@ impl<C: Fn(Pixel) -> Option<[f32; 2]> + Copy> Visitor<'_> for Partners<'_, C> {
         let (Some(a), Some(b)) = (vertex(j), vertex(j + 1)) else {
             // (Not offered: a segment with an unkeyed end meets no key in
             // the fold test's index.)
-            return (Flow::Continue, 1);
+            return (Flow::Continue, PARTNER_UNITS);
         };
         match self.ray.crossing(a, b) {
-            Meets::No => (Flow::Continue, 1),
+            Meets::No => (Flow::Continue, PARTNER_UNITS),
             // Behind `F`: the other half of the line.
-            Meets::At(x) if x <= -self.ray.r => (Flow::Continue, 1),
+            Meets::At(x) if x <= -self.ray.r => (Flow::Continue, PARTNER_UNITS),
             Meets::At(x) if x < -self.ray.n && self.partner.is_none() => {
                 self.partner = Some(x);
-                (Flow::Continue, 1)
+                (Flow::Continue, PARTNER_UNITS)
             }
             // A second partner, one in or beyond the band, or one that
             // cannot be placed.
             _ => {
                 self.keep = true;
-                (Flow::Stop, 1)
+                (Flow::Stop, PARTNER_UNITS)
             }
         }
     }
@@ -235,7 +245,12 @@ impl Visitor<'_> for Images<'_> {
 /// `z_far`. `index` is the fold test's index of the boundary (step 1's
 /// keys and margins), `at` step 1's compensation of a frame-1 pixel. The
 /// points take their units from `work`, each asking `guard` first. The FOE
-/// `foe`, the frame-2 error `e2`. Returns whether any point has a partner.
+/// `foe`, the frame-2 error `e2`. Returns whether any point has a partner,
+/// or `None` where the clock stopped the pass: then every point that folds
+/// has its flag ([`settle`] for those before the stop, `over_budget` for
+/// the rest), in one pass over the boundary (two passes after the yes, the
+/// rest's and then [`settle`]'s over all, made an eighth review's pair
+/// later).
 #[cold]
 #[inline(never)]
 pub(crate) fn partners<const N: usize, D: Deadline>(
@@ -245,7 +260,7 @@ pub(crate) fn partners<const N: usize, D: Deadline>(
     (foe, e2): ([f32; 2], f32),
     work: &mut Work,
     guard: &mut Guard<'_, D>,
-) -> bool {
+) -> Option<bool> {
     let mut any = false;
     for i in 0..slots.len() {
         let Some(r) = slots.get(i).filter(|r| r.status == Status::Folded) else {
@@ -259,12 +274,14 @@ pub(crate) fn partners<const N: usize, D: Deadline>(
             // (Without step 1's values: no key.)
             Standing::Folded
         } else if !guard.proceed(work) {
-            // Out of time: this point and the rest of the boundary's that
-            // fold `over_budget` (their `z_far` holds no standing yet).
-            if let Some(rest) = slots.get_mut(i..) {
-                unsearched(rest);
-            }
-            return any;
+            // Out of time: the points before this one settled (the
+            // boundary's steps cut), this point and the rest of the
+            // boundary's that fold `over_budget` (their `z_far` holds no
+            // standing yet).
+            let (done, rest) = slots.split_at_mut(i.min(slots.len()));
+            settle(done, true);
+            unsearched(rest);
+            return None;
         } else {
             match Ray::of(r.pixel2.arr(), foe, r.z_near, e2) {
                 None => Standing::Folded,
@@ -302,7 +319,7 @@ pub(crate) fn partners<const N: usize, D: Deadline>(
             r.z_far = standing.z_far();
         }
     }
-    any
+    Some(any)
 }
 
 /// Step 4's part of the rule for one boundary (after its search): each

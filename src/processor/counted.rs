@@ -127,11 +127,20 @@ pub(super) fn counted_search<const N: usize, D: Deadline>(
     }
     let at = |p: Pixel| recompensate(pair, keying, p).map(|(c, _)| c.pixel2.arr());
     let e2 = pair.e2();
-    if !crate::fold::partners(index, slots, at, (foe, e2), work, guard) || guard.has_expired() {
-        // No point has a partner: nothing to look for in frame 2 (or the
-        // time ran out: no frame-2 index either).
-        crate::fold::settle(slots, guard.has_expired());
-        return;
+    match crate::fold::partners(index, slots, at, (foe, e2), work, guard) {
+        // The time ran out in the pass: its points settled there (no
+        // frame-2 index either).
+        None => return,
+        // No point has a partner: nothing to look for in frame 2.
+        Some(false) => {
+            crate::fold::settle(slots, guard.has_expired());
+            return;
+        }
+        Some(true) if guard.has_expired() => {
+            crate::fold::settle(slots, true);
+            return;
+        }
+        Some(true) => {}
     }
     // The frame-2 index again (its block tree built at once: the tree the
     // walks would build), and the points given back searched.

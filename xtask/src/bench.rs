@@ -460,7 +460,7 @@ limits {} … {} instructions): the overrun is the call's instructions past the 
     by.sort_by_key(|b| std::cmp::Reverse(b.3));
     println!(
         "
-lateness where it is worst (a limit just before each pair's four longest gaps between questions; every pair, the probes, `search_3+e_100`, at 2 × 256 and 2 × 512; the reviews' pairs also with the counting rule for folded points on), the 8 latest:"
+lateness where it is worst (a limit just before each pair's four longest gaps between questions; every pair, the probes, `search_3+e_100`, at 2 × 256 and 2 × 512; each also with the counting rule for folded points on), the 8 latest:"
     );
     println!("| pair | questions | longest gap | overrun | lateness |");
     println!("|---|---:|---:|---:|---:|");

@@ -164,10 +164,12 @@ fn adversarial_base_is_the_representative_pair() {
 }
 
 /// The pairs reviews found by hill climbing (`src/bin/data/rev_*.bin`,
+/// `rev8_*.bin`, `rev9_*.bin`,
 /// the bench's `FOUND`, stored as found): each decodes as the firmware
 /// reads it, two frames of two boundaries of the N the bench runs it at,
 /// every boundary accepted by `Frame::push_boundary` (with the file's
-/// camera; the frame 1 of `rev_e4`, `rev_f1`, `rev_g1`, `rev_h1` and `rev_x3` has
+/// camera; the frame 1 of `rev_e4`, `rev_f1`, `rev_g1`, `rev_h1`, `rev_x3`,
+/// `rev8_a`, `rev8_b`, `rev8_l` and `rev9_s` has
 /// its own too, `CAMERA1`, which the bench checks as it loads it), the motion by `Motion::new`; and the bench's
 /// table names every file.
 #[test]
@@ -187,6 +189,11 @@ fn found_pairs_pass_validation() {
         ("rev_g1", 512),
         ("rev_h1", 512),
         ("rev_x3", 64),
+        ("rev8_a", 64),
+        ("rev8_b", 128),
+        ("rev8_l", 512),
+        ("rev8_s", 512),
+        ("rev9_s", 512),
     ];
     for (name, n) in found {
         assert!(
@@ -211,7 +218,7 @@ fn found_pairs_pass_validation() {
     let on_disk = std::fs::read_dir(&dir)
         .expect("data dir")
         .filter_map(|e| e.ok()?.file_name().into_string().ok())
-        .filter(|f| f.starts_with("rev_"))
+        .filter(|f| f.starts_with("rev"))
         .count();
     assert_eq!(on_disk, found.len(), "stray rev_*.bin files");
 }

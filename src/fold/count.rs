@@ -167,12 +167,15 @@ impl Ray {
 /// Work units a segment offered to [`partners`]' visitor costs on top of
 /// the look: both its ends compensated again (step 1's arithmetic, a
 /// division and a key each) and the ray's crossing, about 270 instructions
-/// with the look, so at four units a unit costs about 70, under the band
-/// path's (`docs/VEHICLE.md`, "Worst case": `C_U`). At one (a unit about
-/// 140 instructions) a partners query's capped stretch between two of the
-/// clock's questions reached 22 077 instructions at 2 × 512, and an eighth
-/// review's pair was 47 616 late with it (README allows 40 000).
-const PARTNER_UNITS: u32 = 3;
+/// with the look on a certified pair and 320 on one whose step 1 is not
+/// certified (each point compensated on its own), so at six units a unit
+/// costs about 45–53, under the band path's (`docs/VEHICLE.md`, "Worst
+/// case": `C_U`). At one (a unit about 140 instructions) a partners
+/// query's capped stretch between two of the clock's questions reached
+/// 22 077 instructions at 2 × 512, and an eighth review's pair was 47 616
+/// late with it (README allows 40 000); at three a ninth review's
+/// uncertified pair was 39 711 late.
+const PARTNER_UNITS: u32 = 5;
 
 /// The frame-1 visitor of [`partners`]: the compensated vertex `j` is
 /// `at(slots[j].pixel1)` (step 1's arithmetic again; `None` where step 1

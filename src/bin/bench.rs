@@ -102,7 +102,7 @@ static FOUND: &[(&str, u32, &[u8])] = &[
     // A ninth review's lateness climb from `rev8_s` (frame 2 turned 0.5 rad
     // about `y`: step 1 not certified, so a partners query compensates
     // point by point, dearer a segment): 39 725 late with the counting
-    // rule on at `PARTNER_UNITS` = 3.
+    // rule on at `PARTNER_UNITS` = 3 (35 668 at 5).
     ("rev9_s", 512, include_bytes!("data/rev9_s.bin")),
 ];
 

@@ -368,16 +368,16 @@ impl<const N: usize> Index<N> {
         if a < self.segments {
             self.hint = a;
         }
-        // The credit in a local while the lists are merged (written back
-        // at every return, as [`Work::spend`] leaves it: 0 when short).
-        let mut credit = work.credit;
-        let r = self.merge_aside::<RAD>(a, (ql, qh), ((skip0, skip1), rad), &mut credit, visit);
-        work.credit = credit;
+        // The credit in a local copy while the lists are merged (written
+        // back at every return, as [`Work::spend`] leaves it).
+        let mut w = *work;
+        let r = self.merge_aside::<RAD>(a, (ql, qh), ((skip0, skip1), rad), &mut w, visit);
+        *work = w;
         r
     }
 
     /// The merge of [`Self::visit_run_aside`] from run start `j`, the
-    /// credit in `credit`. The run's stretch before the list's next entry
+    /// credit in `work` (a local copy). The run's stretch before the list's next entry
     /// is walked in a loop of its own (the list's next index is read once
     /// a stretch, not once a step; the same steps, units and offers in the
     /// same order as one loop over both). Bounded: every step advances the
@@ -388,22 +388,12 @@ impl<const N: usize> Index<N> {
         mut j: usize,
         (ql, qh): (f32, f32),
         ((skip0, skip1), rad): ((usize, usize), Option<Radial>),
-        credit: &mut u32,
+        work: &mut Work,
         visit: &mut impl Visitor<'b>,
     ) -> Result<(), OutOfWork> {
         let s = self.segments.min(N);
         let meets = |l: f32, h: f32| l <= qh && h >= ql;
         let skipped = |k: usize| k >= skip0 && k <= skip1;
-        let spend = |c: &mut u32, units: u32| match c.checked_sub(units) {
-            Some(left) => {
-                *c = left;
-                Ok(())
-            }
-            None => {
-                *c = 0;
-                Err(OutOfWork)
-            }
-        };
         let mut ia = 0usize;
         loop {
             let aside_next = self
@@ -413,7 +403,7 @@ impl<const N: usize> Index<N> {
             // The run's segments up to the entry's index (a run segment
             // with the entry's index comes first).
             loop {
-                spend(credit, 1)?;
+                work.spend(1)?;
                 let Some(g) = self
                     .seg
                     .get(j)
@@ -432,7 +422,7 @@ impl<const N: usize> Index<N> {
                 }
                 if meets(g.lo, g.hi) && !skipped(j) {
                     let (flow, units) = visit.segment(j, (g.lo, g.hi));
-                    spend(credit, units)?;
+                    work.spend(units)?;
                     if flow == Flow::Stop {
                         return Ok(());
                     }
@@ -447,7 +437,7 @@ impl<const N: usize> Index<N> {
             ia += 1;
             if meets(l, h) && !skipped(aside_next) {
                 let (flow, units) = visit.segment(aside_next, (l, h));
-                spend(credit, units)?;
+                work.spend(units)?;
                 if flow == Flow::Stop {
                     return Ok(());
                 }

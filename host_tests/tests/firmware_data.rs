@@ -170,12 +170,12 @@ fn adversarial_base_is_the_representative_pair() {
 /// every boundary accepted by `Frame::push_boundary` (with the file's
 /// camera; the frame 1 of `rev_e4`, `rev_f1`, `rev_g1`, `rev_h1`, `rev_x3`,
 /// `rev8_a`, `rev8_b`, `rev8_l` and `rev9_s` has
-/// its own too, `CAMERA1`, which the bench checks as it loads it), the motion by `Motion::new`; and the bench's
-/// table names every file.
+/// its own too, `Found::camera1`, which the bench checks as it loads it), the motion by `Motion::new`; and the bench's
+/// table (`src/bin/bench/pairs.rs`) names every file.
 #[test]
 fn found_pairs_pass_validation() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../src/bin/data");
-    let bench = std::fs::read_to_string(dir.join("../bench.rs")).expect("bench.rs");
+    let bench = std::fs::read_to_string(dir.join("../bench/pairs.rs")).expect("bench/pairs.rs");
     let found = [
         ("rev_a1", 64),
         ("rev_b1", 256),
@@ -198,7 +198,7 @@ fn found_pairs_pass_validation() {
     for (name, n) in found {
         assert!(
             bench.contains(&format!(
-                "(\"{name}\", {n}, include_bytes!(\"data/{name}.bin\"))"
+                "name: \"{name}\",\n        n: {n},\n        data: include_bytes!(\"../data/{name}.bin\"),"
             )),
             "{name} in FOUND"
         );

@@ -56,7 +56,7 @@ const FUSED: bool = cfg!(feature = "link-fused");
 /// README tells a firmware to allow for (40 000 instructions), and with the
 /// fusion also less the fusion's own work after the matching, which the
 /// deadline does not cut: the demo's limit for its fusion steps (212 000,
-/// `src/bin/bench.rs`, `DRIVE_LIMIT`; at most 74 instructions a key-frame
+/// `src/bin/bench/fusion.rs`, `DRIVE_LIMIT`; at most 74 instructions a key-frame
 /// point on the demo drive, README).
 const LIMIT_INSTRUCTIONS: u32 = if FUSED {
     212_000

@@ -22,7 +22,7 @@
 //!   to 16 × the default (the `sweep` rows): per member, the largest
 //!   rise of the instructions between two of its budgets over the units'
 //!   rise (pairs whose units move by fewer than 256 are left out), and the
-//!   same over the configuration probes (`PROBES` in `src/bin/bench.rs`:
+//!   same over the configuration probes (`PROBES` in `src/bin/bench/pairs.rs`:
 //!   members' pairs, or windows of them, under other valid configurations),
 //!   which the firmware logs as sweep rows too.
 //! * `C_P`: the largest per-point remainder, `(I − C0 − C_B·B − C_U·u) /

@@ -164,7 +164,7 @@ fn adversarial_base_is_the_representative_pair() {
 }
 
 /// The pairs reviews found by hill climbing (`src/bin/data/rev_*.bin`,
-/// `rev8_*.bin`, `rev9_*.bin`,
+/// `rev8_*.bin`, `rev9_*.bin`, `rev10_*.bin`,
 /// the bench's `FOUND`, stored as found): each decodes as the firmware
 /// reads it, two frames of two boundaries of the N the bench runs it at,
 /// every boundary accepted by `Frame::push_boundary` (with the file's
@@ -194,6 +194,9 @@ fn found_pairs_pass_validation() {
         ("rev8_l", 512),
         ("rev8_s", 512),
         ("rev9_s", 512),
+        ("rev10_l1", 512),
+        ("rev10_l2", 512),
+        ("rev10_off", 512),
     ];
     for (name, n) in found {
         assert!(

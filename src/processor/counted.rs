@@ -37,6 +37,15 @@ fn recompensate(pair: &Pair, keying: &Keying, p1: Pixel) -> Option<(PointResult,
     }
 }
 
+/// Whether the counting rule applies to the pair's boundary: the lean
+/// wedge path (half-plane keys, moving forwards without a translation
+/// error). Elsewhere a point the fold test flags stays
+/// [`Status::Folded`], the rule on or off.
+#[inline(always)]
+pub(super) fn applies(pair: &Pair, keying: &Keying) -> bool {
+    matches!(keying.pencil, Pencil::Half { .. }) && step4::wedge_path(pair)
+}
+
 /// The counting rule ([`Processor::set_fold_counting`]) for one boundary,
 /// after its search, where it applies (the lean wedge path: half-plane
 /// keys, moving forwards without a translation error) and a point was
@@ -60,7 +69,7 @@ pub(super) fn counted_search<const N: usize, D: Deadline>(
     let Pencil::Half { foe, side, min_t } = keying.pencil else {
         return;
     };
-    if !step4::wedge_path(pair) || !slots.iter().any(|r| r.status == Status::Folded) {
+    if !applies(pair, keying) || !slots.iter().any(|r| r.status == Status::Folded) {
         return;
     }
     // What the usual steps had: the keys' orientation, the largest `r₁`.

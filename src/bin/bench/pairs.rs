@@ -334,6 +334,56 @@ pub static FOUND: &[Found] = &[
             max_depth: 2_135.399_6,
         },
     },
+    // A tenth review's (after the sixteenth session's bench split): frame
+    // 2's boundary zig-zags 48 times across a point's ray inside a wide
+    // band (`e₂` 33–48 px), so the first point searched walks a piece of
+    // 48 segments at three units each and then refines its stick over
+    // them, which its units did not pay for: 18 886 instructions between
+    // two questions, then every other point of the frame flagged; 40 760
+    // late with the counting rule on (40 747 in this bench), 33 710 with
+    // it off. The refinement is now a stretch of its own.
+    Found {
+        name: "rev10_l1",
+        n: 512,
+        data: include_bytes!("../data/rev10_l1.bin"),
+        camera1: None,
+        config: FoundConfig {
+            e1: 1.153_068_4,
+            e2: 48.306_522,
+            angle: 0.296_287_54,
+            translation: None,
+            rotation: None,
+            max_depth: 1.0e6,
+        },
+    },
+    Found {
+        name: "rev10_l2",
+        n: 512,
+        data: include_bytes!("../data/rev10_l2.bin"),
+        camera1: None,
+        config: FoundConfig {
+            e1: 3.663_606,
+            e2: 32.801_842,
+            angle: 17.082_836,
+            translation: None,
+            rotation: None,
+            max_depth: 1.0e6,
+        },
+    },
+    Found {
+        name: "rev10_off",
+        n: 512,
+        data: include_bytes!("../data/rev10_off.bin"),
+        camera1: None,
+        config: FoundConfig {
+            e1: 0.0,
+            e2: 32.989_357,
+            angle: 14.463_311,
+            translation: None,
+            rotation: None,
+            max_depth: 1.0e6,
+        },
+    },
 ];
 
 /// Frame 1 made again with pair `name`'s own frame-1 camera, if it has one

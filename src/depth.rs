@@ -113,7 +113,12 @@ use crate::math::{cross, dot, fmax, fmin, sqrt_pos};
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct DepthInterval {
-    /// Nearest consistent depth `Z_near` (> 0).
+    /// Nearest consistent depth `Z_near`: above 0 on a pair's stick
+    /// ([`crate::PointResult::interval`]); a fused interval's
+    /// ([`crate::fusion`]) can have 0 here, its ends being kept in 16 bits
+    /// each and a near end below `2⁻¹⁵` of the configured maximum depth
+    /// rounded down to 0 (still holding the truth; a tenth review's find
+    /// against the "> 0" this said before).
     pub z_near: f32,
     /// Farthest consistent depth `Z_far`.
     pub z_far: f32,

@@ -363,7 +363,7 @@ pub static FOUND: &[Found] = &[
         camera1: None,
         config: FoundConfig {
             e1: 3.663_606,
-            e2: 32.801_842,
+            e2: 32.801_84,
             angle: 17.082_836,
             translation: None,
             rotation: None,

@@ -61,9 +61,9 @@
 //! of the adversarial family's (2 × 64 and 2 × 256 pairs) do, 453 of them
 //! then `over_budget` (`host_tests/tests/deadline.rs` counts them); with
 //! `w = 8` some random scenarios lose most of their points. Pairs across
-//! several frames walk longer: on the fusion's random drives 51 of 304
-//! have a pair where the cap changes points, 102 of them `over_budget`, 4
-//! of those `ok` without the cap (54 `unbounded`) (`host_tests/tests/fusion.rs`,
+//! several frames walk longer: on the fusion's random drives 24 of 304
+//! have a pair where the cap changes points, 59 of them `over_budget`, 3
+//! of those `ok` without the cap (`host_tests/tests/fusion.rs`,
 //! `the_deadline_cap_on_the_drives`). A firmware
 //! that needs `process`'s results whenever its clock does not fire should
 //! give a larger `w`, or a clock whose [`Deadline::carry`] is larger.

@@ -181,7 +181,7 @@ fn sweep_with(
     let mut c = Counts::default();
     compare(&uncut, &full, what, &mut c);
     for (x, y) in uncut.boundaries().iter().zip(default.boundaries()) {
-        for (_, b) in x.points().iter().zip(y.points()).filter(|(a, b)| a != b) {
+        for (a, b) in x.points().iter().zip(y.points()).filter(|(a, b)| a != b) {
             c.capped += 1;
             if b.depth().is_some() {
                 c.capped_depths += 1;

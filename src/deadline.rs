@@ -54,10 +54,7 @@
 //! a point whose search needs more than `CARRY · w` units at once comes
 //! out [`crate::Status::OverBudget`] where [`crate::Processor::process`]
 //! would have finished it from the carried credit: at the default budget
-//! no point of the certification's synthetic scenarios loses a depth (three
-//! `unbounded` points of one scenario come out `over_budget`: their stick's
-//! refinement pays for its passes over a long piece, since a tenth
-//! review, and that no longer fits the cap after the walk), and 462
+//! no point of the certification's synthetic scenarios changes, and 462
 //! of the adversarial family's (2 × 64 and 2 × 256 pairs) do, 453 of them
 //! then `over_budget` (`host_tests/tests/deadline.rs` counts them); with
 //! `w = 8` some random scenarios lose most of their points. Pairs across

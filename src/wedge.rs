@@ -164,13 +164,11 @@
 //! segment the credit left cannot pay for keeps only its `d̂` bound, the
 //! stick from its range: `t_far` is still a maximum over the segments of
 //! bounds each valid for its segment, so the stick still holds, only less
-//! tight (with credit for the passes below only, it is the stick from the piece's range, bit for
+//! tight (with no credit it is the stick from the piece's range, bit for
 //! bit; one left unbounded for want of credit is flagged
 //! [`Status::OverBudget`]). The rest of the pass (the piece found again,
-//! each segment's part and crossing, as the walk computed them) is paid
-//! first, [`REFINE_PASS_UNITS`] a segment: a refinement the credit cannot
-//! pass over the piece with is not made, and the point is flagged
-//! [`Status::OverBudget`]. The band path keeps the stick from
+//! each segment's part and crossing, as the walk computed them) is bounded
+//! by the segments the walk paid for. The band path keeps the stick from
 //! the range alone. Rounding: `|u|` is bounded above (`rsqrt_pos` with
 //! [`crate::math::RSQRT_UP`] twice), each `u·(v − P₁')` and `u_x R` is
 //! widened by four times its rounding bound, and the ends are rounded
@@ -484,16 +482,13 @@ impl Wedge {
     /// only when the piece is not found again (not reached: the walk found
     /// it with this wedge). Out of line: the usual point does not take it.
     /// Two passes over the piece's segments (and one more), each of which
-    /// the walk paid for; the passes cost [`REFINE_PASS_UNITS`] a segment
-    /// from `credit` first (short of them: no stick, `(0, None, true)`,
-    /// the credit spent, and the caller flags the point
-    /// [`Status::OverBudget`], as a walk short of its units is), the lines'
-    /// bounds of a segment (its normal's and the chord's, the dear part)
-    /// [`REFINE_UNITS`] more, and a segment the credit cannot pay lines for
-    /// keeps the bound from its range (the stick of [`Self::depths`] over
-    /// that segment): valid, only less tight. The third value says whether
-    /// a segment went unpaid (then an unbounded stick is the budget's
-    /// doing, not the geometry's).
+    /// the walk paid for; the lines' bounds of a segment (its normal's and
+    /// the chord's, the dear part) cost [`REFINE_UNITS`] more from
+    /// `credit`, and a segment the credit cannot pay for keeps the bound
+    /// from its range (the stick of [`Self::depths`] over that segment):
+    /// valid, only less tight. The third value says whether a segment went
+    /// unpaid (then an unbounded stick is the budget's doing, not the
+    /// geometry's).
     #[inline(never)]
     pub(crate) fn refined(
         &self,
@@ -505,21 +500,12 @@ impl Wedge {
         let first = self.piece_start(b2, end)?;
         let (v0, rest) = b2.get(first..=end)?.split_first()?;
         let last = rest.last()?;
-        // The passes over the piece first (found again, then each
-        // segment's part, crossing and central bounds): short of them, no
-        // refinement, and the credit spent.
-        let segments = u32::try_from(rest.len()).unwrap_or(u32::MAX);
-        let passes = segments.saturating_mul(REFINE_PASS_UNITS);
-        if *credit < passes {
-            *credit = 0;
-            return Some((0.0, None, true));
-        }
-        *credit -= passes;
         let r2 = self.r2;
         let pr1 = self.rho * r1;
         let p1 = (r2, pr1, self.rho_re);
         let mut va = self.vertex(v0.arr());
-        // The segments whose lines the credit pays for, from the first.
+        // The segments the credit pays for, from the first.
+        let segments = u32::try_from(rest.len()).unwrap_or(u32::MAX);
         let paid = (*credit / REFINE_UNITS).min(segments);
         *credit -= paid * REFINE_UNITS;
         // The normal of the piece's chord, one direction for every paid
@@ -592,16 +578,6 @@ impl Wedge {
 /// tenth, but the demo's costliest frame would refine 70 of its points,
 /// +11 %; `docs/PERFORMANCE.md`.)
 pub(crate) const REFINE_GAP: f32 = 4.0;
-
-/// Work units [`Wedge::refined`] pays for each segment of the piece
-/// before anything else, for its two passes over it (the piece found
-/// again backwards; each segment's part, crossing and central bounds,
-/// two divisions): about 227 instructions a segment, so about 113 a unit.
-/// Until a tenth review they were unpaid, left to the units the walk paid
-/// for the same segments: a capped walk of 150 units and the refinement
-/// after it were 18 886 instructions between two questions of a caller's
-/// clock (`docs/PERFORMANCE.md`, "A tenth review").
-pub(crate) const REFINE_PASS_UNITS: u32 = 2;
 
 /// Work units [`Wedge::refined`] pays for a segment's lines (its normal
 /// and the chord's bounds: two divisions each, a reciprocal square root),

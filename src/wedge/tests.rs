@@ -252,45 +252,24 @@ fn refined_stick_holds_every_consistent_depth() {
                     .expect("the piece again");
                 assert!(!unpaid, "case {case}: unlimited credit");
                 assert_eq!(x.to_bits(), lam.to_bits(), "case {case}: crossing");
-                // A short credit: the passes first, REFINE_PASS_UNITS a
-                // segment (short of them, no stick and the credit spent);
-                // then each segment whose lines it pays costs
-                // REFINE_UNITS, an unpaid one keeps its range's bound, so
-                // the stick lies between the full refinement's and the
-                // coarse one, and with no credit for lines it is the
-                // coarse.
+                // A short credit: each segment it pays costs
+                // REFINE_UNITS, an unpaid one keeps its range's bound,
+                // so the stick lies between the full refinement's and
+                // the coarse one, and with no credit it is the coarse.
                 let segs = (e - piece.0) as u32;
-                let passes = segs * REFINE_PASS_UNITS;
-                for give in [0, passes.saturating_sub(1)] {
-                    let mut credit = give;
-                    if give >= passes {
-                        continue;
-                    }
-                    let got = wedge.refined(&poly, e, (stick_w(w), r1), &mut credit);
-                    assert_eq!(
-                        got,
-                        Some((0.0, None, true)),
-                        "case {case}: {give} for the passes"
-                    );
-                    assert_eq!(credit, 0, "case {case}: the credit spent");
-                }
-                let credits = (0..=segs + 1).flat_map(|k| {
-                    [k * REFINE_UNITS, k * REFINE_UNITS + REFINE_UNITS - 1].map(|c| c + passes)
-                });
+                let credits = (0..=segs + 1)
+                    .flat_map(|k| [k * REFINE_UNITS, k * REFINE_UNITS + REFINE_UNITS - 1]);
                 for give in credits {
                     let mut credit = give;
                     let (xs, short, unpaid) = wedge
                         .refined(&poly, e, (stick_w(w), r1), &mut credit)
                         .expect("the piece again");
                     assert_eq!(xs.to_bits(), lam.to_bits(), "case {case}: crossing");
-                    let paid_now = (give - passes) / REFINE_UNITS;
-                    assert_eq!(credit, give - passes - paid_now.min(segs) * REFINE_UNITS);
+                    let paid_now = give / REFINE_UNITS;
+                    assert_eq!(credit, give - paid_now.min(segs) * REFINE_UNITS);
                     assert_eq!(unpaid, paid_now < segs, "case {case}: {give} for {segs}");
-                    if give == passes {
-                        assert_eq!(
-                            short, coarse,
-                            "case {case}: no credit for lines, the coarse stick"
-                        );
+                    if give == 0 {
+                        assert_eq!(short, coarse, "case {case}: no credit, the coarse stick");
                     }
                     if let (Some((_, fnr, ffr)), Some((_, pn, pf))) = (stick, short) {
                         assert!(

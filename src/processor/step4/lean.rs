@@ -157,6 +157,20 @@ impl LeanWalk<'_> {
                 let (h, refine) = self.walk_out::<WALK>(r, hint, work);
                 hint = h;
                 if refine != 0 {
+                    // The refinement a stretch of its own: the clock asked
+                    // between the walk and it, the credit left as the walk
+                    // left it (so the same results while the clock says
+                    // no). Until a tenth review it followed the walk
+                    // unasked: a capped walk of 150 units, then its 48
+                    // piece segments twice over, 18 886 instructions
+                    // between two questions. (Asking through `proceed`,
+                    // which caps the credit anew, let the refinement pay
+                    // more lines: 20 640.)
+                    if guard.check() {
+                        *r = PointResult::flagged(r.pixel1, Status::OverBudget);
+                        super::flag_pending(rest.into_slice(), Status::OverBudget);
+                        break;
+                    }
                     self.refine(r, refine, work);
                 }
             }

@@ -47,8 +47,8 @@
 //!   instructions), not a boundary's worth. What does grow with `N` is
 //!   the flags after the yes (one store a point) and the number of
 //!   questions. The bench measures the lateness where it is worst at
-//!   2 × 256 and 2 × 512 (`docs/VEHICLE.md`, "Within a deadline": 22 396 and
-//!   35 670 instructions; 51 051 and 101 082 before these questions).
+//!   2 × 256 and 2 × 512 (`docs/VEHICLE.md`, "Within a deadline": 22 394 and
+//!   35 784 instructions; 51 051 and 101 082 before these questions).
 //!
 //! **What the cap costs.** The cap holds even while the clock says no, so
 //! a point whose search needs more than `CARRY · w` units at once comes

@@ -164,7 +164,7 @@ fn adversarial_base_is_the_representative_pair() {
 }
 
 /// The pairs reviews found by hill climbing (`src/bin/data/rev_*.bin`,
-/// `rev8_*.bin`, `rev9_*.bin`, `rev10_*.bin`,
+/// `rev8_*.bin`, `rev9_*.bin`, `rev10_*.bin`, `rev11_*.bin`,
 /// the bench's `FOUND`, stored as found): each decodes as the firmware
 /// reads it, two frames of two boundaries of the N the bench runs it at,
 /// every boundary accepted by `Frame::push_boundary` (with the file's
@@ -197,6 +197,8 @@ fn found_pairs_pass_validation() {
         ("rev10_l1", 512),
         ("rev10_l2", 512),
         ("rev10_off", 512),
+        ("rev11_e", 512),
+        ("rev11_u1", 512),
     ];
     for (name, n) in found {
         assert!(

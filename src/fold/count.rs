@@ -382,6 +382,14 @@ pub(crate) fn images<const N: usize, D: Deadline>(
                 if let Some(one) = slots.get_mut(i..=i) {
                     search(one, index, work, guard);
                 }
+                // The clock said yes in that search: the points left keep
+                // their standings for [`settle`]. (Until an eleventh review
+                // the loop went on over the rest of the boundary, a look at
+                // each slot after the yes: 5 639 instructions of a pair's
+                // 41 404 late.)
+                if guard.has_expired() {
+                    return;
+                }
             }
             Ok(false) => r.z_far = Standing::Folded.z_far(),
             Err(OutOfWork) => r.z_far = Standing::OverBudget.z_far(),

@@ -384,6 +384,40 @@ pub static FOUND: &[Found] = &[
             max_depth: 1.0e6,
         },
     },
+    // An eleventh review's (climbed from `rev8_s`, the counting rule on):
+    // a query of the rule's images (`fold::images`) the last stretch
+    // before the yes, then its loop went on over the boundary's slots and
+    // `fold::settle` flagged its ~500 folded points (about 35 instructions
+    // each): `rev11_e` 41 404 late; `rev11_u1` the bench's four longest
+    // gaps under-reported (33 591, the later of two equal gaps 39 157).
+    Found {
+        name: "rev11_e",
+        n: 512,
+        data: include_bytes!("../data/rev11_e.bin"),
+        camera1: None,
+        config: FoundConfig {
+            e1: 12.037_727,
+            e2: 0.691_006_54,
+            angle: 39.153_034,
+            translation: None,
+            rotation: None,
+            max_depth: 659.2579,
+        },
+    },
+    Found {
+        name: "rev11_u1",
+        n: 512,
+        data: include_bytes!("../data/rev11_u1.bin"),
+        camera1: None,
+        config: FoundConfig {
+            e1: 6.829_25,
+            e2: 2.140_742_5,
+            angle: 39.153_034,
+            translation: None,
+            rotation: None,
+            max_depth: 659.2579,
+        },
+    },
 ];
 
 /// Frame 1 made again with pair `name`'s own frame-1 camera, if it has one

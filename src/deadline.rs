@@ -18,7 +18,9 @@
 //!   questions a point's search may spend at most [`CARRY`] times the
 //!   configured allowance (`work_per_point`) under a deadline (on the
 //!   pseudo-angle path a point's walk and its deferred refinement are two
-//!   such stretches): the units cheap points leave still carry over to
+//!   such stretches; on the half-plane path the clock is asked between a
+//!   point's walk and its stick's refinement too, which pays from what the
+//!   walk left): the units cheap points leave still carry over to
 //!   later points, but no single point can spend the whole frame's savings
 //!   at once, which is what makes its cost bounded by a constant (`C_P +
 //!   C_U · CARRY · w` instructions in the terms of README's "Worst case")

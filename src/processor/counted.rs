@@ -47,7 +47,7 @@ pub(super) fn applies(pair: &Pair, keying: &Keying) -> bool {
 }
 
 /// The counting rule ([`Processor::set_fold_counting`]) for one boundary,
-/// after its search, where it applies (the lean wedge path: half-plane
+/// after its search, where it [`applies`] (the lean wedge path: half-plane
 /// keys, moving forwards without a translation error) and a point was
 /// flagged [`Status::Folded`]: step 1's values again ([`recompensate`]:
 /// the same arithmetic) for the fold test's index of the boundary and for
@@ -69,7 +69,9 @@ pub(super) fn counted_search<const N: usize, D: Deadline>(
     let Pencil::Half { foe, side, min_t } = keying.pencil else {
         return;
     };
-    if !applies(pair, keying) || !slots.iter().any(|r| r.status == Status::Folded) {
+    // (Its one caller, `match_boundary`, runs it only where it
+    // [`applies`].)
+    if !slots.iter().any(|r| r.status == Status::Folded) {
         return;
     }
     // What the usual steps had: the keys' orientation, the largest `r₁`.

@@ -496,9 +496,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             if guard.check() {
                 // The time is up: the boundary's points flagged, its steps
                 // skipped.
-                for (slot, &p1) in slots.iter_mut().zip(b1) {
-                    *slot = PointResult::flagged(p1, Status::OverBudget);
-                }
+                cut_off(slots, b1);
                 continue;
             }
             let mut r1_max = 0.0f32;
@@ -541,7 +539,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                         // (The point-by-point path is the dear one: the
                         // caller's deadline is asked at each point.)
                         if guard.check() {
-                            *slot = PointResult::flagged(p1, Status::OverBudget);
+                            slot.flag_at(p1, Status::OverBudget);
                             *m = 0.0;
                             order.push(NO_KEY, 0.0);
                             continue;
@@ -781,14 +779,25 @@ fn step1_certified<D: Deadline, const BOUNDED: bool>(
         if !first && guard.check() {
             let rest = core::iter::once((s, b)).chain(parts.by_ref().map(|(p, _)| p));
             for (s, b) in rest {
-                for (slot, &p1) in s.iter_mut().zip(b) {
-                    *slot = PointResult::flagged(p1, Status::OverBudget);
-                }
+                cut_off(s, b);
             }
             return;
         }
         *pushed += compensate_all_certified::<BOUNDED>(pair, r1, (s, b, m), order, &key);
         first = false;
+    }
+}
+
+/// The slots of points `b1` the caller's deadline cut off before step 1
+/// reached them, flagged [`Status::OverBudget`]: a pixel and a status a
+/// point, the slot's other bytes (an earlier frame's) not what the result
+/// says ([`PointResult`]). (Out of line: the loop on its own, after the
+/// clock's yes, is a few instructions a point.)
+#[cold]
+#[inline(never)]
+fn cut_off(slots: &mut [PointResult], b1: &[Pixel]) {
+    for (slot, &p1) in slots.iter_mut().zip(b1) {
+        slot.flag_at(p1, Status::OverBudget);
     }
 }
 

@@ -185,8 +185,17 @@ impl fmt::Display for Status {
 }
 
 /// Result for one frame-1 boundary point (32 bytes).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+///
+/// What a result says is its status, its frame-1 pixel, and what the
+/// status gives: the frame-2 pixel where [`Status::has_match`], the depth
+/// and stick where [`Status::has_depth`]. That is all the accessors show,
+/// and all that equality (`==`), `Debug`, `defmt` and
+/// [`Structure::digest`] look at: the bytes a flagged result keeps for
+/// what its status does not give are unspecified (a point the caller's
+/// deadline cut off gets its status, not a clean slot: the flags written
+/// after the clock's yes are one byte a point,
+/// [`crate::Processor::process_within`]).
+#[derive(Clone, Copy, Default)]
 pub struct PointResult {
     pub(crate) pixel1: Pixel,
     pub(crate) pixel2: Pixel,
@@ -215,6 +224,43 @@ impl PointResult {
             status,
             ..Self::EMPTY
         }
+    }
+
+    /// This result flagged `status` (not [`Status::Ok`], nor a status with
+    /// a match), its pixel kept and the rest left as it is: what the
+    /// result says is [`Self::flagged`]'s (the type's docs). One store,
+    /// where [`Self::flagged`] writes the whole slot: the flags a cut
+    /// frame writes after the clock's yes.
+    #[inline(always)]
+    pub(crate) fn flag(&mut self, status: Status) {
+        self.status = status;
+    }
+
+    /// [`Self::flag`] for a slot that holds another point's result (an
+    /// earlier frame's): `pixel1` written too. Two stores.
+    #[inline(always)]
+    pub(crate) fn flag_at(&mut self, pixel1: Pixel, status: Status) {
+        self.pixel1 = pixel1;
+        self.status = status;
+    }
+
+    /// What the result says (the type's docs): status, `pixel1`, and
+    /// `pixel2`, `z`, `z_near`, `z_far` where the status gives them, 0
+    /// where it does not (what [`Self::flagged`] holds there).
+    #[inline]
+    fn view(&self) -> (Status, Pixel, Pixel, [f32; 3]) {
+        let s = self.status;
+        let pixel2 = if s.has_match() {
+            self.pixel2
+        } else {
+            Pixel::new(0.0, 0.0)
+        };
+        let depth = if s.has_depth() {
+            [self.z, self.z_near, self.z_far]
+        } else {
+            [0.0; 3]
+        };
+        (s, self.pixel1, pixel2, depth)
     }
 
     /// The outcome.
@@ -246,6 +292,45 @@ impl PointResult {
             z_near: self.z_near,
             z_far: self.z_far,
         })
+    }
+}
+
+/// Equal when they say the same (the type's docs): the fields a status
+/// does not give are not compared.
+impl PartialEq for PointResult {
+    fn eq(&self, other: &Self) -> bool {
+        self.view() == other.view()
+    }
+}
+
+impl fmt::Debug for PointResult {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (status, pixel1, pixel2, [z, z_near, z_far]) = self.view();
+        f.debug_struct("PointResult")
+            .field("pixel1", &pixel1)
+            .field("pixel2", &pixel2)
+            .field("z", &z)
+            .field("z_near", &z_near)
+            .field("z_far", &z_far)
+            .field("status", &status)
+            .finish()
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for PointResult {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        let (status, pixel1, pixel2, [z, z_near, z_far]) = self.view();
+        defmt::write!(
+            f,
+            "PointResult {{ pixel1: {}, pixel2: {}, z: {}, z_near: {}, z_far: {}, status: {} }}",
+            pixel1,
+            pixel2,
+            z,
+            z_near,
+            z_far,
+            status
+        );
     }
 }
 
@@ -377,8 +462,10 @@ impl<const N: usize, const B: usize> Structure<N, B> {
     }
 
     /// A 32-bit FNV-1a digest of every result, bit for bit (status, both
-    /// pixels, depth and stick of every point, boundary by boundary): two
-    /// runs agree exactly iff their digests agree (up to hash collisions).
+    /// pixels, depth and stick of every point, boundary by boundary; a
+    /// field the point's status does not give counts as 0, as
+    /// [`PointResult`]'s equality ignores it): two runs agree exactly iff
+    /// their digests agree (up to hash collisions).
     /// Used to check that the firmware computes what the host computes.
     pub fn digest(&self) -> u32 {
         let mut h: u32 = 0x811c_9dc5;
@@ -390,10 +477,10 @@ impl<const N: usize, const B: usize> Structure<N, B> {
         for b in self.boundaries() {
             eat(0xB0B0_B0B0);
             for r in b.points() {
-                eat(r.status as u32);
-                for x in [
-                    r.pixel1.u, r.pixel1.v, r.pixel2.u, r.pixel2.v, r.z, r.z_near, r.z_far,
-                ] {
+                // (What the result says: [`PointResult`]'s docs.)
+                let (status, p1, p2, [z, z_near, z_far]) = r.view();
+                eat(status as u32);
+                for x in [p1.u, p1.v, p2.u, p2.v, z, z_near, z_far] {
                     eat(x.to_bits());
                 }
             }
@@ -460,5 +547,62 @@ mod tests {
         c.counts[Status::Ok as usize] = 426;
         c.counts[Status::Grazing as usize] = 3;
         assert_eq!(format!("{c:?}"), "{\"ok\": 426, \"grazing\": 3}");
+    }
+
+    /// A result is what its status gives (`PointResult`'s docs): a flag
+    /// written over another result's bytes (`flag`, `flag_at`) equals the
+    /// clean flagged result, prints as it, and digests as it; a field the
+    /// status gives still counts.
+    #[test]
+    fn a_result_is_what_its_status_gives() {
+        let p = Pixel::new(3.0, 4.0);
+        let ok = PointResult {
+            pixel1: Pixel::new(9.0, 9.0),
+            pixel2: Pixel::new(5.0, 6.0),
+            z: 7.0,
+            z_near: 6.5,
+            z_far: f32::NAN,
+            status: Status::Ok,
+        };
+        for status in [Status::OverBudget, Status::Folded, Status::NoIntersection] {
+            let clean = PointResult::flagged(p, status);
+            let mut left = ok;
+            left.flag_at(p, status);
+            assert_eq!(left, clean);
+            assert_eq!(format!("{left:?}"), format!("{clean:?}"));
+            let mut over = ok;
+            over.pixel1 = p;
+            over.flag(status);
+            assert_eq!(over, clean);
+            let digest = |r: PointResult| {
+                let mut s = Structure::<1, 1>::EMPTY;
+                s.count = 1;
+                if let Some(b) = s.slots.first_mut() {
+                    b.points.set_len(1);
+                    if let Some(slot) = b.points.as_mut_slice().first_mut() {
+                        *slot = r;
+                    }
+                }
+                s.digest()
+            };
+            assert_eq!(digest(left), digest(clean), "{status:?}");
+            assert_ne!(digest(ok), digest(clean));
+        }
+        // A status with a match compares its frame-2 pixel, and `ok` its
+        // depth and stick (a NaN there is unequal, as any float's `==`).
+        let mut unbounded = PointResult::flagged(p, Status::Unbounded);
+        unbounded.pixel2 = Pixel::new(1.0, 2.0);
+        assert_ne!(unbounded, PointResult::flagged(p, Status::Unbounded));
+        unbounded.z = 8.0;
+        let mut other = unbounded;
+        other.z = 0.0;
+        assert_eq!(unbounded, other);
+        assert_ne!(ok, ok);
+        let mut ok2 = ok;
+        ok2.z_far = 7.5;
+        assert_eq!(ok2, ok2);
+        let mut ok3 = ok2;
+        ok3.z_near = 6.0;
+        assert_ne!(ok2, ok3);
     }
 }

@@ -106,6 +106,9 @@ fn compare(got: &Structure<N, B>, full: &Structure<N, B>, what: &str, c: &mut Co
             "{what}: one result per point"
         );
         for (a, b) in x.points().iter().zip(y.points()) {
+            // (A cut point's slot is flagged with a pixel and a status,
+            // its other bytes left: its pixel must still be its own.)
+            assert_eq!(a.pixel1(), b.pixel1(), "{what}: another point's pixel");
             if a == b {
                 c.equal += 1;
             } else if a.status() == Status::OverBudget {

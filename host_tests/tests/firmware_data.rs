@@ -199,6 +199,9 @@ fn found_pairs_pass_validation() {
         ("rev10_off", 512),
         ("rev11_e", 512),
         ("rev11_u1", 512),
+        ("rev12_a", 512),
+        ("rev12_c", 512),
+        ("rev12_d", 512),
     ];
     for (name, n) in found {
         assert!(

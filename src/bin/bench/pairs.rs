@@ -418,6 +418,48 @@ pub static FOUND: &[Found] = &[
             max_depth: 659.2579,
         },
     },
+    Found {
+        name: "rev12_a",
+        n: 512,
+        data: include_bytes!("../data/rev12_a.bin"),
+        camera1: None,
+        config: FoundConfig {
+            e1: 17.411_743,
+            e2: 0.047_549_83,
+            angle: 39.153_034,
+            translation: None,
+            rotation: None,
+            max_depth: 659.2579,
+        },
+    },
+    Found {
+        name: "rev12_c",
+        n: 512,
+        data: include_bytes!("../data/rev12_c.bin"),
+        camera1: None,
+        config: FoundConfig {
+            e1: 17.411_743,
+            e2: 0.047_549_83,
+            angle: 39.153_034,
+            translation: None,
+            rotation: None,
+            max_depth: 659.2579,
+        },
+    },
+    Found {
+        name: "rev12_d",
+        n: 512,
+        data: include_bytes!("../data/rev12_d.bin"),
+        camera1: None,
+        config: FoundConfig {
+            e1: 15.538_553,
+            e2: 0.364_923_3,
+            angle: 39.153_034,
+            translation: None,
+            rotation: None,
+            max_depth: 659.2579,
+        },
+    },
 ];
 
 /// Frame 1 made again with pair `name`'s own frame-1 camera, if it has one

@@ -37,7 +37,7 @@ pub(super) fn match_wedge_angular<const N: usize, D: Deadline>(
         if !guard.proceed(work) {
             // The time is up: this point and the rest flagged in a loop of
             // their own (those left for the deferred refinement too).
-            *r = PointResult::flagged(p1, Status::OverBudget);
+            r.flag(Status::OverBudget);
             super::flag_pending(rest.into_slice(), Status::OverBudget);
             break;
         }
@@ -110,7 +110,7 @@ fn refine_deferred<D: Deadline>(
     {
         let (p1, p, iz, r1) = (r.pixel1, r.pixel2.arr(), r.z, r.z_near);
         if !guard.proceed(work) {
-            *r = PointResult::flagged(p1, Status::OverBudget);
+            r.flag(Status::OverBudget);
             continue;
         }
         // (Finite, integral and below 2²⁴: the loop stored only such.)

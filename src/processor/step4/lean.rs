@@ -150,7 +150,7 @@ impl LeanWalk<'_> {
                 if !guard.proceed(work) {
                     // The time is up: this point and the rest flagged in a
                     // loop of their own.
-                    *r = PointResult::flagged(r.pixel1, Status::OverBudget);
+                    r.flag(Status::OverBudget);
                     super::flag_pending(rest.into_slice(), Status::OverBudget);
                     break;
                 }
@@ -167,7 +167,7 @@ impl LeanWalk<'_> {
                     // which caps the credit anew, let the refinement pay
                     // more lines: 20 640.)
                     if guard.check() {
-                        *r = PointResult::flagged(r.pixel1, Status::OverBudget);
+                        r.flag(Status::OverBudget);
                         super::flag_pending(rest.into_slice(), Status::OverBudget);
                         break;
                     }

@@ -144,7 +144,7 @@ pub(super) fn match_points<const N: usize, D: Deadline>(
             } else {
                 // The time is up: this point and the rest flagged in a
                 // loop of their own, out of this one's way.
-                *r = PointResult::flagged(r.pixel1, Status::OverBudget);
+                r.flag(Status::OverBudget);
                 flag_pending(rest.into_slice(), Status::OverBudget);
                 break;
             }
@@ -166,10 +166,11 @@ pub(super) fn wedge_path(pair: &Pair) -> bool {
     pair.geom.w() > 0.0 && pair.translation <= 0.0
 }
 
-/// Every point still to be matched flagged `status` (a clean result,
-/// step 1's values gone): [`Status::NoIntersection`] where frame 2 lacks
-/// the boundary, [`Status::OverBudget`] once the caller's deadline has
-/// expired ([`crate::deadline`]).
+/// Every point still to be matched flagged `status`:
+/// [`Status::NoIntersection`] where frame 2 lacks the boundary,
+/// [`Status::OverBudget`] once the caller's deadline has expired
+/// ([`crate::deadline`]). A status a point ([`PointResult::flag`]): step
+/// 1's values stay in the bytes the result does not give.
 #[cold]
 #[inline(never)]
 pub(super) fn flag_pending(slots: &mut [PointResult], status: Status) {
@@ -177,7 +178,7 @@ pub(super) fn flag_pending(slots: &mut [PointResult], status: Status) {
         .iter_mut()
         .filter(|r| r.status == Status::NoIntersection)
     {
-        *r = PointResult::flagged(r.pixel1, status);
+        r.flag(status);
     }
 }
 

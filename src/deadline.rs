@@ -47,10 +47,11 @@
 //!   So the longest stretch is one point's capped search, or up to 64
 //!   items of each of a boundary's few passes (a few thousand
 //!   instructions), not a boundary's worth. What does grow with `N` is
-//!   the flags after the yes (one store a point) and the number of
-//!   questions. The bench measures the lateness where it is worst at
-//!   2 × 256 and 2 × 512 (`docs/VEHICLE.md`, "Within a deadline": 22 394 and
-//!   35 784 instructions; 51 051 and 101 082 before these questions).
+//!   the flags after the yes (a status store a point,
+//!   [`crate::PointResult`]) and the number of questions. The bench
+//!   measures the lateness where it is worst at 2 × 256 and 2 × 512
+//!   (`docs/VEHICLE.md`, "Within a deadline": 21 103 and 29 600
+//!   instructions; 51 051 and 101 082 before these questions).
 //!
 //! **What the cap costs.** The cap holds even while the clock says no, so
 //! a point whose search needs more than `CARRY · w` units at once comes

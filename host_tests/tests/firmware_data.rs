@@ -202,6 +202,7 @@ fn found_pairs_pass_validation() {
         ("rev12_a", 512),
         ("rev12_c", 512),
         ("rev12_d", 512),
+        ("rev13_a", 512),
     ];
     for (name, n) in found {
         assert!(

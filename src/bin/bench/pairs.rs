@@ -418,6 +418,10 @@ pub static FOUND: &[Found] = &[
             max_depth: 659.2579,
         },
     },
+    // A twelfth review's (climbed from `rev11_e`, the counting rule on):
+    // an images query, then the images loop's look at ~500 slots that
+    // fold without a partner, unasked, to the next partner, then
+    // `fold::settle` and the next boundary's flags: 41 061–42 494 late.
     Found {
         name: "rev12_a",
         n: 512,
@@ -458,6 +462,25 @@ pub static FOUND: &[Found] = &[
             translation: None,
             rotation: None,
             max_depth: 659.2579,
+        },
+    },
+    // A thirteenth review's (`rev9_s` with frame 1's first boundary made
+    // straight after its point 0, which has no key): the rule's first
+    // pass's last 64 compensations and the fold test's rebuild's first
+    // 64 pushes on the slow path between two questions (23 687): 34 449
+    // late, under the 40 000.
+    Found {
+        name: "rev13_a",
+        n: 512,
+        data: include_bytes!("../data/rev13_a.bin"),
+        camera1: Some((3_177.910_3, 3_200.0, 1_023.5, 959.5, 2048, 1920)),
+        config: FoundConfig {
+            e1: 0.963_977_4,
+            e2: 0.219_373_36,
+            angle: 7.695_428_3,
+            translation: None,
+            rotation: None,
+            max_depth: 2_135.399_6,
         },
     },
 ];

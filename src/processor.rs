@@ -96,7 +96,7 @@ mod step4;
 
 pub(crate) use pair::Rounding;
 use pair::{composition_box, Pair};
-use step4::{flag_pending, match_boundary};
+use step4::{flag_pending, match_boundary, unmatched};
 
 /// The per-frame motion-stereo processor for up to `B` boundaries of up to
 /// `N` points. No heap: everything lives inside this value, so it can be a
@@ -561,7 +561,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             }
             if guard.check() {
                 // The time ran out in step 1: no fold test, no search.
-                flag_pending(slots, Status::OverBudget);
+                flag_pending(slots);
                 continue;
             }
             // (Step 1's half-plane keys on a certified pair: every point
@@ -603,7 +603,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 continue;
             }
             let Some(b2) = b2 else {
-                flag_pending(slots, Status::NoIntersection);
+                unmatched(slots);
                 continue;
             };
             let near_foe = pair.near_foe(r1_max);
@@ -1221,6 +1221,42 @@ mod tests {
             assert!(
                 spent <= bound,
                 "skip {skip}: {spent} units > {bound} for an empty query"
+            );
+        }
+    }
+
+    /// A boundary frame 2 lacks: its points still to be matched get clean
+    /// `no_intersection` results (`step4::unmatched`), not step 1's values
+    /// (a `no_intersection` slot with `r₁` in `z_near` is what a pass over
+    /// a boundary takes for a point still to be matched; a review's find
+    /// when the flags after a deadline became a status).
+    #[test]
+    fn a_boundary_frame_2_lacks_is_left_clean() {
+        let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).expect("camera");
+        let mut p = std::boxed::Box::new(Processor::<64, 2>::new(Config::DEFAULT));
+        let mut f1 = Frame::<64, 2>::new(cam);
+        for b in [
+            [(100.0, 400.0), (150.0, 300.0)],
+            [(400.0, 400.0), (350.0, 300.0)],
+        ] {
+            let b = b.map(|(u, v)| Pixel::new(u, v));
+            assert!(f1.push_boundary(&b).is_ok());
+        }
+        assert!(p.process(&f1, None).is_ok());
+        let mut f2 = Frame::<64, 2>::new(cam);
+        assert!(f2
+            .push_boundary(&[Pixel::new(40.0, 470.0), Pixel::new(130.0, 300.0)])
+            .is_ok());
+        let m = Motion::new([0.0, 0.0, 0.4], [0.0, 0.0, 0.0]).expect("motion");
+        let s = p.process_against_kept(&f2, &m).expect("kept");
+        let points = s.boundaries().get(1).map_or(&[][..], |b| b.points());
+        assert_eq!(points.len(), 2);
+        for r in points {
+            assert_eq!(r.status, Status::NoIntersection);
+            assert_eq!(
+                (r.pixel2, r.z, r.z_near, r.z_far),
+                (Pixel::new(0.0, 0.0), 0.0, 0.0, 0.0),
+                "step 1's values left in {r:?}"
             );
         }
     }

@@ -191,10 +191,11 @@ impl fmt::Display for Status {
 /// and stick where [`Status::has_depth`]. That is all the accessors show,
 /// and all that equality (`==`), `Debug`, `defmt` and
 /// [`Structure::digest`] look at: the bytes a flagged result keeps for
-/// what its status does not give are unspecified (a point the caller's
-/// deadline cut off gets its status, not a clean slot: the flags written
-/// after the clock's yes are one byte a point,
-/// [`crate::Processor::process_within`]).
+/// what its status does not give are unspecified, with or without a
+/// deadline (a point the caller's deadline cut off gets its status, not a
+/// clean slot, so that the flags written after the clock's yes are one
+/// byte a point, [`crate::Processor::process_within`]; a point the
+/// counting rule leaves `folded` keeps what the rule kept in its slot).
 #[derive(Clone, Copy, Default)]
 pub struct PointResult {
     pub(crate) pixel1: Pixel,
@@ -230,7 +231,10 @@ impl PointResult {
     /// a match), its pixel kept and the rest left as it is: what the
     /// result says is [`Self::flagged`]'s (the type's docs). One store,
     /// where [`Self::flagged`] writes the whole slot: the flags a cut
-    /// frame writes after the clock's yes.
+    /// frame writes after the clock's yes, and the counting rule's. Not
+    /// for [`Status::NoIntersection`] (a `no_intersection` slot with step
+    /// 1's values is a point still to be matched to the passes over a
+    /// boundary).
     #[inline(always)]
     pub(crate) fn flag(&mut self, status: Status) {
         self.status = status;

@@ -458,8 +458,9 @@ pub(crate) fn unsearched(slots: &mut [PointResult]) {
     }
 }
 
-/// Every point the fold test flagged and the rule left given its flag: a
-/// clean [`Status::Folded`], or [`Status::OverBudget`] where the budget or
+/// Every point the fold test flagged and the rule left given its flag:
+/// [`Status::Folded`] (its slot keeping what the rule kept there, which
+/// the result does not give: [`PointResult`]), or [`Status::OverBudget`] where the budget or
 /// the deadline stopped the rule, or where `cut` (the boundary's steps
 /// were cut short by the deadline) left a point with a partner that might
 /// have been searched.

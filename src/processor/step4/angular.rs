@@ -38,7 +38,7 @@ pub(super) fn match_wedge_angular<const N: usize, D: Deadline>(
             // The time is up: this point and the rest flagged in a loop of
             // their own (those left for the deferred refinement too).
             r.flag(Status::OverBudget);
-            super::flag_pending(rest.into_slice(), Status::OverBudget);
+            super::flag_pending(rest.into_slice());
             break;
         }
         let lean = index.lean();
@@ -85,8 +85,10 @@ pub(super) fn match_wedge_angular<const N: usize, D: Deadline>(
 
 /// The points [`match_wedge_angular`] left to refine: still
 /// [`Status::NoIntersection`] with steps 1–2's `r₁ > 0` in `z_near` (every
-/// point it concluded or flagged has a clean result, `z_near` 0 where it
-/// is flagged) and the piece's end in `z_far`. Each gets its wedge's
+/// point it concluded has a clean result, `z_near` 0 where it is
+/// `no_intersection`; one it flagged `over_budget` may keep step 1's
+/// values, [`PointResult::flag`], but not the status) and the piece's end
+/// in `z_far`. Each gets its wedge's
 /// geometry again (the same bits; the keys are not needed) and the refined
 /// stick ([`conclude_refined`]), its lines paid from `credit`, what the
 /// walks left of the frame's work budget. (So under a tight budget this

@@ -151,7 +151,7 @@ impl LeanWalk<'_> {
                     // The time is up: this point and the rest flagged in a
                     // loop of their own.
                     r.flag(Status::OverBudget);
-                    super::flag_pending(rest.into_slice(), Status::OverBudget);
+                    super::flag_pending(rest.into_slice());
                     break;
                 }
                 let (h, refine) = self.walk_out::<WALK>(r, hint, work);
@@ -168,7 +168,7 @@ impl LeanWalk<'_> {
                     // more lines: 20 640.)
                     if guard.check() {
                         r.flag(Status::OverBudget);
-                        super::flag_pending(rest.into_slice(), Status::OverBudget);
+                        super::flag_pending(rest.into_slice());
                         break;
                     }
                     self.refine(r, refine, work);

@@ -131,7 +131,7 @@ pub(super) fn match_points<const N: usize, D: Deadline>(
             index.build_radial_once(b2, &mut Some(&mut ask));
         }
         if guard.has_expired() {
-            flag_pending(slots, Status::OverBudget);
+            flag_pending(slots);
             *work = credit;
             return;
         }
@@ -145,7 +145,7 @@ pub(super) fn match_points<const N: usize, D: Deadline>(
                 // The time is up: this point and the rest flagged in a
                 // loop of their own, out of this one's way.
                 r.flag(Status::OverBudget);
-                flag_pending(rest.into_slice(), Status::OverBudget);
+                flag_pending(rest.into_slice());
                 break;
             }
         }
@@ -166,19 +166,37 @@ pub(super) fn wedge_path(pair: &Pair) -> bool {
     pair.geom.w() > 0.0 && pair.translation <= 0.0
 }
 
-/// Every point still to be matched flagged `status`:
-/// [`Status::NoIntersection`] where frame 2 lacks the boundary,
-/// [`Status::OverBudget`] once the caller's deadline has expired
-/// ([`crate::deadline`]). A status a point ([`PointResult::flag`]): step
-/// 1's values stay in the bytes the result does not give.
+/// Every point still to be matched flagged [`Status::OverBudget`], once
+/// the caller's deadline has expired ([`crate::deadline`]): a status a
+/// point ([`PointResult::flag`]), step 1's values left in the bytes the
+/// result does not give (no later pass reads them: the boundary's steps
+/// end here).
 #[cold]
 #[inline(never)]
-pub(super) fn flag_pending(slots: &mut [PointResult], status: Status) {
+pub(super) fn flag_pending(slots: &mut [PointResult]) {
     for r in slots
         .iter_mut()
         .filter(|r| r.status == Status::NoIntersection)
     {
-        r.flag(status);
+        r.flag(Status::OverBudget);
+    }
+}
+
+/// Every point still to be matched given a clean
+/// [`Status::NoIntersection`] (frame 2 lacks the boundary): step 1's
+/// values cleared, since a `no_intersection` slot with `r₁ > 0` in its
+/// `z_near` is what the passes over a boundary take for a point still to
+/// be matched (the fold test, `refine_deferred`); a later pass over the
+/// whole frame would take these for such. (Kept clean when the flags
+/// after a deadline became a status, by a review of that change.)
+#[cold]
+#[inline(never)]
+pub(super) fn unmatched(slots: &mut [PointResult]) {
+    for r in slots
+        .iter_mut()
+        .filter(|r| r.status == Status::NoIntersection)
+    {
+        *r = PointResult::flagged(r.pixel1, Status::NoIntersection);
     }
 }
 

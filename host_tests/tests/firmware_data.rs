@@ -203,6 +203,7 @@ fn found_pairs_pass_validation() {
         ("rev12_c", 512),
         ("rev12_d", 512),
         ("rev13_a", 512),
+        ("rev14_c1", 512),
     ];
     for (name, n) in found {
         assert!(

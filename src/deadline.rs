@@ -50,7 +50,7 @@
 //!   the flags after the yes (a status store a point,
 //!   [`crate::PointResult`]) and the number of questions. The bench
 //!   measures the lateness where it is worst at 2 × 256 and 2 × 512
-//!   (`docs/VEHICLE.md`, "Within a deadline": 21 110 and 29 035
+//!   (`docs/VEHICLE.md`, "Within a deadline": 21 101 and 29 086
 //!   instructions; 51 051 and 101 082 before these questions).
 //!
 //! **What the cap costs.** The cap holds even while the clock says no, so

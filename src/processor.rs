@@ -270,7 +270,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     /// another result where that call ran out of budget (`Ok`, or `Folded`
     /// where the fold test's pass the clock stopped had found the point
     /// folding before an unkeyed point sent that call to the index, which
-    /// ran out: a review's find). The call returned at most 29 035
+    /// ran out: a review's find). The call returned at most 29 086
     /// instructions after the clock's last no over everything measured
     /// (README, "Within a deadline": allow 40 000, about 60 000 estimated
     /// Cortex-M4F cycles for a cycle counter).

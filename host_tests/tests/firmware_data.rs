@@ -204,6 +204,7 @@ fn found_pairs_pass_validation() {
         ("rev12_d", 512),
         ("rev13_a", 512),
         ("rev14_c1", 512),
+        ("rev15_c", 512),
     ];
     for (name, n) in found {
         assert!(

@@ -502,6 +502,24 @@ pub static FOUND: &[Found] = &[
             max_depth: 22_964.826,
         },
     },
+    // A fifteenth review's (a local search from `rev12_c`, the counting
+    // rule on): the same images query before the yes and a few more
+    // partners for `fold::settle` to flag after it: 29 085 late, 50 past
+    // `rev12_c`.
+    Found {
+        name: "rev15_c",
+        n: 512,
+        data: include_bytes!("../data/rev15_c.bin"),
+        camera1: None,
+        config: FoundConfig {
+            e1: 17.411_743,
+            e2: 0.047_549_83,
+            angle: 39.153_034,
+            translation: None,
+            rotation: None,
+            max_depth: 659.2579,
+        },
+    },
 ];
 
 /// Frame 1 made again with pair `name`'s own frame-1 camera, if it has one

@@ -7,10 +7,41 @@
 //! `#![no_std]`, no allocator, no `unsafe`, single precision only; every
 //! buffer has a compile-time capacity and nothing panics on any input.
 //!
+//! ```
+//! use roadstereo::{Camera, Config, Frame, Motion, Pixel, Processor, Status, Step};
+//!
+//! // The paper's simulated camera: 512 x 480, f = 800 px.
+//! let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480)?;
+//! // 2 boundaries of up to 256 points (in a firmware: a `static`).
+//! let mut processor = Processor::<256, 2>::new(Config::DEFAULT);
+//!
+//! // Frame 1: a road edge on the ground, to the left; no motion yet.
+//! let mut f1 = Frame::new(cam);
+//! f1.push_boundary(&[Pixel::new(100.0, 400.0), Pixel::new(150.0, 300.0)])?;
+//! assert!(matches!(processor.process(&f1, None)?, Step::First));
+//!
+//! // Frame 2, after 0.4 units forward: a depth and a guaranteed stick.
+//! let mut f2 = Frame::new(cam);
+//! f2.push_boundary(&[Pixel::new(40.0, 470.0), Pixel::new(130.0, 300.0)])?;
+//! let motion = Motion::new([0.0, 0.0, 0.4], [0.0; 3])?;
+//! if let Step::Structure(s) = processor.process(&f2, Some(&motion))? {
+//!     for r in s.boundaries()[0].points() {
+//!         if let (Status::Ok, Some(stick)) = (r.status(), r.interval()) {
+//!             assert!(stick.z_near <= stick.z_far);
+//!         }
+//!     }
+//! }
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! The README (in the repository) has the conventions, the guarantees and
+//! their limits, running within a deadline (`Processor::process_within`),
+//! the fusion of many frames and the figures behind every budget.
+//!
 //! The pipeline, one module per concept of the paper:
 //! [`camera`] (intrinsics), [`motion`] (frame-to-frame motion and its
 //! conventions), [`boundary`] (validated polylines and frames),
-//! [`epipolar`] (rotation compensation, FOE, epipolar search, Sec. 2),
+//! [`epipolar`] (rotation compensation and the FOE of a pair, Sec. 2),
 //! [`depth`] (triangulation, eq. 2.3, and the stick, Sec. 4.1), and
 //! [`processor`] (the per-frame driver and its output), and
 //! [`calibration`] (intrinsics from foci of expansion, Appendix II B), and
@@ -22,8 +53,6 @@
 //!
 //! [`wire`] is the camera front-end link's format and streaming decoder,
 //! [`link`] its embedded-hal / embedded-io drivers.
-//!
-//! See the README for the coordinate conventions and a worked example.
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]

@@ -21,8 +21,11 @@ pub enum Status {
     /// The band meets the boundary in two (or more) separate pieces: the
     /// correspondence is not unique, and no depth is given.
     Ambiguous,
-    /// The point's error disc holds the focus of expansion, or the point is
-    /// too close to it for its band to be told from the FOE's: no disparity.
+    /// The point lies within `3 (r₁ + e₂)` of the focus of expansion
+    /// (moving forwards without a translation error), its error disc
+    /// widened by the motion's error bounds holds the FOE, or (moving
+    /// backwards) it is too close to the FOE for its band to be told from
+    /// the FOE's: no usable disparity.
     AtFoe,
     /// After rotation compensation the ray points behind the frame-2 camera,
     /// or the depth scale `q_z` is not known to better than half its value.
@@ -282,7 +285,7 @@ impl PointResult {
     /// it lies on, the compensated frame-1 point and the FOE, at least 1
     /// (the fuzz pass checks it on every match; with a FOE far outside the
     /// image, nearly sideways motion, or a long segment, the tolerance is
-    /// as loose as `S` is large: README, "Using the library").
+    /// as loose as `S` is large: `docs/METHOD.md`, "A match's pixel lies on the polyline").
     pub fn pixel2(&self) -> Option<Pixel> {
         self.status.has_match().then_some(self.pixel2)
     }

@@ -892,8 +892,8 @@ pub fn on_segment_distance(q: Pixel, (a, b): (Pixel, Pixel)) -> f64 {
 /// Every reported frame-2 match of `s` lies on its boundary's frame-2
 /// polyline within the documented tolerance, `2⁻¹⁶ S` with `S` the largest
 /// coordinate magnitude of the match, the ends of a segment it lies that
-/// close to, the compensated frame-1 point and the FOE (README, "Using the
-/// library"; the largest ratio seen in a minute of this pass was
+/// close to, the compensated frame-1 point and the FOE (`docs/METHOD.md`,
+/// "A match's pixel lies on the polyline"; the largest ratio seen in a minute of this pass was
 /// `8.3·10⁻⁷` before the segment's ends counted, about a twentieth of it).
 fn check_on_polyline<const N: usize, const B: usize>(
     s: &Structure<N, B>,

@@ -8,7 +8,7 @@
 //! memory map in `boards/` (beside `stm32f405.x`) and its arm in
 //! `build.rs`, its constants here (and its feature in the default's
 //! `not(any(...))`), and its QEMU machine in `xtask/src/firmware.rs`
-//! (`Board`; README, "Boards", lists every place).
+//! (`Board`; `docs/VEHICLE.md`, "The firmware and the boards", lists every place).
 
 /// The board's name, as the firmware logs it.
 #[cfg(not(any(feature = "board-f405")))]

@@ -3,7 +3,7 @@
 //! each within the library's stated error model, and checked point by point
 //! against ground truth computed from the generator's own geometry.
 //!
-//! **The model** (README, `src/depth.rs`): the true frame-1 point is within
+//! **The model** (README's first section, `docs/METHOD.md`, `src/depth.rs`): the true frame-1 point is within
 //! `e₁` of the detected one; the true frame-2 boundary curve is within `e₂`
 //! of the frame-2 polyline (every point of the true curve, over the stretch
 //! frame 2 observed, within `e₂` of some point of the polyline).

@@ -1,7 +1,7 @@
 //! A reported frame-2 match lies on the frame-2 polyline within `2⁻¹⁶ S`
 //! pixels, `S` the largest coordinate magnitude among the match, the ends
 //! of the frame-2 segment it lies on, the compensated frame-1 point and the
-//! FOE (README, "Using the library"): the match is the exact epipolar
+//! FOE (`docs/METHOD.md`, "A match's pixel lies on the polyline"): the match is the exact epipolar
 //! line's point at its crossing, computed in `f32` from those points. The
 //! fuzz target checks every match of every case
 //! (`host_tests/src/fuzz/frame.rs`, `check_on_polyline`); these are the

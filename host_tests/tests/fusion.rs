@@ -1008,6 +1008,49 @@ fn a_failed_constraint_after_a_retire_changes_nothing() {
     assert_eq!(f.key().map(|k| (k.id(), k.partners())), Some((2, 0)));
 }
 
+/// Found by an adversarial review: a key frame retired because the
+/// composed motion passed its limit, on a frame without points (every
+/// boundary lost), left `key()` at `None`, though its docs promise the
+/// retired key frame's final state until the next step (as a frame with
+/// points that starts the next key frame shows it). The reviewer's drive:
+/// two turns of 0.6 rad, the second on a frame whose boundary is absent.
+#[test]
+fn a_key_frame_retired_on_a_frame_without_points_is_still_shown() {
+    let cam = synth::Intrinsics::default().camera();
+    let edge = |shift: f32| {
+        let mut f = Frame::<N, B>::new(cam);
+        let pts: Vec<Pixel> = (0..40)
+            .map(|k| Pixel::new(100.0 + shift + 2.0 * k as f32, 300.0 + 4.0 * k as f32))
+            .collect();
+        f.push_boundary(&pts).expect("edge");
+        f.push_absent().expect("absent");
+        f
+    };
+    let turn = Motion::new([0.0, 0.0, 0.3], [0.0, 0.6, 0.0]).expect("motion");
+    let mut f = Box::new(HostFusion::new(Config::DEFAULT, FusionConfig::DEFAULT));
+    f.step(0, &edge(0.0), None).expect("key frame 0");
+    let m = |from| ChainedMotion { from, motion: turn };
+    f.step(1, &edge(-30.0), Some(&m(0))).expect("partner 1");
+    let after_1 = key_view(&f);
+    assert!(after_1.starts_with("0 1 "), "{after_1}");
+    let mut lost = Frame::<N, B>::new(cam);
+    lost.push_absent().expect("absent");
+    lost.push_absent().expect("absent");
+    let s = f.step(2, &lost, Some(&m(1))).expect("frame 2");
+    assert_eq!(s.retired.map(|r| r.key), Some(0), "{s:?}");
+    assert_eq!(s.new_key, None, "no points, no key frame: {s:?}");
+    // The retired key frame as it went into the map, until the next step.
+    assert_eq!(key_view(&f), after_1);
+    assert_eq!((f.key_id(), f.key_ref()), (None, None));
+    let m3 = ChainedMotion {
+        from: 2,
+        motion: Motion::new([0.0, 0.0, 0.3], [0.0; 3]).expect("motion"),
+    };
+    let s = f.step(3, &edge(-60.0), Some(&m3)).expect("frame 3");
+    assert!(s.new_key.is_some(), "{s:?}");
+    assert_eq!(f.key().map(|k| (k.id(), k.partners())), Some((3, 0)));
+}
+
 /// Found by an adversarial review: constraints named key frames by frame
 /// id alone, and frame ids need not be unique over a drive (a front end
 /// that restarts its ids, a fusion reset after a broken chain): a return

@@ -394,6 +394,10 @@ pub struct Fusion<const N: usize, const B: usize, const M: usize> {
     config: FusionConfig,
     key: KeyFrame<N, B>,
     has_key: bool,
+    /// No key frame, but `key` shows the one the last step retired (a
+    /// frame without points could not start the next): [`Fusion::key`]
+    /// until the next step.
+    shows_retired: bool,
     /// The key frame's motion to the last accepted frame.
     chain: Chain,
     last: Option<u32>,
@@ -447,6 +451,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             config,
             key: KeyFrame::new(scale, config.map_min_pairs),
             has_key: false,
+            shows_retired: false,
             chain: Chain::IDENTITY,
             last: None,
             due: false,
@@ -463,6 +468,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         self.processor.reset();
         self.processor.set_config(self.base);
         self.has_key = false;
+        self.shows_retired = false;
         self.chain = Chain::IDENTITY;
         self.last = None;
         self.due = false;
@@ -577,6 +583,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         self.last = Some(id);
         let bounds = StepBounds::of(&self.base);
         self.settle();
+        self.shows_retired = false;
         if !self.has_key {
             self.map.carry(&m.motion, &bounds, true);
             out.new_key = self.start_key(id, frame, KeyReason::First, false);
@@ -725,6 +732,9 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         self.pending = None;
         if !has_points(frame) {
             self.has_key = false;
+            // (`key` keeps the retired key frame's state until the next
+            // step, as with a frame that starts the next key frame.)
+            self.shows_retired = show_retired;
             return None;
         }
         let _ = self.processor.process(frame, None);
@@ -892,9 +902,11 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// after a step that retired a key frame ([`FusionStep::retired`]) and
     /// until the next step, the retired key frame's final state (its
     /// [`KeyFrame::id`] tells): what went into the map, and what the pairs
-    /// made of every point.
+    /// made of every point. That holds also when the retiring frame had no
+    /// points and so started no key frame ([`Fusion::key_id`] is then
+    /// `None`).
     pub fn key(&self) -> Option<&KeyFrame<N, B>> {
-        self.has_key.then_some(&self.key)
+        (self.has_key || self.shows_retired).then_some(&self.key)
     }
 
     /// Point `index` of key-frame boundary `boundary` with its pixel and

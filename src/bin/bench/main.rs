@@ -13,7 +13,8 @@
 //! of up to 256 points): per frame the instructions of the whole fusion
 //! step and of the processor call inside it (the same call replayed on a
 //! copy of the processor), whose difference is the fusion and the road
-//! map's own cost.
+//! map's own cost; the same over a sideways drive whose road map fills
+//! (every retiring key frame then drops the oldest points for room).
 //! `cargo xtask bench` runs it, prints the tables and checks the budgets.
 
 #![no_std]

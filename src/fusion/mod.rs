@@ -555,11 +555,13 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// matched" rule (a frame the clock cut short says nothing about how
     /// much of the key frame is still in view). The fusion's own work after
     /// the matching (one pass over the key frame's points, the map) is not
-    /// cut: it is bounded by the points (`docs/FUSION.md`), so
-    /// leave room for it in the limit: at most 74 instructions a key-frame
-    /// point on the demo drive, 191 with the sight check on
-    /// ([`FusionConfig::with_sight_check`]; 68 232 in its costliest frame
-    /// against 8 141 without).
+    /// cut: it is linear in the key frame's points (`docs/FUSION.md`, "The
+    /// fusion's own work"), so leave room for it in the limit: up to 212
+    /// instructions a key-frame point where a key frame retires into a
+    /// full map (108 545 in one step of `Fusion<256, 2, 512>` on the
+    /// emulated Cortex-M4F), 423 with the sight check on
+    /// ([`FusionConfig::with_sight_check`]); 74 and 191 on the demo drive,
+    /// whose map never fills.
     pub fn step_within<D: Deadline>(
         &mut self,
         id: u32,

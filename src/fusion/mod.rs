@@ -558,7 +558,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// cut: it is linear in the key frame's points (`docs/FUSION.md`, "The
     /// fusion's own work"), so leave room for it in the limit: up to 212
     /// instructions a key-frame point where a key frame retires into a
-    /// full map (108 545 in one step of `Fusion<256, 2, 512>` on the
+    /// full map (108 555 in one step of `Fusion<256, 2, 512>` on the
     /// emulated Cortex-M4F), 423 with the sight check on
     /// ([`FusionConfig::with_sight_check`]); 74 and 191 on the demo drive,
     /// whose map never fills.

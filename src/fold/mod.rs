@@ -319,8 +319,12 @@ fn folds_by_hulls<T, const BOUNDED: bool>(
         (n, true)
     };
     // (A tail of fewer than [`TAIL_MIN`] items is not taken: the passes
-    // then run as without one, which their plain loops do for less.)
-    let tail = if tail.saturating_add(TAIL_MIN) <= n {
+    // then run as without one, which their plain loops do for less. Nor
+    // is one with a window of 0, where an item's own key is in its hull
+    // and the tail's first `stop` would be the item before it.)
+    let tail = if w > 0 && tail.saturating_add(TAIL_MIN) <= n {
+        #[cfg(test)]
+        tests::TAILS.with(|c| c.set(c.get() + 1));
         tail
     } else {
         n
@@ -493,6 +497,11 @@ mod tests {
     use crate::test_rng::Rng;
     extern crate std;
     use std::vec::Vec;
+
+    std::thread_local! {
+        /// Strict tails [`folds_by_hulls`] took on this thread.
+        pub(super) static TAILS: core::cell::Cell<usize> = const { core::cell::Cell::new(0) };
+    }
 
     /// The fold test straight from the keys ([`folds_by_hulls`]) equals
     /// the brute force over the segments on every key sequence with all
@@ -668,18 +677,20 @@ mod tests {
         // the tail (the tail after it only), and the clock stopping the
         // test. Bounded (which takes the tail) equals the plain test and
         // the brute force.
-        let mut tails = 0;
-        for (case, (len, dir, unkeyed)) in [31usize, 32, 33, 40, 90]
+        let (mut tails, mut cut_in_tail) = (0, 0);
+        let cases = [31usize, 32, 33, 40, 90]
             .into_iter()
             .flat_map(|len| [1.0f32, -1.0].map(|d| (len, d)))
             .flat_map(|(len, d)| [None, Some(len / 2), Some(len - 3)].map(|u| (len, d, u)))
-            .enumerate()
-        {
+            .flat_map(|c| [0.3f32, 1.0].map(|h| (c, h)))
+            .flat_map(|c| [w, 1, 0].map(|ww| (c, ww)));
+        for (case, (((len, dir, unkeyed), high), ww)) in cases.enumerate() {
             let e = 1.0e-3;
-            // The head: a zig-zag over [0.1, 0.3], then the tail from 0.2
-            // up by 0.01 a vertex (its first ten within the head's range).
+            // The head: a zig-zag over [0.1, high], then the tail from 0.2
+            // up by 0.01 a vertex (its first items within the head's
+            // range: 10 of them, or 80 with the high head).
             let mut ks: Vec<(f32, f32)> = (0..12)
-                .map(|i| (if i % 2 == 0 { 0.1 } else { 0.3 } + 0.001 * i as f32, e))
+                .map(|i| (if i % 2 == 0 { 0.1 } else { high } + 0.001 * i as f32, e))
                 .collect();
             ks.extend((0..len).map(|i| (0.2 + 0.01 * i as f32, e)));
             for k in ks.iter_mut() {
@@ -694,7 +705,7 @@ mod tests {
             let ivs = intervals(&ks, false);
             let brute = |i: usize, (k, e): (f32, f32)| {
                 ivs.iter().enumerate().any(|(j, iv)| {
-                    let outside = j + w < i || j > i + w - 1;
+                    let outside = j + ww < i || j + 1 > i + ww;
                     outside && iv.is_some_and(|iv| meets(iv, (k - e, k + e), false))
                 })
             };
@@ -706,19 +717,29 @@ mod tests {
             );
             let (mut plain, mut bounded) = (items.clone(), items.clone());
             // The bounded form's items: every one valid (an unkeyed one
-            // too, its key NO_KEY with margin 0), unmarked.
+            // too, its key NO_KEY with margin 0), unmarked. The tail it
+            // takes: the items after the unkeyed one, or all after the
+            // head, if 32 or more, with a window.
+            let taken = TAILS.with(|c| c.get());
             let got = folds_by_hulls::<_, true>(
                 &mut bounded,
                 &margins,
-                (w, 0),
+                (ww, 0),
                 (|it: &(f32, u32)| it.1 == 0, |it| it.0),
                 marks,
                 || false,
             );
+            let tail = unkeyed.map_or(len, |u| len - u - 1);
+            assert_eq!(
+                TAILS.with(|c| c.get()) - taken,
+                usize::from(ww > 0 && tail >= TAIL_MIN),
+                "case {case}: the tail of {tail} taken or not"
+            );
+            tails += TAILS.with(|c| c.get()) - taken;
             let want = folds_by_hulls::<_, false>(
                 &mut plain,
                 &margins,
-                (w, 0),
+                (ww, 0),
                 (|it: &(f32, u32)| it.0.is_finite() && it.1 == 0, |it| it.0),
                 marks,
                 || false,
@@ -733,6 +754,11 @@ mod tests {
                 continue;
             }
             assert_eq!(got, Hulls::Decided, "case {case}");
+            if ww == 0 {
+                // (Every item meets its own key: the same as the plain
+                // test is all that is asked.)
+                continue;
+            }
             let mut folds = 0;
             for (i, (&k, it)) in ks.iter().zip(&bounded).enumerate() {
                 let f = brute(i, k);
@@ -740,16 +766,16 @@ mod tests {
                 assert_eq!(it.1, u32::from(f), "case {case} vertex {i} of {n}");
             }
             assert!(folds > 0, "case {case}: some of the tail's items fold");
-            tails += usize::from(len >= TAIL_MIN);
-            // Stopped by the clock after `q` questions: whatever is marked
-            // folds.
+            // Stopped by the clock after `q` questions (the scan from the
+            // end asks at item 63, the tail's loop at 63 too when its
+            // items fold past it): whatever is marked folds.
             for q in 0..4 {
                 let mut asked = 0;
                 let mut cut = items.clone();
                 let r = folds_by_hulls::<_, true>(
                     &mut cut,
                     &margins,
-                    (w, 0),
+                    (ww, 0),
                     (|it: &(f32, u32)| it.1 == 0, |it| it.0),
                     marks,
                     || {
@@ -763,9 +789,25 @@ mod tests {
                         "case {case} q {q} ({r:?}): vertex {i} marked, does not fold"
                     );
                 }
+                // The long tail under the high head: the second question
+                // is the tail loop's at item 63, and the test stops there,
+                // its folding items from 63 on unmarked.
+                if len == 90 && high > 0.5 && ww == w && q == 1 {
+                    assert_eq!(r, Hulls::Stopped, "case {case}");
+                    let left = (63..n).filter(|&i| {
+                        cut.get(i).is_some_and(|it| it.1 == 0)
+                            && ks.get(i).is_some_and(|&k| brute(i, k))
+                    });
+                    assert!(
+                        left.count() > 20,
+                        "case {case}: not stopped in the tail's loop"
+                    );
+                    cut_in_tail += 1;
+                }
             }
         }
-        assert!(tails >= 6, "{tails} cases with a tail taken");
+        assert!(tails >= 20, "{tails} tails taken");
+        assert_eq!(cut_in_tail, 2, "stopped inside a tail's loop, both ways");
         // A window past every vertex (no run on either side): nothing
         // folds, and no index arithmetic overflows.
         let mut items: Vec<(f32, u32)> = (0..5).map(|i| ((i % 2) as f32, 0)).collect();

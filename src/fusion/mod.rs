@@ -555,13 +555,14 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// matched" rule (a frame the clock cut short says nothing about how
     /// much of the key frame is still in view). The fusion's own work after
     /// the matching (one pass over the key frame's points, the map) is not
-    /// cut: it is linear in the key frame's points (`docs/FUSION.md`, "The
-    /// fusion's own work"), so leave room for it in the limit: up to 212
-    /// instructions a key-frame point where a key frame retires into a
-    /// full map (108 555 in one step of `Fusion<256, 2, 512>` on the
-    /// emulated Cortex-M4F), 423 with the sight check on
-    /// ([`FusionConfig::with_sight_check`]); 74 and 191 on the demo drive,
-    /// whose map never fills.
+    /// cut: it is linear in the key frame's points plus a constant
+    /// (`docs/FUSION.md`, "The fusion's own work"), so leave room for it in
+    /// the limit. Measured on the emulated Cortex-M4F, `Fusion<256, 2,
+    /// 512>`, not a bound: 212 instructions a key-frame point (108 555 a
+    /// step) where a key frame retires into a full map, up to 223 (114 414)
+    /// in an adversarial review's runs; with the sight check on
+    /// ([`FusionConfig::with_sight_check`]) 423, up to 553 (283 190); 74
+    /// and 191 on the demo drive, whose map never fills.
     pub fn step_within<D: Deadline>(
         &mut self,
         id: u32,

@@ -5,7 +5,7 @@
 
 use core::hint::black_box;
 
-use roadstereo::fusion::{Fusion, FusionConfig};
+use roadstereo::fusion::{Fusion, FusionConfig, FusionStep};
 use roadstereo::{Camera, Config, Frame, Motion, Pixel, Status};
 use static_cell::ConstStaticCell;
 
@@ -39,7 +39,6 @@ pub fn fusion_bench() -> bool {
             return false;
         };
         let chained = fw::chained(i, motion);
-        let mut copy = fusion.processor().clone();
         // The stack of one step, on a copy (a retiring frame and the next).
         if i == 8 || i == 9 {
             let mut twin = fusion.clone();
@@ -48,36 +47,16 @@ pub fn fusion_bench() -> bool {
             });
             defmt::info!("fusion_stack frame={=u32} bytes={=u32}", i, bytes);
         }
-        let (result, step_instr) =
-            fw::measure(|| fusion.step(black_box(i), &frame, chained.as_ref()));
-        let Ok(step) = result else {
+        let Some(Measured {
+            step,
+            step_instr,
+            matching,
+            same,
+        }) = measured_step(fusion, i, &frame, motion, &mut key_motion)
+        else {
             return false;
         };
-        let composed = match (key_motion, motion) {
-            (Some(k), Some(m)) => k.then(&m).ok(),
-            (None, m) => m,
-            _ => None,
-        };
-        let matching = match (step.new_key.is_some(), step.paired.is_some(), composed) {
-            (true, false, _) => {
-                copy.reset();
-                fw::measure(|| copy.process(&frame, None).is_ok()).1
-            }
-            // (The pair with its configuration and composition's rounding,
-            // as the fusion gave them.)
-            (last, true, Some(m)) => {
-                fw::measure(|| fusion.replay_pair(&mut copy, &frame, &m, last).is_ok()).1
-            }
-            _ => 0,
-        };
-        key_motion = if step.new_key.is_some() {
-            None
-        } else {
-            composed
-        };
         let points = fw::point_count(fusion.structure());
-        let same =
-            step.paired.is_none() || copy.structure().digest() == fusion.structure().digest();
         let own = step_instr.saturating_sub(matching);
         defmt::info!(
             "fusion frame={=u32} points={=u32} step_instr={=u32} matching_instr={=u32} fusion_instr={=u32} per_point={=u32} paired={=bool} retired={=bool} same_structure={=bool} map={=u32} ok={=u32} folded={=u32}",
@@ -181,36 +160,16 @@ fn sideways(fusion: &mut Fusion<256, 2, 512>, name: &str) -> bool {
             dir = -dir;
         }
         sideways_frame(&mut frame, x);
-        let chained = fw::chained(i, motion);
-        let mut copy = fusion.processor().clone();
-        let (result, step_instr) =
-            fw::measure(|| fusion.step(black_box(i), &frame, chained.as_ref()));
-        let Ok(step) = result else {
+        let Some(Measured {
+            step,
+            step_instr,
+            matching,
+            same,
+        }) = measured_step(fusion, i, &frame, motion, &mut key_motion)
+        else {
             return false;
         };
-        let composed = match (key_motion, motion) {
-            (Some(k), Some(m)) => k.then(&m).ok(),
-            (None, m) => m,
-            _ => None,
-        };
-        let matching = match (step.new_key.is_some(), step.paired.is_some(), composed) {
-            (true, false, _) => {
-                copy.reset();
-                fw::measure(|| copy.process(&frame, None).is_ok()).1
-            }
-            (last, true, Some(m)) => {
-                fw::measure(|| fusion.replay_pair(&mut copy, &frame, &m, last).is_ok()).1
-            }
-            _ => 0,
-        };
-        key_motion = if step.new_key.is_some() {
-            None
-        } else {
-            composed
-        };
         let points = fw::point_count(fusion.structure()) as u32;
-        let same =
-            step.paired.is_none() || copy.structure().digest() == fusion.structure().digest();
         let own = step_instr.saturating_sub(matching);
         defmt::info!(
             "fusion_sideways run={=str} frame={=u32} points={=u32} step_instr={=u32} matching_instr={=u32} fusion_instr={=u32} per_point={=u32} paired={=bool} retired={=bool} entered={=u32} dropped={=u32} same_structure={=bool} map={=u32} ok={=u32}",
@@ -231,6 +190,64 @@ fn sideways(fusion: &mut Fusion<256, 2, 512>, name: &str) -> bool {
         );
     }
     true
+}
+
+/// One step of the fusion measured ([`measured_step`]).
+struct Measured {
+    step: FusionStep,
+    /// The whole step's instructions.
+    step_instr: u32,
+    /// The processor call inside it, replayed on a copy of the processor.
+    matching: u32,
+    /// Whether the replay gave the step's structure.
+    same: bool,
+}
+
+/// Frame `i` through `fusion.step` (with `motion` from frame `i − 1`),
+/// measured, and the processor call inside it replayed on a copy of the
+/// processor as the step made it: a key frame kept without a pair, or the
+/// pair with the motion composed from the key frame (`key_motion`, the
+/// motion from the key frame to the previous frame, updated here) and the
+/// configuration and composition's rounding the fusion gave it. `None` on
+/// a step error.
+fn measured_step(
+    fusion: &mut Fusion<256, 2, 512>,
+    i: u32,
+    frame: &Frame<256, 2>,
+    motion: Option<Motion>,
+    key_motion: &mut Option<Motion>,
+) -> Option<Measured> {
+    let chained = fw::chained(i, motion);
+    let mut copy = fusion.processor().clone();
+    let (result, step_instr) = fw::measure(|| fusion.step(black_box(i), frame, chained.as_ref()));
+    let step = result.ok()?;
+    let composed = match (*key_motion, motion) {
+        (Some(k), Some(m)) => k.then(&m).ok(),
+        (None, m) => m,
+        _ => None,
+    };
+    let matching = match (step.new_key.is_some(), step.paired.is_some(), composed) {
+        (true, false, _) => {
+            copy.reset();
+            fw::measure(|| copy.process(frame, None).is_ok()).1
+        }
+        (last, true, Some(m)) => {
+            fw::measure(|| fusion.replay_pair(&mut copy, frame, &m, last).is_ok()).1
+        }
+        _ => 0,
+    };
+    *key_motion = if step.new_key.is_some() {
+        None
+    } else {
+        composed
+    };
+    let same = step.paired.is_none() || copy.structure().digest() == fusion.structure().digest();
+    Some(Measured {
+        step,
+        step_instr,
+        matching,
+        same,
+    })
 }
 
 /// The demo drive again through `Fusion::step` with the sight check on

@@ -41,6 +41,17 @@ pub struct FoundConfig {
 /// ids from 10 on, in the table's order).
 pub const FOUND_MODELS: u8 = 10;
 
+/// The configuration a twelfth review climbed to (`rev12_a`, `rev12_c`)
+/// and a fifteenth kept (`rev15_c`).
+const REV12_CONFIG: FoundConfig = FoundConfig {
+    e1: 17.411_743,
+    e2: 0.047_549_83,
+    angle: 39.153_034,
+    translation: None,
+    rotation: None,
+    max_depth: 659.2579,
+};
+
 /// Frame pairs adversarial reviews found by hill climbing on the emulated
 /// controller, each run under its own configuration (error model
 /// [`FOUND_MODELS`] + its index) as a probe of the worst-case sweep after
@@ -427,28 +438,14 @@ pub static FOUND: &[Found] = &[
         n: 512,
         data: include_bytes!("../data/rev12_a.bin"),
         camera1: None,
-        config: FoundConfig {
-            e1: 17.411_743,
-            e2: 0.047_549_83,
-            angle: 39.153_034,
-            translation: None,
-            rotation: None,
-            max_depth: 659.2579,
-        },
+        config: REV12_CONFIG,
     },
     Found {
         name: "rev12_c",
         n: 512,
         data: include_bytes!("../data/rev12_c.bin"),
         camera1: None,
-        config: FoundConfig {
-            e1: 17.411_743,
-            e2: 0.047_549_83,
-            angle: 39.153_034,
-            translation: None,
-            rotation: None,
-            max_depth: 659.2579,
-        },
+        config: REV12_CONFIG,
     },
     Found {
         name: "rev12_d",
@@ -511,14 +508,7 @@ pub static FOUND: &[Found] = &[
         n: 512,
         data: include_bytes!("../data/rev15_c.bin"),
         camera1: None,
-        config: FoundConfig {
-            e1: 17.411_743,
-            e2: 0.047_549_83,
-            angle: 39.153_034,
-            translation: None,
-            rotation: None,
-            max_depth: 659.2579,
-        },
+        config: REV12_CONFIG,
     },
 ];
 

@@ -80,8 +80,11 @@
 //! * **Capacity**: a boundary holds at most `M` points and the map at most
 //!   [`MAP_BATCHES`] batches; a retiring key frame makes room by dropping
 //!   the oldest points first (the oldest batch's, in the order they
-//!   entered; any of them already behind count as behind), and leaves out
-//!   its own farthest points beyond `M`.
+//!   entered; any of them already behind count as behind: a batch wholly
+//!   ahead has none, so only those of a batch the camera is passing are
+//!   tested; a batch dropped whole for want of a batch slot counts all its
+//!   live points as dropped for room), and leaves out its own farthest
+//!   points beyond `M`.
 //!
 //! Size: `12·B·M` bytes of points and [`MAP_BATCHES`] batches of
 //! `76 + 4·B` bytes (13 000 bytes in all for `B = 2`, `M = 512`).
@@ -257,6 +260,14 @@ impl Extent {
         hi: f32::NEG_INFINITY,
         reach: 0.0,
     };
+
+    /// The batch's forward extent and reach: the decoded ends are up to
+    /// `2⁻¹²` beyond those of the extent ([`entry_of`]), and the products
+    /// round, so both are widened by `2⁻¹⁰` of the reach.
+    fn widened(&self) -> ((f32, f32), f32) {
+        let reach = self.reach * (1.0 + 1.0 / 1024.0);
+        ((self.lo - reach / 1024.0, self.hi + reach / 1024.0), reach)
+    }
 }
 
 /// The forward axis of the vehicle frame in camera coordinates.
@@ -364,6 +375,49 @@ fn radius(rho: f32, phi: f32, lat: f32, e: &Entry, zf: f32) -> f32 {
     let (x, y) = (e.x.abs() + lat, e.y.abs() + lat);
     let reach = zf * (1.0 + 0.5 * (x * x + y * y));
     (zf * lat + rho + (phi + EVAL_ROUNDING) * reach) * ROUND_UP
+}
+
+/// A retiring point's entry: its key-frame ray `[x, y]` (normalised) and
+/// fused ends, coded outwards ([`DepthScale`]), its forward coordinates
+/// (key frame's vehicle frame, the camera tilted by `tilt`) and reach
+/// (`|P_K|` on the true ray, `lat` the batch's `λ`) taken into `extent`.
+/// `None`: a far end the codes cannot hold, or a distance bound past
+/// [`MAX_REACH`] ([`Retired::unbounded`]).
+#[inline(always)]
+fn entry_of(
+    [x, y]: [f32; 2],
+    (z_near, z_far): (f32, f32),
+    lat: f32,
+    ((ts, tc), scale): ((f32, f32), &DepthScale),
+    extent: &mut Extent,
+) -> Option<Entry> {
+    let (near, far) = (scale.down(z_near), scale.up(z_far).max(1));
+    // The ends as the map decodes them: within `2⁻¹²` of the fused ones
+    // (the caller widens the extent by more), but below `2⁻¹⁵ s` a near end
+    // is code 0, depth 0, and a far end code 1, about `2⁻¹⁵ s` (with a huge
+    // `max_depth` far above the fused one).
+    let zn = if near == 0 { 0.0 } else { z_near };
+    let zf = if far == 1 {
+        scale.depth_inner(1)
+    } else {
+        z_far
+    };
+    // `|P_K|`'s bound on the true ray: past `10³⁰` (a far ray of a
+    // wide-angle camera, or such a scale) the map's `f32` arithmetic could
+    // overflow, so such a point is left out too.
+    let (xl, yl) = (x.abs() + lat, y.abs() + lat);
+    let reach = zf * (1.0 + 0.5 * (xl * xl + yl * yl));
+    // (A NaN fails.)
+    if far == UNBOUNDED || !(reach <= MAX_REACH) {
+        return None;
+    }
+    // Forward coordinate (key frame's vehicle frame) of both ends.
+    let dir = tc - ts * y;
+    let (a, b) = (zn * dir, zf * dir);
+    extent.lo = fmin(extent.lo, fmin(a, b));
+    extent.hi = fmax(extent.hi, fmax(a, b));
+    extent.reach = fmax(extent.reach, reach);
+    Some(Entry { x, y, near, far })
 }
 
 /// The fixed-capacity road map: up to `M` points on each of `B`
@@ -699,7 +753,12 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
 
     /// Free `need` slots on `boundary` by dropping its oldest points;
     /// returns the live points dropped for room (those found behind count
-    /// as behind).
+    /// as behind, [`Self::taken`]).
+    ///
+    /// The slots leave the ring's used part: no reader looks at a slot
+    /// outside a batch's range ([`Self::range`]), and [`Self::enter`]
+    /// writes every slot it gives a batch, so the freed entries are left
+    /// as they are.
     fn free_slots(&mut self, boundary: usize, need: usize) -> u32 {
         let mut dropped = 0u32;
         let mut need = need;
@@ -713,26 +772,9 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             let Some(b) = self.batches.get(slot).copied() else {
                 break;
             };
-            let alive = b.live_on(boundary);
-            let view = View::of(&b, self.tilt);
             let (start, len) = self.range(i, boundary);
             let take = len.min(need);
-            let Some(ring) = self.entries.get_mut(boundary) else {
-                break;
-            };
-            let (mut live, mut behind) = (0u16, 0u16);
-            for j in 0..take {
-                if let Some(e) = ring.get_mut((start + j) % M) {
-                    if alive && e.live() {
-                        if view.behind(e, &self.scale) {
-                            behind += 1;
-                        } else {
-                            live += 1;
-                        }
-                    }
-                    *e = Entry::DEAD;
-                }
-            }
+            let (live, behind) = self.taken(&b, boundary, (start, len, take));
             if let (Some(b), Some(t), Some(u), Some(c)) = (
                 self.batches.get_mut(slot),
                 self.tail.get_mut(boundary),
@@ -754,6 +796,54 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             need -= take;
         }
         dropped
+    }
+
+    /// Of the first `take` of batch `b`'s `len` slots on `boundary` (from
+    /// ring slot `start`), the live points ahead of the camera and those
+    /// behind it ([`View::behind`]). A batch wholly ahead
+    /// ([`View::whole`], the bound the sweep skips it by) has none behind:
+    /// `Ahead` bounds every stick end's forward coordinate below by `0`,
+    /// the extent's widening (`2⁻¹⁰` of the reach) covering the codes'
+    /// rounding (`2⁻¹²` of a depth) and the evaluation's (a few `2⁻²⁴` of
+    /// the reach, as `|g0|` is at most about twice the reach where the
+    /// bound is near 0), while `behind` asks for the **largest** end plus a
+    /// positive radius below 0 (`a_batch_wholly_ahead_has_no_point_behind`
+    /// checks both at the edge of `Ahead`). So its live points are counted
+    /// without their tests, all of them at once when the whole of it goes
+    /// (its live count): making room in a map the camera is not passing
+    /// costs `O(1)` a batch. A batch the camera is passing has each taken
+    /// point tested, as before.
+    fn taken(
+        &self,
+        b: &Batch<B>,
+        boundary: usize,
+        (start, len, take): (usize, usize, usize),
+    ) -> (u16, u16) {
+        let batch_live = b.live.get(boundary).copied().unwrap_or(0);
+        if batch_live == 0 {
+            return (0, 0);
+        }
+        let view = View::of(b, self.tilt);
+        let ahead = matches!(view.whole(b), Whole::Ahead);
+        if ahead && take == len {
+            return (batch_live, 0);
+        }
+        let Some(ring) = self.entries.get(boundary) else {
+            return (0, 0);
+        };
+        let (mut live, mut behind) = (0u16, 0u16);
+        for j in 0..take {
+            if let Some(e) = ring.get((start + j) % M) {
+                if e.live() {
+                    if !ahead && view.behind(e, &self.scale) {
+                        behind += 1;
+                    } else {
+                        live += 1;
+                    }
+                }
+            }
+        }
+        (live, behind)
     }
 
     /// Put a retiring key frame's fused points into the map: the points
@@ -835,11 +925,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             }
             out.entered += n as u32;
         }
-        // The decoded ends are up to 2⁻¹² beyond those of the extent
-        // (`enter`), and the products round: widened by 2⁻¹⁰ of the reach.
-        let reach = extent.reach * (1.0 + 1.0 / 1024.0);
-        batch.forward = (extent.lo - reach / 1024.0, extent.hi + reach / 1024.0);
-        batch.reach = reach;
+        (batch.forward, batch.reach) = extent.widened();
         let slot = self.slot(usize::from(self.count));
         if let Some(b) = self.batches.get_mut(slot) {
             *b = batch;
@@ -886,7 +972,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         extent: &mut Extent,
     ) -> (usize, u32) {
         let min_pairs = key.min_pairs();
-        let (ts, tc) = self.tilt;
+        let tilt = self.tilt;
         let (cam, scale) = (s.camera1(), self.scale);
         let start = self.tail.get(k).map_or(0, |&t| usize::from(t))
             + self.used.get(k).map_or(0, |&u| usize::from(u));
@@ -895,51 +981,27 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         };
         let (mut n, mut unbounded) = (0usize, 0u32);
         let (cells, points) = (key.cells(k), results.points());
-        // From one admitted point to the next (a tight scan: most are not).
         let mut at = 0;
         while n < w {
-            let Some(skip) = cells
-                .get(at..)
-                .and_then(|rest| rest.iter().position(|c| c.admitted(min_pairs)))
-            else {
-                break;
-            };
-            at += skip;
+            // The next admitted point (a tight scan: on most drives most
+            // are not).
+            while cells.get(at).is_some_and(|c| !c.admitted(min_pairs)) {
+                at += 1;
+            }
             let (Some(c), Some(r)) = (cells.get(at), points.get(at)) else {
                 break;
             };
             at += 1;
-            let [x, y] = cam.normalise(r.pixel1());
-            let (z_near, z_far) = c.ends();
-            let (near, far) = (scale.down(z_near), scale.up(z_far).max(1));
-            // The ends as the map decodes them: within `2⁻¹²` of the fused
-            // ones (the caller widens the extent by more), but below `2⁻¹⁵
-            // s` a near end is code 0, depth 0, and a far end code 1, about
-            // `2⁻¹⁵ s` (with a huge `max_depth` far above the fused one).
-            let zn = if near == 0 { 0.0 } else { z_near };
-            let zf = if far == 1 {
-                scale.depth_inner(1)
-            } else {
-                z_far
-            };
-            // `|P_K|`'s bound on the true ray: past `10³⁰` (a far ray of a
-            // wide-angle camera, or such a scale) the map's `f32`
-            // arithmetic could overflow, so such a point is left out too.
-            let (xl, yl) = (x.abs() + lat, y.abs() + lat);
-            let reach = zf * (1.0 + 0.5 * (xl * xl + yl * yl));
-            // (A NaN fails.)
-            if far == UNBOUNDED || !(reach <= MAX_REACH) {
+            let Some(e) = entry_of(
+                cam.normalise(r.pixel1()),
+                c.ends(),
+                lat,
+                (tilt, &scale),
+                extent,
+            ) else {
                 unbounded += 1;
                 continue;
-            }
-            let e = Entry { x, y, near, far };
-            // Forward coordinate (key frame's vehicle frame) of both
-            // ends.
-            let dir = tc - ts * y;
-            let (a, b) = (zn * dir, zf * dir);
-            extent.lo = fmin(extent.lo, fmin(a, b));
-            extent.hi = fmax(extent.hi, fmax(a, b));
-            extent.reach = fmax(extent.reach, reach);
+            };
             if let Some(slot) = ring.get_mut((start + n) % M) {
                 *slot = e;
             }
@@ -973,5 +1035,130 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         }
         eat(self.drops.behind);
         eat(self.drops.capacity);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_rng::Rng;
+
+    const M: usize = 64;
+
+    /// A batch of random sticks (rays to ±1, depths 0.01–1000 with near
+    /// and far equal to 4 times apart, `λ` 0 or up to 10⁻³, tilt to
+    /// ±17°) posed by a rotation near the identity or up to ±0.25 rad, its
+    /// key-frame camera placed along the forward axis within `10⁻⁶` of
+    /// where [`View::whole`] stops saying `Ahead` (one case in four up to
+    /// the reach short of it: the camera passing the batch).
+    fn batch_at_the_edge(g: &mut Rng, case: usize) -> (RoadMap<1, M>, Batch<1>, usize) {
+        let scale = DepthScale::for_max_depth(1000.0);
+        let (ts, tc) = crate::math::sin_cos((g.next() - 0.5) * 0.6);
+        let spread = if case.is_multiple_of(2) { 1e-6 } else { 0.5 };
+        let angles = [0; 3].map(|_| (g.next() - 0.5) * spread);
+        let a = Motion::new([0.0, 0.0, 1.0], angles)
+            .expect("angles")
+            .rotation_matrix();
+        let lat = if case.is_multiple_of(3) {
+            0.0
+        } else {
+            g.next() * 1e-3
+        };
+        let mut map = RoadMap::<1, M>::new((ts, tc), scale);
+        let mut extent = Extent::EMPTY;
+        let mut m = 0;
+        for _ in 0..1 + (g.next() * 63.0) as usize {
+            let ray = [(g.next() - 0.5) * 2.0, (g.next() - 0.5) * 2.0];
+            let z_near = 0.01 + 999.0 * g.next() * g.next() * g.next();
+            let z_far = z_near * (1.0 + 3.0 * g.next() * g.next() * g.next());
+            let e = entry_of(ray, (z_near, z_far), lat, ((ts, tc), &scale), &mut extent);
+            if let Some(e) = e {
+                map.entries[0][m] = e;
+                m += 1;
+            }
+        }
+        let (forward, reach) = extent.widened();
+        let (rho, phi) = if case.is_multiple_of(5) {
+            (g.next() * 0.1, g.next() * 1e-3)
+        } else {
+            (0.0, 0.0)
+        };
+        let mut batch = Batch::<1> {
+            a,
+            b: [0.0; 3],
+            rho,
+            phi,
+            lat,
+            key: case as u32,
+            len: [m as u16],
+            live: [m as u16],
+            forward,
+            reach,
+        };
+        // `forward.0 + g0 − dg reach ≥ 0` is `Ahead`; `g0 = w · b`.
+        let edge = View::of(&batch, (ts, tc)).dg * reach - forward.0;
+        let off = if case % 4 == 3 {
+            // Well into `Passing`: some points behind.
+            edge - g.next() * reach
+        } else {
+            edge * (1.0 + (g.next() - 0.5) * 1e-6) + (g.next() - 0.5) * 1e-6 * reach
+        };
+        batch.b = forward_axis((ts, tc)).map(|w| w * off);
+        map.batches[0] = batch;
+        map.count = 1;
+        map.used[0] = m as u16;
+        (map, batch, m)
+    }
+
+    /// [`RoadMap::taken`] counts a batch wholly ahead without testing its
+    /// points: sound only if no point of such a batch is behind. Near the
+    /// edge of `Ahead`, every decoded stick end of a batch said to be
+    /// wholly ahead has a forward coordinate of at least 0 as `f32`
+    /// evaluates it (so [`View::behind`], which asks for the largest one
+    /// plus the radius below 0, is false), and `taken` gives what the
+    /// point-by-point test gives, whole and in part. (Without the extent's
+    /// widening by `2⁻¹⁰` of the reach, which covers the codes' rounding,
+    /// the first check fails.)
+    #[test]
+    fn a_batch_wholly_ahead_has_no_point_behind() {
+        let mut g = Rng(0x5EED_4A11);
+        let (mut ahead, mut closest, mut behind) = (0usize, f32::INFINITY, 0usize);
+        for case in 0..20_000 {
+            let (map, batch, m) = batch_at_the_edge(&mut g, case);
+            if m == 0 {
+                continue;
+            }
+            let view = View::of(&batch, map.tilt);
+            let is_ahead = matches!(view.whole(&batch), Whole::Ahead);
+            let ring = &map.entries[0];
+            if is_ahead {
+                ahead += 1;
+                for e in &ring[..m] {
+                    let dir = view.g[0] * e.x + view.g[1] * e.y + view.g[2];
+                    for z in [map.scale.depth(e.near), map.scale.depth_inner(e.far)] {
+                        let fwd = dir * z + view.g0;
+                        assert!(fwd >= 0.0, "case {case}: {fwd} {e:?} {batch:?}");
+                        closest = closest.min(fwd / batch.reach);
+                    }
+                    assert!(!view.behind(e, &map.scale), "case {case}");
+                }
+            }
+            for take in [m, m / 2, 1] {
+                let brute = ring[..take].iter().fold((0u16, 0u16), |(l, b), e| {
+                    match (e.live(), view.behind(e, &map.scale)) {
+                        (false, _) => (l, b),
+                        (true, false) => (l + 1, b),
+                        (true, true) => (l, b + 1),
+                    }
+                });
+                assert_eq!(map.taken(&batch, 0, (0, m, take)), brute, "case {case}");
+                behind += usize::from(brute.1);
+            }
+        }
+        // Most cases land on the `Ahead` side, some point of them within
+        // the widening (`2⁻¹⁰` of the reach) of the edge: the test looks
+        // where the bound is tight.
+        assert!(ahead > 5_000 && behind > 1_000, "{ahead} {behind}");
+        assert!(closest < 1.0 / 1024.0, "{closest}");
     }
 }

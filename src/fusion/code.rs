@@ -22,6 +22,9 @@ const EXP_BASE: u32 = 127 - 15;
 const EXP_SPAN: u32 = 16;
 /// The unbounded far end.
 pub(crate) const UNBOUNDED: u16 = 0xFFFF;
+/// `EXP_BASE · 2¹²`: a positive `z/s`'s bits shifted right by 11, less
+/// this, are its code (before the range's clamp).
+const CODE_BASE: i32 = (EXP_BASE << 12) as i32;
 
 /// The power of two `s` the codes are relative to, and its inverse.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -62,50 +65,36 @@ impl DepthScale {
     }
 
     /// The code of a near end: the largest code not above `z`.
+    ///
+    /// For `z > 0`, `(z/s)`'s bits shifted right by 11 are `e · 2¹² + m`
+    /// (the sign bit is 0), so the code is that less `EXP_BASE · 2¹²`,
+    /// clamped to `[0, UNBOUNDED − 1]`: below `2⁻¹⁵ s` (and an underflow
+    /// to 0) code 0, from `2 s` on (and infinity) the top code of a near
+    /// end. No branch on the exponent.
     #[inline]
     pub(crate) fn down(&self, z: f32) -> u16 {
         // (A NaN fails the comparison.)
         if !(z > 0.0) {
             return 0;
         }
-        let b = (z * self.inv).to_bits();
-        let e = b >> 23;
-        if e < EXP_BASE {
-            return 0;
-        }
-        if e >= EXP_BASE + EXP_SPAN {
-            return UNBOUNDED - 1;
-        }
-        // The top code is the unbounded far end: a near end just below 2 s
-        // takes the one below it.
-        let code = ((e - EXP_BASE) << 12) | ((b >> 11) & 0xFFF);
-        if code >= u32::from(UNBOUNDED) {
-            UNBOUNDED - 1
-        } else {
-            code as u16
-        }
+        let c = ((z * self.inv).to_bits() >> 11) as i32 - CODE_BASE;
+        c.clamp(0, i32::from(UNBOUNDED - 1)) as u16
     }
 
-    /// The code of a far end: the smallest code not below `z`.
+    /// The code of a far end: the smallest code not below `z` (at least 1
+    /// for `z > 0`: code 0 stands for depth 0). As [`Self::down`], plus one
+    /// where any of the 11 bits cut is set, clamped to `[1, UNBOUNDED]`.
+    /// (Until a twentieth session's rewrite the exponent's tests gave code
+    /// 0 to `z = 2⁻¹⁵ s` exactly, a far end rounded down to depth 0;
+    /// `codes_agree_with_their_definition` checks every exponent.)
     #[inline]
     pub(crate) fn up(&self, z: f32) -> u16 {
         if !(z > 0.0) {
             return if z.is_nan() { UNBOUNDED } else { 0 };
         }
         let b = (z * self.inv).to_bits();
-        let e = b >> 23;
-        if e < EXP_BASE {
-            return 1;
-        }
-        if e >= EXP_BASE + EXP_SPAN {
-            return UNBOUNDED;
-        }
-        let code = (((e - EXP_BASE) << 12) | ((b >> 11) & 0xFFF)) + u32::from(b & 0x7FF != 0);
-        if code >= u32::from(UNBOUNDED) {
-            UNBOUNDED
-        } else {
-            code as u16
-        }
+        let c = (b >> 11) as i32 - CODE_BASE + i32::from(b & 0x7FF != 0);
+        c.clamp(1, i32::from(UNBOUNDED)) as u16
     }
 
     /// The depth a code stands for (0 for code 0, infinity for
@@ -169,6 +158,79 @@ mod tests {
                 assert!(z >= prev.0 && lo >= prev.1 && hi >= prev.2);
                 prev = (z, lo, hi);
             }
+        }
+    }
+
+    /// The codes as first written, exponent and mantissa apart, with the
+    /// far end's one fix: a positive `z` never codes 0.
+    fn reference(sc: &DepthScale, z: f32) -> (u16, u16) {
+        const EXP_SPAN: u32 = 16;
+        let down = if !(z > 0.0) {
+            0
+        } else {
+            let b = (z * sc.inv).to_bits();
+            let e = b >> 23;
+            if e < EXP_BASE {
+                0
+            } else if e >= EXP_BASE + EXP_SPAN {
+                UNBOUNDED - 1
+            } else {
+                let code = ((e - EXP_BASE) << 12) | ((b >> 11) & 0xFFF);
+                code.min(u32::from(UNBOUNDED) - 1) as u16
+            }
+        };
+        let up = if !(z > 0.0) {
+            if z.is_nan() {
+                UNBOUNDED
+            } else {
+                0
+            }
+        } else {
+            let b = (z * sc.inv).to_bits();
+            let e = b >> 23;
+            if e < EXP_BASE {
+                1
+            } else if e >= EXP_BASE + EXP_SPAN {
+                UNBOUNDED
+            } else {
+                let code =
+                    (((e - EXP_BASE) << 12) | ((b >> 11) & 0xFFF)) + u32::from(b & 0x7FF != 0);
+                code.clamp(1, u32::from(UNBOUNDED)) as u16
+            }
+        };
+        (down, up)
+    }
+
+    /// The clamped codes against [`reference`] for every exponent of
+    /// `z/s` (all 256, both signs) with the mantissa's edges and random
+    /// mantissas, and NaN, for three scales; and the edge the first codes
+    /// got wrong: `2⁻¹⁵ s`, whose far end coded 0 (depth 0).
+    #[test]
+    fn codes_agree_with_their_definition() {
+        let mut g = Rng(0x0C0D_E5ED);
+        for max_depth in [1000.0f32, 1.0, 3.0e5, 1e-30, 1e30] {
+            let sc = DepthScale::for_max_depth(max_depth);
+            for sign in [0u32, 1 << 31] {
+                for e in 0..256u32 {
+                    let mut ms = [0, 1, 0x7FF, 0x800, 0x7F_F800, 0x7F_FFFF, 0x40_0000, 0];
+                    for m in 0..200 {
+                        let r = (g.next() * 8_388_608.0) as u32 & 0x7F_FFFF;
+                        let m = [r, r & !0x7FF, r | 0x7FF][m % 3];
+                        ms[7] = m;
+                        for m in ms {
+                            let q = f32::from_bits(sign | e << 23 | m);
+                            // `z = q·s` (exact but at the ends of the range).
+                            let z = q * sc.scale();
+                            assert_eq!((sc.down(z), sc.up(z)), reference(&sc, z), "{z:e}");
+                        }
+                    }
+                }
+            }
+            let edge = sc.scale() * 2f32.powi(-15);
+            assert_eq!((sc.down(edge), sc.up(edge)), (0, 1));
+            assert!(sc.depth(sc.up(edge)) >= edge);
+            let nan = f32::NAN;
+            assert_eq!((sc.down(nan), sc.up(nan)), (0, UNBOUNDED));
         }
     }
 

@@ -18,8 +18,6 @@
 
 /// Smallest exponent (biased) of `z/s` with a code of its own: `2⁻¹⁵`.
 const EXP_BASE: u32 = 127 - 15;
-/// Exponents from `EXP_BASE` to `EXP_BASE + 15`: `z/s` below 2.
-const EXP_SPAN: u32 = 16;
 /// The unbounded far end.
 pub(crate) const UNBOUNDED: u16 = 0xFFFF;
 /// `EXP_BASE · 2¹²`: a positive `z/s`'s bits shifted right by 11, less
@@ -164,6 +162,7 @@ mod tests {
     /// The codes as first written, exponent and mantissa apart, with the
     /// far end's one fix: a positive `z` never codes 0.
     fn reference(sc: &DepthScale, z: f32) -> (u16, u16) {
+        // Exponents from `EXP_BASE` to `EXP_BASE + 15`: `z/s` below 2.
         const EXP_SPAN: u32 = 16;
         let down = if !(z > 0.0) {
             0

@@ -809,10 +809,12 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
     /// bound is near 0), while `behind` asks for the **largest** end plus a
     /// positive radius below 0 (`a_batch_wholly_ahead_has_no_point_behind`
     /// checks both at the edge of `Ahead`). So its live points are counted
-    /// without their tests, all of them at once when the whole of it goes
-    /// (its live count): making room in a map the camera is not passing
-    /// costs `O(1)` a batch. A batch the camera is passing has each taken
-    /// point tested, as before.
+    /// without their tests: all of them at once when the whole of it goes
+    /// (its live count), or when none of its slots was dropped (every
+    /// taken one live); otherwise one look a taken slot. Making room in a
+    /// map the camera is not passing costs `O(1)` a batch, unless the sweep
+    /// dropped some of its points. A batch the camera is passing has each
+    /// taken point tested, as before.
     fn taken(
         &self,
         b: &Batch<B>,
@@ -827,6 +829,10 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         let ahead = matches!(view.whole(b), Whole::Ahead);
         if ahead && take == len {
             return (batch_live, 0);
+        }
+        if ahead && usize::from(batch_live) == len {
+            // (Every slot of the batch live: so are the taken ones.)
+            return (take as u16, 0);
         }
         let Some(ring) = self.entries.get(boundary) else {
             return (0, 0);
@@ -1050,7 +1056,8 @@ mod tests {
     /// ±17°) posed by a rotation near the identity or up to ±0.25 rad, its
     /// key-frame camera placed along the forward axis within `10⁻⁶` of
     /// where [`View::whole`] stops saying `Ahead` (one case in four up to
-    /// the reach short of it: the camera passing the batch).
+    /// the reach short of it: the camera passing the batch; one in seven
+    /// with some points dropped).
     fn batch_at_the_edge(g: &mut Rng, case: usize) -> (RoadMap<1, M>, Batch<1>, usize) {
         let scale = DepthScale::for_max_depth(1000.0);
         let (ts, tc) = crate::math::sin_cos((g.next() - 0.5) * 0.6);
@@ -1104,6 +1111,15 @@ mod tests {
             edge * (1.0 + (g.next() - 0.5) * 1e-6) + (g.next() - 0.5) * 1e-6 * reach
         };
         batch.b = forward_axis((ts, tc)).map(|w| w * off);
+        if case % 7 == 6 {
+            // Some points dropped already (by the sweep, say).
+            for e in map.entries[0].iter_mut().take(m) {
+                if g.next() < 0.3 {
+                    *e = Entry::DEAD;
+                    batch.live[0] -= 1;
+                }
+            }
+        }
         map.batches[0] = batch;
         map.count = 1;
         map.used[0] = m as u16;
@@ -1133,7 +1149,7 @@ mod tests {
             let ring = &map.entries[0];
             if is_ahead {
                 ahead += 1;
-                for e in &ring[..m] {
+                for e in ring[..m].iter().filter(|e| e.live()) {
                     let dir = view.g[0] * e.x + view.g[1] * e.y + view.g[2];
                     for z in [map.scale.depth(e.near), map.scale.depth_inner(e.far)] {
                         let fwd = dir * z + view.g0;

@@ -85,14 +85,19 @@ pub fn fusion_bench() -> bool {
     fusion.reset_with(POLICY.with_sight_check(true));
     let sighted = fusion_sighted(fusion);
     // The sideways drives, with the default policy and with the sight
-    // check on.
+    // check on, and turning as it goes.
     let mut sideways_ok = true;
-    for (name, policy) in [
-        ("default", FusionConfig::DEFAULT),
-        ("sight_check", FusionConfig::DEFAULT.with_sight_check(true)),
+    for (name, policy, yaw) in [
+        ("default", FusionConfig::DEFAULT, 0.0),
+        (
+            "sight_check",
+            FusionConfig::DEFAULT.with_sight_check(true),
+            0.0,
+        ),
+        ("turning", FusionConfig::DEFAULT, TURN),
     ] {
         fusion.reset_with(policy);
-        sideways_ok &= sideways(fusion, name);
+        sideways_ok &= sideways(fusion, name, yaw);
     }
     fusion.reset_with(POLICY);
     counted && sighted && sideways_ok
@@ -100,18 +105,21 @@ pub fn fusion_bench() -> bool {
 
 /// The frames of [`sideways`]: the camera of the fusion examples (800 px,
 /// 512 × 480, level) at `x` across a straight road whose two edges lie on
-/// the ground 1.2 below it at `X = ±0.6`, seen on image rows 250 … 478
-/// (256 points a boundary, depths 4.3 to 80).
-fn sideways_frame(frame: &mut Frame<256, 2>, x: f32) {
+/// the ground 1.2 below it at `X = ±0.6`, turned by `yaw` about its
+/// vertical axis, seen on image rows 250 … 478 (256 points a boundary,
+/// depths 4.3 to 80).
+fn sideways_frame(frame: &mut Frame<256, 2>, x: f32, yaw: f32) {
     frame.clear();
     let cam = *frame.camera();
+    let (s, c) = sin_cos_small(yaw);
     for edge in [-0.6f32, 0.6] {
         let mut pts = [Pixel::new(0.0, 0.0); 256];
         let mut m = 0;
         for i in 0..256u16 {
             let v = 250.0 + 228.0 * f32::from(i) / 255.0;
             let z = cam.fy() * 1.2 / (v - cam.cy());
-            let u = cam.cx() + cam.fx() * (edge - x) / z;
+            // (World `X − x = c x_c + s z`: the camera's `x_c` at depth `z`.)
+            let u = cam.cx() + cam.fx() * (edge - x - s * z) / (c * z);
             if (0.0..=511.0).contains(&u) {
                 if let Some(p) = pts.get_mut(m) {
                     *p = Pixel::new(u, v);
@@ -131,6 +139,21 @@ fn sideways_frame(frame: &mut Frame<256, 2>, x: f32) {
 /// Frames of the sideways drive.
 const SIDEWAYS_FRAMES: u32 = 80;
 
+/// The sine and cosine of a small angle (the drive's turns, `|x| ≤ 0.1`:
+/// Taylor to `x⁷`, within `10⁻¹²`) for the generator (the library's own
+/// are crate-private; `libm` is not a firmware dependency).
+fn sin_cos_small(x: f32) -> (f32, f32) {
+    let x2 = x * x;
+    let s = x * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)));
+    let c = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0));
+    (s, c)
+}
+
+/// The turning sideways drive's turn a frame (radians; about its vertical
+/// axis, turning back with the motion every 8 frames: up to 0.04 from a key
+/// frame, an adversarial review's, issue 13).
+const TURN: f32 = 0.005;
+
 /// A drive where the road map fills (an adversarial review's, issue 13):
 /// the camera moves sideways (`W = 0`: the epipolar lines are the image
 /// rows) 0.05 a frame, turning back every 8 frames, so almost every point
@@ -140,26 +163,31 @@ const SIDEWAYS_FRAMES: u32 = 80;
 /// drops the oldest points for room. Per frame the step, the processor
 /// call inside it (replayed as [`fusion_bench`] does) and the difference:
 /// the fusion's and the map's own work, which the demo drive, whose map
-/// never fills, does not show at its worst.
-fn sideways(fusion: &mut Fusion<256, 2, 512>, name: &str) -> bool {
+/// never fills, does not show at its worst. With `yaw` the camera also
+/// turns that much a frame, back and forth with the motion: the map's
+/// older batches are then seen turned from their key frames.
+fn sideways(fusion: &mut Fusion<256, 2, 512>, name: &str, yaw: f32) -> bool {
     let Ok(camera) = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480) else {
         return false;
     };
     let mut frame = Frame::<256, 2>::new(camera);
-    let (mut x, mut dir) = (0.0f32, 1.0f32);
+    let (mut x, mut psi, mut dir) = (0.0f32, 0.0f32, 1.0f32);
     let mut key_motion: Option<Motion> = None;
     for i in 0..SIDEWAYS_FRAMES {
         let motion = if i == 0 {
             None
         } else {
-            let t = 0.05 * dir;
+            // The world step `(t, 0, 0)` in the camera's axes, then its turn.
+            let (t, turn) = (0.05 * dir, yaw * dir);
+            let (s, c) = sin_cos_small(psi);
             x += t;
-            Motion::new([t, 0.0, 0.0], [0.0; 3]).ok()
+            psi += turn;
+            Motion::new([c * t, 0.0, s * t], [0.0, turn, 0.0]).ok()
         };
         if i > 0 && i % 8 == 0 {
             dir = -dir;
         }
-        sideways_frame(&mut frame, x);
+        sideways_frame(&mut frame, x, psi);
         let Some(Measured {
             step,
             step_instr,

@@ -87,8 +87,9 @@
 //!   points beyond `M`.
 //!
 //! Size: `12·B·M` bytes of points and [`MAP_BATCHES`] batches of
-//! `76 + 4·B` bytes (13 000 bytes in all for `B = 2`, `M = 512`).
+//! `88 + 4·B` bytes (13 096 bytes in all for `B = 2`, `M = 512`).
 
+use crate::camera::{Camera, IMAGE_MARGIN_PX};
 use crate::fusion::code::{DepthScale, UNBOUNDED};
 use crate::fusion::{norm1, Chain, KeyFrame, StepBounds, STEP_ROUNDING};
 use crate::geometry::Sample;
@@ -106,8 +107,9 @@ pub const SWEEP_PER_FRAME: usize = 32;
 /// Rounding allowance of a bound's arithmetic.
 const ROUND_UP: f32 = 1.0 + 1.0 / 65_536.0;
 
-/// The largest `|P_K|` bound a map point may have (its coordinates, the
-/// radius and the sweep's bounds then stay finite; [`Retired::unbounded`]).
+/// The largest `|P_K|` bound a map point may have, its far end times its
+/// camera's ray bound ([`ray_bound`]): its coordinates, the radius and the
+/// sweep's bounds then stay finite ([`Retired::unbounded`]).
 const MAX_REACH: f32 = 1.0e30;
 
 /// The `f32` rounding of a map point's evaluation, relative to `|P_K|`
@@ -244,9 +246,9 @@ pub struct Retired {
     /// Points left out: admitted, but with a far end beyond what the map's
     /// depth codes hold (about twice `Config::max_depth`: a range
     /// constraint or a stick reaching that far), which would be an
-    /// unbounded stick in the map, or so far along a steep ray (a distance
-    /// bound past `10³⁰`, with a huge `max_depth`) that the map's `f32`
-    /// arithmetic could overflow.
+    /// unbounded stick in the map, or so far (a distance bound past `10³⁰`
+    /// along the camera's steepest ray, with a huge `max_depth`) that the
+    /// map's `f32` arithmetic could overflow.
     pub unbounded: u32,
     /// Older points dropped to make room (also in [`MapDrops::capacity`]).
     pub dropped: u32,
@@ -255,37 +257,61 @@ pub struct Retired {
     pub unfit: u32,
 }
 
-/// A retiring batch's bounds over its points' ends ([`Batch`]'s `dir`,
-/// `ray`, `depth`, `reach`), before the coding's widening.
+/// A retiring batch's bounds over its points: the smallest and largest
+/// normalised `y` of a ray, and depth of an end, before the coding's
+/// widening.
 #[derive(Debug, Clone, Copy)]
 struct Extent {
-    dir: (f32, f32),
-    ray: f32,
+    y: (f32, f32),
     depth: (f32, f32),
-    reach: f32,
 }
 
 impl Extent {
     const EMPTY: Self = Self {
-        dir: (f32::INFINITY, f32::NEG_INFINITY),
-        ray: 0.0,
+        y: (f32::INFINITY, f32::NEG_INFINITY),
         depth: (f32::INFINITY, f32::NEG_INFINITY),
-        reach: 0.0,
     };
 
-    /// Into `b`, widened for the coding: a decoded depth is within `2⁻¹²`
-    /// of the one the extent took ([`entry_of`]), so the depths are widened
-    /// by `2⁻¹¹` of themselves; the reach by `2⁻¹⁰` (it bounds the radius's
-    /// rest, [`View`], and the products round).
-    fn widen_into<const B: usize>(&self, b: &mut Batch<B>) {
-        b.dir = self.dir;
-        b.ray = self.ray;
+    /// Into `b`, with its points' ray bound `ray` ([`ray_bound`]) and the
+    /// camera's tilt (sine and cosine), widened for the coding: a decoded
+    /// depth is within `2⁻¹²` of the one the extent took ([`entry_of`]), so
+    /// the depths are widened by `2⁻¹¹` of themselves; the reach, `ray`
+    /// times the largest depth, by `2⁻¹⁰` (it bounds the radius's rest,
+    /// [`View`], and the products round). A ray's forward rate, `w · (x,
+    /// y, 1)` or `cos − sin · y`, is monotone in `y`, and so is its `f32`
+    /// value (rounding is monotone): the rates at the two ends of the `y`
+    /// range are the smallest and largest of the batch's, as each point's
+    /// would be computed. (Nothing for an empty extent: a batch without
+    /// points is never bounded.)
+    fn widen_into<const B: usize>(&self, ray: f32, (ts, tc): (f32, f32), b: &mut Batch<B>) {
+        if !(self.y.0 <= self.y.1) {
+            return;
+        }
+        let (d0, d1) = (tc - ts * self.y.0, tc - ts * self.y.1);
+        b.dir = (fmin(d0, d1), fmax(d0, d1));
+        b.ray = ray;
         b.depth = (
             self.depth.0 * (1.0 - 1.0 / 2048.0),
             self.depth.1 * (1.0 + 1.0 / 2048.0),
         );
-        b.reach = self.reach * (1.0 + 1.0 / 1024.0);
+        b.reach = self.depth.1 * ray * (1.0 + 1.0 / 1024.0);
     }
+}
+
+/// An upper bound `c` of `1 + ½((|x| + λ)² + (|y| + λ)²)` over every pixel
+/// `cam`'s image (with its margin, [`crate::IMAGE_MARGIN_PX`]) can hold, in
+/// normalised coordinates `(x, y)`, `λ = lat`: so of every key-frame ray's
+/// `|(x, y, 1)|` (`√(1 + u) ≤ 1 + u/2`) and, times its far end, of a
+/// point's `|P_K|` on the true ray ([`radius`]). A batch's points are that
+/// camera's pixels (`Frame::push_boundary` refuses any other), so one
+/// bound serves them all: no per-point maximum. Rounded up by `2⁻¹⁶`
+/// (the normalisation's and the sum's rounding).
+fn ray_bound(cam: &Camera, lat: f32) -> f32 {
+    let m = IMAGE_MARGIN_PX;
+    let dx = fmax(cam.cx() + m, f32::from(cam.width()) - 1.0 + m - cam.cx());
+    let dy = fmax(cam.cy() + m, f32::from(cam.height()) - 1.0 + m - cam.cy());
+    let (x, y) = (dx / cam.fx() + lat, dy / cam.fy() + lat);
+    (1.0 + 0.5 * (x * x + y * y)) * ROUND_UP
 }
 
 /// The forward axis of the vehicle frame in camera coordinates.
@@ -432,17 +458,16 @@ fn radius(rho: f32, phi: f32, lat: f32, e: &Entry, zf: f32) -> f32 {
 }
 
 /// A retiring point's entry: its key-frame ray `[x, y]` (normalised) and
-/// fused ends, coded outwards ([`DepthScale`]), its forward coordinates
-/// (key frame's vehicle frame, the camera tilted by `tilt`) and reach
-/// (`|P_K|` on the true ray, `lat` the batch's `λ`) taken into `extent`.
-/// `None`: a far end the codes cannot hold, or a distance bound past
-/// [`MAX_REACH`] ([`Retired::unbounded`]).
+/// fused ends, coded outwards ([`DepthScale`]), its `y` and its depths
+/// taken into `extent`. `None`: a far end the codes cannot hold, or one past
+/// `max_far`, [`MAX_REACH`] over the batch's ray bound ([`ray_bound`]; the
+/// distance bound past `MAX_REACH`, [`Retired::unbounded`]).
 #[inline(always)]
 fn entry_of(
     [x, y]: [f32; 2],
     (z_near, z_far): (f32, f32),
-    lat: f32,
-    ((ts, tc), scale): ((f32, f32), &DepthScale),
+    max_far: f32,
+    scale: &DepthScale,
     extent: &mut Extent,
 ) -> Option<Entry> {
     let (near, far) = (scale.down(z_near), scale.up(z_far).max(1));
@@ -456,23 +481,15 @@ fn entry_of(
     } else {
         z_far
     };
-    // `|P_K|`'s bound on the true ray: past `10³⁰` (a far ray of a
-    // wide-angle camera, or such a scale) the map's `f32` arithmetic could
-    // overflow, so such a point is left out too.
-    let (xl, yl) = (x.abs() + lat, y.abs() + lat);
-    // (`c ≥ √(1 + x² + y²)`: `√(1 + u) ≤ 1 + u/2`.)
-    let c = 1.0 + 0.5 * (xl * xl + yl * yl);
-    let reach = zf * c;
-    // (A NaN fails.)
-    if far == UNBOUNDED || !(reach <= MAX_REACH) {
+    // `|P_K|`'s bound on the true ray, `zf` times the batch's ray bound:
+    // past `10³⁰` (a far ray of a wide-angle camera, or such a scale) the
+    // map's `f32` arithmetic could overflow, so such a point is left out
+    // too. (A NaN fails.)
+    if far == UNBOUNDED || !(zf <= max_far) {
         return None;
     }
-    // The ray's forward rate (key frame's vehicle frame), `w · (x, y, 1)`.
-    let dir = tc - ts * y;
-    extent.dir = (fmin(extent.dir.0, dir), fmax(extent.dir.1, dir));
-    extent.ray = fmax(extent.ray, c);
+    extent.y = (fmin(extent.y.0, y), fmax(extent.y.1, y));
     extent.depth = (fmin(extent.depth.0, zn), fmax(extent.depth.1, zf));
-    extent.reach = fmax(extent.reach, reach);
     Some(Entry { x, y, near, far })
 }
 
@@ -917,7 +934,8 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
     /// frame). `s` is a reconstruction of the key frame (its pixels), `e1`
     /// the key frame's localisation error (the radius, module docs). The
     /// oldest points make room. An admitted point whose far end the depth
-    /// codes cannot hold, or whose distance bound passes [`MAX_REACH`], is
+    /// codes cannot hold, or whose distance bound (its far end times the
+    /// camera's ray bound, [`ray_bound`]) passes [`MAX_REACH`], is
     /// left out ([`Retired::unbounded`]; the room made for it goes to the
     /// next admitted point, and what the scan does not reach is
     /// [`Retired::unfit`]).
@@ -967,8 +985,11 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             ..Batch::EMPTY
         };
         let mut extent = Extent::EMPTY;
+        let ray = ray_bound(cam, batch.lat);
+        // (A NaN or infinite bound leaves every point out.)
+        let max_far = MAX_REACH / ray;
         for (k, &w) in want.iter().enumerate() {
-            let (n, unbounded) = self.enter(k, w, (key, s, batch.lat), &mut extent);
+            let (n, unbounded) = self.enter(k, w, (key, s, max_far), &mut extent);
             out.unbounded += unbounded;
             // The admitted points the scan did not reach: an unbounded
             // point it passed over left room for one more (each point is
@@ -987,7 +1008,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             }
             out.entered += n as u32;
         }
-        extent.widen_into(&mut batch);
+        extent.widen_into(ray, self.tilt, &mut batch);
         let slot = self.slot(usize::from(self.count));
         if let Some(b) = self.batches.get_mut(slot) {
             *b = batch;
@@ -1022,19 +1043,18 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
 
     /// [`Self::retire`]'s entries on boundary `k`: the first `w` admitted
     /// points of the key frame, written into the ring after its used
-    /// slots, their forward coordinates and reach (`|P_K|` on the true
-    /// ray, `lat` the batch's `λ`) taken into `extent`. Returns how many
-    /// entered, and how many were left out for a far end the codes cannot
-    /// hold or a distance bound past [`MAX_REACH`].
+    /// slots, their rays' forward rates and their depths taken into
+    /// `extent`. Returns how many entered, and how many were left out for a
+    /// far end the codes cannot hold or past `max_far` (a distance bound
+    /// past [`MAX_REACH`], [`entry_of`]).
     fn enter<const N: usize>(
         &mut self,
         k: usize,
         w: usize,
-        (key, s, lat): (&KeyFrame<N, B>, &Structure<N, B>, f32),
+        (key, s, max_far): (&KeyFrame<N, B>, &Structure<N, B>, f32),
         extent: &mut Extent,
     ) -> (usize, u32) {
         let min_pairs = key.min_pairs();
-        let tilt = self.tilt;
         let (cam, scale) = (s.camera1(), self.scale);
         let start = self.tail.get(k).map_or(0, |&t| usize::from(t))
             + self.used.get(k).map_or(0, |&u| usize::from(u));
@@ -1054,13 +1074,8 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
                 break;
             };
             at += 1;
-            let Some(e) = entry_of(
-                cam.normalise(r.pixel1()),
-                c.ends(),
-                lat,
-                (tilt, &scale),
-                extent,
-            ) else {
+            let Some(e) = entry_of(cam.normalise(r.pixel1()), c.ends(), max_far, &scale, extent)
+            else {
                 unbounded += 1;
                 continue;
             };
@@ -1104,12 +1119,14 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
 mod tests {
     extern crate std;
     use super::*;
+    use crate::camera::Pixel;
     use crate::test_rng::Rng;
 
     const M: usize = 64;
 
-    /// A batch of random sticks (rays to ±1, depths 0.01–1000 with near
-    /// and far equal to 4 times apart, `λ` 0 or up to 10⁻³, tilt to
+    /// A batch of random sticks (pixels anywhere in a wide camera's image
+    /// and its margin, rays to about ±0.86, depths 0.01–1000 with near and
+    /// far equal to 4 times apart, `λ` 0 or up to 10⁻³, tilt to
     /// ±17°) posed by a rotation near the identity or up to ±0.25 rad, its
     /// key-frame camera placed along the forward axis within `10⁻⁶` of
     /// where [`View::whole`] stops saying `Ahead` (one case in four at the
@@ -1130,12 +1147,20 @@ mod tests {
         };
         let mut map = RoadMap::<1, M>::new((ts, tc), scale);
         let mut extent = Extent::EMPTY;
+        let cam = Camera::new(300.0, 310.0, 255.5, 239.5, 512, 480).expect("camera");
+        let bound = ray_bound(&cam, lat);
         let mut m = 0;
         for _ in 0..1 + (g.next() * 63.0) as usize {
-            let ray = [(g.next() - 0.5) * 2.0, (g.next() - 0.5) * 2.0];
+            let px = Pixel::new(g.next() * 513.0 - 1.0, g.next() * 481.0 - 1.0);
+            assert!(cam.contains(px));
+            let ray = cam.normalise(px);
+            // The bound holds the ray's `|(x, y, 1)|` and its `|P_K|` rate.
+            let (xl, yl) = (ray[0].abs() + lat, ray[1].abs() + lat);
+            assert!(1.0 + 0.5 * (xl * xl + yl * yl) <= bound);
             let z_near = 0.01 + 999.0 * g.next() * g.next() * g.next();
             let z_far = z_near * (1.0 + 3.0 * g.next() * g.next() * g.next());
-            let e = entry_of(ray, (z_near, z_far), lat, ((ts, tc), &scale), &mut extent);
+            let max_far = MAX_REACH / bound;
+            let e = entry_of(ray, (z_near, z_far), max_far, &scale, &mut extent);
             if let Some(e) = e {
                 map.entries[0][m] = e;
                 m += 1;
@@ -1157,7 +1182,7 @@ mod tests {
             live: [m as u16],
             ..Batch::EMPTY
         };
-        extent.widen_into(&mut batch);
+        extent.widen_into(bound, (ts, tc), &mut batch);
         // `Ahead` from `g0 = w · b` at the lowest end's `−lowest` on (`b`
         // still 0 here; `g0` moves the bound's rounding a little), `Behind`
         // below `−(highest + radius)`.
@@ -1185,6 +1210,31 @@ mod tests {
         map.count = 1;
         map.used[0] = m as u16;
         (map, batch, m)
+    }
+
+    /// [`ray_bound`] at the corners of the image and its margin (where
+    /// `|x|` and `|y|` are largest) of cameras with the principal point
+    /// off centre, narrow and wide, with and without `λ`.
+    #[test]
+    fn the_ray_bound_holds_every_pixel() {
+        for (f, cx, cy, w, h) in [
+            (800.0, 255.5, 239.5, 512u16, 480u16),
+            (120.0, 10.0, 470.0, 512, 480),
+            (2000.0, 1900.0, 5.0, 1920, 1080),
+        ] {
+            let cam = Camera::new(f, f * 1.1, cx, cy, w, h).expect("camera");
+            for lat in [0.0, 1e-3] {
+                let bound = ray_bound(&cam, lat);
+                let (u1, v1) = (f32::from(w), f32::from(h));
+                for (u, v) in [(-1.0, -1.0), (u1, -1.0), (-1.0, v1), (u1, v1), (cx, cy)] {
+                    let px = Pixel::new(u, v);
+                    assert!(cam.contains(px));
+                    let [x, y] = cam.normalise(px);
+                    let (xl, yl) = (x.abs() + lat, y.abs() + lat);
+                    assert!(1.0 + 0.5 * (xl * xl + yl * yl) <= bound, "{f} {u} {v}");
+                }
+            }
+        }
     }
 
     /// [`RoadMap::taken`] counts a batch wholly ahead without testing its

@@ -56,9 +56,9 @@ const FUSED: bool = cfg!(feature = "link-fused");
 /// README tells a firmware to allow for (40 000 instructions), and with the
 /// fusion also less the fusion's own work after the matching, which the
 /// deadline does not cut: the demo's limit for its fusion steps (212 000,
-/// `src/bin/bench/fusion.rs`, `DRIVE_LIMIT`; at most 74 instructions a key-frame
-/// point on the demo drive, whose map never fills; 212, and up to 223 in
-/// a review's runs, where a key frame retires into a full map, README).
+/// `src/bin/bench/fusion.rs`, `DRIVE_LIMIT`; at most 64 instructions a key-frame
+/// point on the demo drive, whose map never fills; 165, and up to 209 in
+/// reviews' runs, where a key frame retires into a full map, README).
 const LIMIT_INSTRUCTIONS: u32 = if FUSED {
     212_000
 } else {

@@ -558,11 +558,11 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// cut: it is linear in the key frame's points plus a constant
     /// (`docs/FUSION.md`, "The fusion's own work"), so leave room for it in
     /// the limit. Measured on the emulated Cortex-M4F, `Fusion<256, 2,
-    /// 512>`, not a bound: 212 instructions a key-frame point (108 545 a
-    /// step) where a key frame retires into a full map, up to 223 (114 414)
-    /// in an adversarial review's runs; with the sight check on
-    /// ([`FusionConfig::with_sight_check`]) 423, up to 553 (283 190); 74
-    /// and 191 on the demo drive, whose map never fills.
+    /// 512>`, not a bound: 165 instructions a key-frame point (84 613 a
+    /// step) where a key frame retires into a full map, up to 209 (107 030)
+    /// in adversarial reviews' runs; with the sight check on
+    /// ([`FusionConfig::with_sight_check`]) 371, up to 534 (273 590); 64
+    /// and 188 on the demo drive, whose map never fills.
     pub fn step_within<D: Deadline>(
         &mut self,
         id: u32,

@@ -875,13 +875,13 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
     /// ring slot `start`), the live points ahead of the camera and those
     /// behind it ([`View::behind`]). A batch wholly ahead
     /// ([`View::whole`], the bound the sweep skips it by) has none behind:
-    /// `Ahead` bounds every stick end's forward coordinate below by `0`,
-    /// the extent's widening (`2⁻¹⁰` of the reach) covering the codes'
-    /// rounding (`2⁻¹²` of a depth) and the evaluation's (a few `2⁻²⁴` of
-    /// the reach, as `|g0|` is at most about twice the reach where the
-    /// bound is near 0), while `behind` asks for the **largest** end plus a
-    /// positive radius below 0 (`a_batch_wholly_ahead_has_no_point_behind`
-    /// checks both at the edge of `Ahead`). So its live points are counted
+    /// `Ahead` bounds every decoded stick end's forward coordinate, as
+    /// `f32` evaluates it, below by `0` ([`View`]'s docs: the codes' and
+    /// the evaluation's rounding included), while `behind` asks for the
+    /// **largest** end plus a positive radius below 0
+    /// (`a_batch_wholly_ahead_has_no_point_behind` and
+    /// `whole_batch_bound_at_its_edges_over_any_camera` check both at the
+    /// edges of the bound). So its live points are counted
     /// without their tests: all of them at once when the whole of it goes
     /// (its live count), or when none of its slots was dropped (every
     /// taken one live); otherwise one look a taken slot. Making room in a
@@ -1128,10 +1128,11 @@ mod tests {
     /// and its margin, rays to about ±0.86, depths 0.01–1000 with near and
     /// far equal to 4 times apart, `λ` 0 or up to 10⁻³, tilt to
     /// ±17°) posed by a rotation near the identity or up to ±0.25 rad, its
-    /// key-frame camera placed along the forward axis within `10⁻⁶` of
-    /// where [`View::whole`] stops saying `Ahead` (one case in four at the
-    /// edge of `Behind` instead, one in four between the two: the camera
-    /// passing the batch; one in seven with some points dropped).
+    /// key-frame camera placed along the forward axis within `±5 · 10⁻⁶`
+    /// of the batch's `z₁ c` of where [`View::whole`] stops saying `Ahead`
+    /// (one case in four at the edge of `Behind` instead, one in four
+    /// between the two: the camera passing the batch; one in seven with
+    /// some points dropped; one in five with motion-error bounds `ρ`, `φ`).
     fn batch_at_the_edge(g: &mut Rng, case: usize) -> (RoadMap<1, M>, Batch<1>, usize) {
         let scale = DepthScale::for_max_depth(1000.0);
         let (ts, tc) = crate::math::sin_cos((g.next() - 0.5) * 0.6);
@@ -1245,9 +1246,15 @@ mod tests {
     /// coordinate of at least 0 as `f32` evaluates it (so [`View::behind`],
     /// which asks for the largest one plus the radius below 0, is false),
     /// every point of a batch said to be wholly behind is behind, and
-    /// `taken` gives what the point-by-point test gives, whole and in part.
-    /// (With the turn's `dg c` left out of the rates the first check fails;
-    /// without the depths' widening for the codes, the second.)
+    /// `taken` gives what the point-by-point test gives, whole and in part;
+    /// and the sweep's radius covers every point's own. (With the turn's
+    /// `dg c` left out of the rates the first check fails; without the
+    /// depths' widening for the codes, the second; without the ray bound in
+    /// the batch's reach, the radius's. The bound's rounding terms are not
+    /// shown needed: the depths' widening, `2⁻¹¹` where the codes need
+    /// `2⁻¹²`, and the slack of `dg c` cover them here and in the search
+    /// below; the argument is in [`View`]'s docs. The bound's branches for
+    /// a negative rate are the search's.)
     #[test]
     fn a_batch_wholly_ahead_has_no_point_behind() {
         let mut g = Rng(0x5EED_4A11);
@@ -1261,6 +1268,14 @@ mod tests {
             let view = View::of(&batch, map.tilt);
             let ring = &map.entries[0];
             let live = || ring[..m].iter().filter(|e| e.live());
+            // The sweep's radius (the batch's `rest`, its reach times the
+            // motion's `φ`) covers each point's own (`radius`, what the
+            // queries add): what it drops, `points` would not show.
+            for e in live() {
+                let zf = map.scale.depth_inner(e.far);
+                let own = radius(batch.rho, batch.phi, batch.lat, e, zf);
+                assert!(view.rest + zf * view.lat * ROUND_UP >= own, "case {case}");
+            }
             match view.whole(&batch) {
                 Whole::Ahead => {
                     ahead += 1;
@@ -1302,5 +1317,240 @@ mod tests {
         );
         assert!(ahead > 4_000 && wholly_behind > 1_000 && behind > 1_000);
         assert!(closest < 1.0 / 4096.0, "{closest}");
+    }
+
+    fn logu(g: &mut Rng, lo: f32, hi: f32) -> f32 {
+        libm::expf(libm::logf(lo) + g.next() * (libm::logf(hi) - libm::logf(lo)))
+    }
+
+    fn next_up(x: f32) -> f32 {
+        if x.is_nan() || x == f32::INFINITY {
+            return x;
+        }
+        if x == 0.0 {
+            return f32::from_bits(1);
+        }
+        let b = x.to_bits();
+        if x > 0.0 {
+            f32::from_bits(b + 1)
+        } else {
+            f32::from_bits(b - 1)
+        }
+    }
+    fn next_down(x: f32) -> f32 {
+        -next_up(-x)
+    }
+
+    /// An adversarial review's search (twentieth session) at the edges of
+    /// [`View::whole`]'s bound over any camera `Camera::new` accepts
+    /// (focal lengths 1 to 10⁵ px, sides to 16 384, the principal point on
+    /// the image's edges), pixels at the margin's corners, `λ` from `e₁`
+    /// up to 100, tilts to ±90°, stacked turns up to 1 rad, `max_depth`
+    /// 10⁻³ to 10⁸, near ends at code 0 and far ends at code 1: for each
+    /// batch the offset `g0` is bisected to the last float where it is
+    /// still `Ahead` (and `Behind`), and every point checked there. It
+    /// reaches the bound's branches for a negative rate (`k₀ < 0`, `k₁ <
+    /// 0`), which the test above does not: each of them ignored fails it.
+    #[test]
+    fn whole_batch_bound_at_its_edges_over_any_camera() {
+        const CASES: u32 = 200_000;
+        let mut g = Rng(0xA11C_E5ED);
+        let (mut bad_ahead, mut bad_behind, mut n_ahead, mut n_behind) = (0, 0, 0, 0);
+        let mut worst: f32 = f32::INFINITY;
+        for case in 0..CASES {
+            let w = 2 + (g.next() * 16382.0) as u16;
+            let h = 2 + (g.next() * 16382.0) as u16;
+            let (w, h) = if case % 3 == 0 {
+                (w.min(640), h.min(480))
+            } else {
+                (w, h)
+            };
+            let fx = logu(&mut g, 1.0, 1e5);
+            let fy = if case % 2 == 0 {
+                fx
+            } else {
+                logu(&mut g, 1.0, 1e5)
+            };
+            let cx = match case % 4 {
+                0 => 0.0,
+                1 => f32::from(w) - 1.0,
+                _ => g.next() * (f32::from(w) - 1.0),
+            };
+            let cy = match (case / 4) % 4 {
+                0 => 0.0,
+                1 => f32::from(h) - 1.0,
+                _ => g.next() * (f32::from(h) - 1.0),
+            };
+            let Ok(cam) = Camera::new(fx, fy, cx, cy, w, h) else {
+                continue;
+            };
+            let e1 = if case % 5 == 0 { 0.0 } else { g.next() * 100.0 };
+            let lat = e1 / fmin(fx, fy) * ROUND_UP;
+            let tilt = (g.next() - 0.5) * core::f32::consts::PI;
+            let (ts, tc) = crate::math::sin_cos(tilt);
+            let md = logu(&mut g, 1e-3, 1e8);
+            let scale = DepthScale::for_max_depth(md);
+            let mut a = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+            let turns = (g.next() * 4.0) as usize;
+            let amp = [1e-4, 1e-2, 0.3, 1.0][(case as usize / 7) % 4];
+            for _ in 0..turns {
+                let ang = [0; 3].map(|_| (g.next() - 0.5) * 2.0 * amp);
+                let r = Motion::new([0.0, 0.0, 1.0], ang)
+                    .expect("angles")
+                    .rotation_matrix();
+                a = mat3_mul(&mat3_transpose(&r), &a);
+            }
+            let mut map = RoadMap::<1, 64>::new((ts, tc), scale);
+            let mut extent = Extent::EMPTY;
+            let ray = ray_bound(&cam, lat);
+            let max_far = MAX_REACH / ray;
+            let mut m = 0;
+            let npts = 1 + (g.next() * 63.0) as usize;
+            let zc = scale.scale() * logu(&mut g, 1e-6, 1.9);
+            for _ in 0..npts {
+                let px = match (g.next() * 6.0) as u32 {
+                    0 => Pixel::new(-1.0, -1.0),
+                    1 => Pixel::new(f32::from(w), f32::from(h)),
+                    2 => Pixel::new(-1.0, f32::from(h)),
+                    3 => Pixel::new(f32::from(w), -1.0),
+                    _ => Pixel::new(
+                        g.next() * (f32::from(w) + 1.0) - 1.0,
+                        g.next() * (f32::from(h) + 1.0) - 1.0,
+                    ),
+                };
+                if !cam.contains(px) {
+                    continue;
+                }
+                let r = cam.normalise(px);
+                let zn = zc * logu(&mut g, 0.2, 1.0) * if g.next() < 0.1 { 0.0 } else { 1.0 };
+                let top = 1.1 + g.next() * 4.0;
+                let zf = fmax(zn, zc * logu(&mut g, 1.0, top));
+                if let Some(e) = entry_of(r, (zn, zf), max_far, &scale, &mut extent) {
+                    map.entries[0][m] = e;
+                    m += 1;
+                }
+            }
+            if m == 0 {
+                continue;
+            }
+            let mut batch = Batch::<1> {
+                a,
+                b: [0.0; 3],
+                rho: if case % 6 == 0 { g.next() * zc } else { 0.0 },
+                phi: if case % 6 == 0 { g.next() * 1e-2 } else { 0.0 },
+                lat,
+                key: 0,
+                len: [m as u16],
+                live: [m as u16],
+                ..Batch::EMPTY
+            };
+            extent.widen_into(ray, (ts, tc), &mut batch);
+            let base = View::of(&batch, (ts, tc));
+            let (lo, hi, rad) = base.extremes(&batch);
+            if !(lo.is_finite() && hi.is_finite()) {
+                continue;
+            }
+            let live = &map.entries[0][..m];
+            let check = |g0: f32| -> View {
+                let mut v = View::of(&batch, (ts, tc));
+                v.g0 = g0;
+                v
+            };
+            // Ahead edge: smallest g0 with Ahead, searched from -lo.
+            let mut g0 = -lo;
+            let classify = |g0: f32| check(g0).whole(&batch);
+            let mut step = fmax(g0.abs(), 1e-30) * 1e-3;
+            let mut it = 0;
+            while !matches!(classify(g0), Whole::Ahead) && it < 200 {
+                g0 += step;
+                step *= 2.0;
+                it += 1;
+            }
+            // now walk down by bisection
+            let mut lo_g = g0 - fmax(g0.abs(), 1e-30) * 1e-2;
+            let mut hi_g = g0;
+            for _ in 0..200 {
+                let mid = 0.5 * (lo_g + hi_g);
+                if mid == lo_g || mid == hi_g {
+                    break;
+                }
+                if matches!(classify(mid), Whole::Ahead) {
+                    hi_g = mid
+                } else {
+                    lo_g = mid
+                }
+            }
+            let mut gg = hi_g;
+            for _ in 0..4 {
+                let d = next_down(gg);
+                if matches!(classify(d), Whole::Ahead) {
+                    gg = d
+                } else {
+                    break;
+                }
+            }
+            if matches!(classify(gg), Whole::Ahead) {
+                n_ahead += 1;
+                let v = check(gg);
+                for e in live {
+                    let dir = v.g[0] * e.x + v.g[1] * e.y + v.g[2];
+                    for z in [scale.depth(e.near), scale.depth_inner(e.far)] {
+                        let f = dir * z + v.g0;
+                        worst = worst.min(f / (batch.depth.1 * batch.ray));
+                        if f < 0.0 || v.behind(e, &scale) {
+                            bad_ahead += 1;
+                            if bad_ahead < 5 {
+                                std::println!("AHEAD VIOLATION case {case}: f={f:e} e={e:?} cam={cam:?} lat={lat} tilt={tilt} batch={batch:?} g0={gg:e}");
+                            }
+                        }
+                    }
+                }
+            }
+            // Behind edge: largest g0 with Behind.
+            let mut g0 = -(hi + rad);
+            let mut step = fmax(g0.abs(), 1e-30) * 1e-3;
+            let mut it = 0;
+            while !matches!(classify(g0), Whole::Behind) && it < 200 {
+                g0 -= step;
+                step *= 2.0;
+                it += 1;
+            }
+            let mut lo_g = g0;
+            let mut hi_g = g0 + fmax(g0.abs(), 1e-30) * 1e-2;
+            for _ in 0..200 {
+                let mid = 0.5 * (lo_g + hi_g);
+                if mid == lo_g || mid == hi_g {
+                    break;
+                }
+                if matches!(classify(mid), Whole::Behind) {
+                    lo_g = mid
+                } else {
+                    hi_g = mid
+                }
+            }
+            let mut gg = lo_g;
+            for _ in 0..4 {
+                let d = next_up(gg);
+                if matches!(classify(d), Whole::Behind) {
+                    gg = d
+                } else {
+                    break;
+                }
+            }
+            if matches!(classify(gg), Whole::Behind) {
+                n_behind += 1;
+                let v = check(gg);
+                for e in live {
+                    if !v.behind(e, &scale) {
+                        bad_behind += 1;
+                        if bad_behind < 5 {
+                            std::println!("BEHIND VIOLATION case {case}: e={e:?} cam={cam:?} batch={batch:?} g0={gg:e}");
+                        }
+                    }
+                }
+            }
+        }
+        std::println!("ahead {n_ahead} behind {n_behind} bad_ahead {bad_ahead} bad_behind {bad_behind} worst {worst:e}");
+        assert_eq!((bad_ahead, bad_behind), (0, 0));
     }
 }

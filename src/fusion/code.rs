@@ -202,7 +202,7 @@ mod tests {
 
     /// The clamped codes against [`reference`] for every exponent of
     /// `z/s` (all 256, both signs) with the mantissa's edges and random
-    /// mantissas, and NaN, for three scales; and the edge the first codes
+    /// mantissas, and NaN, for five scales; and the edge the first codes
     /// got wrong: `2⁻¹⁵ s`, whose far end coded 0 (depth 0).
     #[test]
     fn codes_agree_with_their_definition() {

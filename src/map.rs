@@ -1341,6 +1341,46 @@ mod tests {
         -next_up(-x)
     }
 
+    /// The last `g0` where `inside` holds, `inside` true from some `g0` on
+    /// in the direction `sign`: from `start`, outwards in doubling steps
+    /// until inside, then bisected back to the edge and nudged to its last
+    /// float.
+    fn last_inside(start: f32, sign: f32, inside: impl Fn(f32) -> bool) -> f32 {
+        let mut g0 = start;
+        let mut step = fmax(g0.abs(), 1e-30) * 1e-3;
+        for _ in 0..200 {
+            if inside(g0) {
+                break;
+            }
+            g0 += sign * step;
+            step *= 2.0;
+        }
+        let (mut out, mut inn) = (g0 - sign * fmax(g0.abs(), 1e-30) * 1e-2, g0);
+        for _ in 0..200 {
+            let mid = 0.5 * (out + inn);
+            if mid == out || mid == inn {
+                break;
+            }
+            if inside(mid) {
+                inn = mid;
+            } else {
+                out = mid;
+            }
+        }
+        for _ in 0..4 {
+            let d = if sign > 0.0 {
+                next_down(inn)
+            } else {
+                next_up(inn)
+            };
+            if !inside(d) {
+                break;
+            }
+            inn = d;
+        }
+        inn
+    }
+
     /// An adversarial review's search (twentieth session) at the edges of
     /// [`View::whole`]'s bound over any camera `Camera::new` accepts
     /// (focal lengths 1 to 10⁵ px, sides to 16 384, the principal point on
@@ -1457,38 +1497,8 @@ mod tests {
                 v
             };
             // Ahead edge: smallest g0 with Ahead, searched from -lo.
-            let mut g0 = -lo;
             let classify = |g0: f32| check(g0).whole(&batch);
-            let mut step = fmax(g0.abs(), 1e-30) * 1e-3;
-            let mut it = 0;
-            while !matches!(classify(g0), Whole::Ahead) && it < 200 {
-                g0 += step;
-                step *= 2.0;
-                it += 1;
-            }
-            // now walk down by bisection
-            let mut lo_g = g0 - fmax(g0.abs(), 1e-30) * 1e-2;
-            let mut hi_g = g0;
-            for _ in 0..200 {
-                let mid = 0.5 * (lo_g + hi_g);
-                if mid == lo_g || mid == hi_g {
-                    break;
-                }
-                if matches!(classify(mid), Whole::Ahead) {
-                    hi_g = mid
-                } else {
-                    lo_g = mid
-                }
-            }
-            let mut gg = hi_g;
-            for _ in 0..4 {
-                let d = next_down(gg);
-                if matches!(classify(d), Whole::Ahead) {
-                    gg = d
-                } else {
-                    break;
-                }
-            }
+            let gg = last_inside(-lo, 1.0, |g0| matches!(classify(g0), Whole::Ahead));
             if matches!(classify(gg), Whole::Ahead) {
                 n_ahead += 1;
                 let v = check(gg);
@@ -1507,36 +1517,9 @@ mod tests {
                 }
             }
             // Behind edge: largest g0 with Behind.
-            let mut g0 = -(hi + rad);
-            let mut step = fmax(g0.abs(), 1e-30) * 1e-3;
-            let mut it = 0;
-            while !matches!(classify(g0), Whole::Behind) && it < 200 {
-                g0 -= step;
-                step *= 2.0;
-                it += 1;
-            }
-            let mut lo_g = g0;
-            let mut hi_g = g0 + fmax(g0.abs(), 1e-30) * 1e-2;
-            for _ in 0..200 {
-                let mid = 0.5 * (lo_g + hi_g);
-                if mid == lo_g || mid == hi_g {
-                    break;
-                }
-                if matches!(classify(mid), Whole::Behind) {
-                    lo_g = mid
-                } else {
-                    hi_g = mid
-                }
-            }
-            let mut gg = lo_g;
-            for _ in 0..4 {
-                let d = next_up(gg);
-                if matches!(classify(d), Whole::Behind) {
-                    gg = d
-                } else {
-                    break;
-                }
-            }
+            let gg = last_inside(-(hi + rad), -1.0, |g0| {
+                matches!(classify(g0), Whole::Behind)
+            });
             if matches!(classify(gg), Whole::Behind) {
                 n_behind += 1;
                 let v = check(gg);

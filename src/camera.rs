@@ -212,9 +212,17 @@ impl Camera {
     /// The square of the largest distance, pixels, from the principal
     /// point to any point the image (with its margin) can hold.
     pub(crate) fn reach2(&self) -> f32 {
-        let m = IMAGE_MARGIN_PX;
-        let dx = crate::math::fmax(self.cx + m, f32::from(self.width) - 1.0 + m - self.cx);
-        let dy = crate::math::fmax(self.cy + m, f32::from(self.height) - 1.0 + m - self.cy);
+        let [dx, dy] = self.reach_uv();
         dx * dx + dy * dy
+    }
+
+    /// The largest `|u − c_x|` and `|v − c_y|`, pixels, of any point the
+    /// image (with its margin) can hold.
+    pub(crate) fn reach_uv(&self) -> [f32; 2] {
+        let m = IMAGE_MARGIN_PX;
+        [
+            crate::math::fmax(self.cx + m, f32::from(self.width) - 1.0 + m - self.cx),
+            crate::math::fmax(self.cy + m, f32::from(self.height) - 1.0 + m - self.cy),
+        ]
     }
 }

@@ -89,7 +89,7 @@
 //! Size: `12·B·M` bytes of points and [`MAP_BATCHES`] batches of
 //! `88 + 4·B` bytes (13 096 bytes in all for `B = 2`, `M = 512`).
 
-use crate::camera::{Camera, IMAGE_MARGIN_PX};
+use crate::camera::Camera;
 use crate::fusion::code::{DepthScale, UNBOUNDED};
 use crate::fusion::{norm1, Chain, KeyFrame, StepBounds, STEP_ROUNDING};
 use crate::geometry::Sample;
@@ -307,9 +307,7 @@ impl Extent {
 /// bound serves them all: no per-point maximum. Rounded up by `2⁻¹⁶`
 /// (the normalisation's and the sum's rounding).
 fn ray_bound(cam: &Camera, lat: f32) -> f32 {
-    let m = IMAGE_MARGIN_PX;
-    let dx = fmax(cam.cx() + m, f32::from(cam.width()) - 1.0 + m - cam.cx());
-    let dy = fmax(cam.cy() + m, f32::from(cam.height()) - 1.0 + m - cam.cy());
+    let [dx, dy] = cam.reach_uv();
     let (x, y) = (dx / cam.fx() + lat, dy / cam.fy() + lat);
     (1.0 + 0.5 * (x * x + y * y)) * ROUND_UP
 }

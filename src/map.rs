@@ -255,6 +255,31 @@ pub struct Retired {
     /// This key frame's own points beyond a boundary's capacity `M` (the
     /// farthest along the boundary), left out.
     pub unfit: u32,
+    /// Admitted points not looked at yet: a retirement that enters more
+    /// points than its step's share enters the rest at the start of the
+    /// next step, which reports them as
+    /// [`crate::fusion::FusionStep::finished`] (`entered + unbounded +
+    /// unfit` there is this count; [`crate::fusion`], "The retirement over
+    /// two steps"). 0 when the retirement is whole.
+    pub pending: u32,
+}
+
+/// What a retirement cut at its share leaves for the next step
+/// ([`RoadMap::finish`]): the batch is the map's newest, its ring slots
+/// were made room for, and the key frame's cells and the reconstruction of
+/// its pixels stay as they were until then ([`crate::fusion`]).
+#[derive(Debug, Clone, Copy)]
+struct Rest<const B: usize> {
+    key: u32,
+    /// Per boundary: the next cell the scan looks at, the points still to
+    /// enter (room made), and the admitted points not accounted for yet
+    /// (entered, unbounded or unfit); 0 for a boundary done.
+    at: [u16; B],
+    want: [u16; B],
+    open: [u16; B],
+    extent: Extent,
+    ray: f32,
+    max_far: f32,
 }
 
 /// A retiring batch's bounds over its points: the smallest and largest
@@ -509,6 +534,8 @@ pub struct RoadMap<const B: usize, const M: usize> {
     tilt: (f32, f32),
     scale: DepthScale,
     drops: MapDrops,
+    /// A retirement cut at its share, to finish ([`RoadMap::finish`]).
+    rest: Option<Rest<B>>,
 }
 
 impl<const B: usize, const M: usize> RoadMap<B, M> {
@@ -533,6 +560,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
                 behind: 0,
                 capacity: 0,
             },
+            rest: None,
         }
     }
 
@@ -551,6 +579,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         self.count = 0;
         self.sweep = [0; B];
         self.drops = MapDrops::default();
+        self.rest = None;
     }
 
     /// Points stored on `boundary` now: those [`RoadMap::points`] gives and
@@ -923,10 +952,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         (live, behind)
     }
 
-    /// Put a retiring key frame's fused points into the map: the points
-    /// [`crate::fusion::FusedStatus::Consistent`] or
-    /// [`crate::fusion::FusedStatus::Widened`] (or
-    /// [`crate::fusion::FusedStatus::Single`] if `min_pairs ≤ 1`) with at
+    /// Move a retiring key frame's fused points into the map: those with at
     /// least `min_pairs` agreeing pairs and a bounded interval, as one
     /// batch posed by `chain` (the key frame's motion to the current
     /// frame). `s` is a reconstruction of the key frame (its pixels), `e1`
@@ -938,15 +964,25 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
     /// next admitted point, and what the scan does not reach is
     /// [`Retired::unfit`]).
     ///
+    /// At most `share` points enter now, boundary by boundary; room is
+    /// made for all, and the rest enter with [`Self::finish`], which must
+    /// come before anything else changes the map, `key` or `s`
+    /// ([`Retired::pending`] counts them). Until then the batch holds the
+    /// points entered, bounded over them.
+    ///
     /// Work: two passes over the key frame's points (`B·N`), plus the
-    /// points dropped for room.
+    /// points dropped for room; the entries, the dearest part, at most
+    /// `share`.
     pub(crate) fn retire<const N: usize>(
         &mut self,
         key: &KeyFrame<N, B>,
         s: &Structure<N, B>,
         chain: &Chain,
-        e1: f32,
+        (e1, share): (f32, usize),
     ) -> Retired {
+        // (An unfinished retirement is finished by the caller first; one
+        // left is forgotten with its points, never written over a batch.)
+        self.rest = None;
         let mut out = Retired {
             key: key.id(),
             ..Retired::default()
@@ -966,8 +1002,8 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         // 2. Room: a batch slot, then ring slots, oldest first.
         let admitted = want;
         self.make_room(&mut want, &mut out);
-        // 3. The batch: its pose, each boundary's points, the bounds over
-        // all of them.
+        // 3. The batch: its pose, each boundary's points (up to the share),
+        // the bounds over them.
         let (a, b, rho, phi) = chain.pose();
         let cam = s.camera1();
         let lat = e1 / fmin(cam.fx(), cam.fy()) * ROUND_UP;
@@ -982,37 +1018,124 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             key: key.id(),
             ..Batch::EMPTY
         };
-        let mut extent = Extent::EMPTY;
         let ray = ray_bound(cam, batch.lat);
-        // (A NaN or infinite bound leaves every point out.)
-        let max_far = MAX_REACH / ray;
+        let mut rest = Rest {
+            key: key.id(),
+            at: [0; B],
+            want: [0; B],
+            open: [0; B],
+            extent: Extent::EMPTY,
+            ray,
+            // (A NaN or infinite bound leaves every point out.)
+            max_far: MAX_REACH / ray,
+        };
+        let mut left = share;
         for (k, &w) in want.iter().enumerate() {
-            let (n, unbounded) = self.enter(k, w, (key, s, max_far), &mut extent);
+            let now = w.min(left);
+            let mut at = 0;
+            let (n, unbounded) =
+                self.enter(k, now, &mut at, (key, s, rest.max_far), &mut rest.extent);
+            left -= n;
             out.unbounded += unbounded;
-            // The admitted points the scan did not reach: an unbounded
-            // point it passed over left room for one more (each point is
-            // counted once, under one reason).
             let a = admitted.get(k).copied().unwrap_or(0);
-            out.unfit += a.saturating_sub(n + unbounded as usize) as u32;
-            let n16 = n as u16;
-            if let (Some(l), Some(lv), Some(u)) = (
-                batch.len.get_mut(k),
-                batch.live.get_mut(k),
-                self.used.get_mut(k),
-            ) {
-                *l = n16;
-                *lv = n16;
-                *u = u.saturating_add(n16);
+            let open = a.saturating_sub(n + unbounded as usize);
+            if now < w {
+                // Cut at the share: the rest next step.
+                if let (Some(r_at), Some(r_want), Some(r_open)) = (
+                    rest.at.get_mut(k),
+                    rest.want.get_mut(k),
+                    rest.open.get_mut(k),
+                ) {
+                    *r_at = at as u16;
+                    *r_want = (w - n) as u16;
+                    *r_open = open as u16;
+                }
+                out.pending += open as u32;
+            } else {
+                // The admitted points the scan did not reach: an unbounded
+                // point it passed over left room for one more (each point
+                // is counted once, under one reason).
+                out.unfit += open as u32;
             }
+            self.grow(&mut batch, k, n);
             out.entered += n as u32;
         }
-        extent.widen_into(ray, self.tilt, &mut batch);
+        rest.extent.widen_into(ray, self.tilt, &mut batch);
         let slot = self.slot(usize::from(self.count));
         if let Some(b) = self.batches.get_mut(slot) {
             *b = batch;
             self.count += 1;
         }
+        if out.pending > 0 || rest.want.iter().any(|&w| w > 0) {
+            self.rest = Some(rest);
+        }
         out
+    }
+
+    /// The rest of a retirement [`Self::retire`] cut at its share: its
+    /// points entered into its batch (the map's newest), which is bounded
+    /// over all of them again. `key` and `s` must be the ones `retire` had
+    /// (unchanged since). `None` without one. The counts are the rest's
+    /// (`entered`, `unbounded`, `unfit`; `key` the key frame's id, the
+    /// others 0).
+    ///
+    /// Work: the points entered (at most `B·N` less the share), and a scan
+    /// over the cells `retire` did not look at.
+    pub(crate) fn finish<const N: usize>(
+        &mut self,
+        key: &KeyFrame<N, B>,
+        s: &Structure<N, B>,
+    ) -> Option<Retired> {
+        let mut rest = self.rest.take()?;
+        let mut out = Retired {
+            key: rest.key,
+            ..Retired::default()
+        };
+        let newest = usize::from(self.count).checked_sub(1)?;
+        let slot = self.slot(newest);
+        let mut batch = self.batches.get(slot).copied()?;
+        if batch.key != rest.key || key.id() != rest.key {
+            return None;
+        }
+        for k in 0..B {
+            let (Some(&at), Some(&w), Some(&open)) =
+                (rest.at.get(k), rest.want.get(k), rest.open.get(k))
+            else {
+                continue;
+            };
+            let mut at = usize::from(at);
+            let (n, unbounded) = self.enter(
+                k,
+                usize::from(w),
+                &mut at,
+                (key, s, rest.max_far),
+                &mut rest.extent,
+            );
+            out.unbounded += unbounded;
+            out.unfit += u32::from(open).saturating_sub(n as u32 + unbounded);
+            self.grow(&mut batch, k, n);
+            out.entered += n as u32;
+        }
+        rest.extent.widen_into(rest.ray, self.tilt, &mut batch);
+        if let Some(b) = self.batches.get_mut(slot) {
+            *b = batch;
+        }
+        Some(out)
+    }
+
+    /// `n` more points of `batch` on boundary `k`, in the ring slots after
+    /// the used ones.
+    fn grow(&mut self, batch: &mut Batch<B>, k: usize, n: usize) {
+        let n16 = n as u16;
+        if let (Some(l), Some(lv), Some(u)) = (
+            batch.len.get_mut(k),
+            batch.live.get_mut(k),
+            self.used.get_mut(k),
+        ) {
+            *l = l.saturating_add(n16);
+            *lv = lv.saturating_add(n16);
+            *u = u.saturating_add(n16);
+        }
     }
 
     /// [`Self::retire`]'s room: a batch slot (the oldest batch goes when
@@ -1039,16 +1162,18 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         self.drops.capacity = self.drops.capacity.saturating_add(out.dropped);
     }
 
-    /// [`Self::retire`]'s entries on boundary `k`: the first `w` admitted
-    /// points of the key frame, written into the ring after its used
-    /// slots, their rays' forward rates and their depths taken into
-    /// `extent`. Returns how many entered, and how many were left out for a
-    /// far end the codes cannot hold or past `max_far` (a distance bound
-    /// past [`MAX_REACH`], [`entry_of`]).
+    /// [`Self::retire`]'s entries on boundary `k`: the next `w` admitted
+    /// points of the key frame from cell `*at` on (left after the last one
+    /// looked at), written into the ring after its used slots, their rays'
+    /// forward rates and their depths taken into `extent`. Returns how
+    /// many entered, and how many were left out for a far end the codes
+    /// cannot hold or past `max_far` (a distance bound past
+    /// [`MAX_REACH`], [`entry_of`]).
     fn enter<const N: usize>(
         &mut self,
         k: usize,
         w: usize,
+        at_out: &mut usize,
         (key, s, max_far): (&KeyFrame<N, B>, &Structure<N, B>, f32),
         extent: &mut Extent,
     ) -> (usize, u32) {
@@ -1061,7 +1186,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         };
         let (mut n, mut unbounded) = (0usize, 0u32);
         let (cells, points) = (key.cells(k), results.points());
-        let mut at = 0;
+        let mut at = *at_out;
         while n < w {
             // The next admitted point (a tight scan: on most drives most
             // are not).
@@ -1082,6 +1207,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             }
             n += 1;
         }
+        *at_out = at;
         (n, unbounded)
     }
 

@@ -655,6 +655,8 @@ struct MapCheck {
     behind: u64,
     capacity: u64,
     live_at_end: u64,
+    /// Retirements cut at their share (the rest entered next step).
+    split: u64,
 }
 
 /// Every map point after every frame: the true 3-D point of its key-frame
@@ -697,17 +699,115 @@ fn check_map(d: &Drive, input: &host_tests::drives::Input, policy: FusionConfig)
     c.entered = r
         .steps
         .iter()
-        .filter_map(|s| s.retired)
+        .flat_map(|s| s.retired.into_iter().chain(s.finished))
         .map(|t| u64::from(t.entered))
         .sum();
+    c.split = r
+        .steps
+        .iter()
+        .filter(|s| s.retired.is_some_and(|t| t.pending > 0))
+        .count() as u64;
     c
+}
+
+/// A retirement cut at its share ([`FusionConfig::with_retirement_share`])
+/// enters the rest at the start of the next step: after that step the
+/// fusion (its key frame, map and counters: the digest) is the one a
+/// whole retirement leaves, and the counts add up; between the two steps
+/// the map holds the points entered so far. Also with a range constraint
+/// between the two steps, which enters the rest then.
+#[test]
+fn a_retirement_over_two_steps_leaves_the_whole_ones_map() {
+    let (mut split, mut constrained, mut steps) = (0, 0, 0);
+    for family in DriveFamily::ALL {
+        let (ds, _) = drives(family, 3, 24);
+        for (seed, d) in &ds {
+            let input = d.input(Noise::Disc, None, *seed);
+            let policy = FusionConfig::DEFAULT
+                .with_tilt(d.spec.tilt as f32)
+                .expect("tilt");
+            let whole_policy = policy.with_retirement_share(1000).expect("share");
+            let mut whole = Box::new(HostFusion::new(input.config(), whole_policy));
+            let mut parts = Box::new(HostFusion::new(
+                input.config(),
+                policy.with_retirement_share(30).expect("share"),
+            ));
+            let mut pending: Option<roadstereo::map::Retired> = None;
+            for j in 0..d.frames.len() {
+                let frame = input.frame(&d.spec.intrinsics, j);
+                let m = (j > 0).then(|| ChainedMotion {
+                    from: j as u32 - 1,
+                    motion: input.given[j - 1],
+                });
+                let a = whole.step(j as u32, &frame, m.as_ref()).expect("step");
+                let b = parts.step(j as u32, &frame, m.as_ref()).expect("step");
+                steps += 1;
+                assert_eq!(a.paired, b.paired, "{} frame {j}", d.spec.name);
+                assert_eq!(a.new_key, b.new_key);
+                assert!(a.finished.is_none() && a.retired.is_none_or(|r| r.pending == 0));
+                // The rest of the last step's retirement, and what it
+                // added up to.
+                match (pending.take(), b.finished) {
+                    (None, None) => {}
+                    (Some(p), Some(f)) => {
+                        assert_eq!(f.key, p.key);
+                        assert_eq!(f.entered + f.unbounded + f.unfit, p.pending, "{f:?} {p:?}");
+                    }
+                    (p, f) => panic!("{} frame {j}: pending {p:?}, finished {f:?}", d.spec.name),
+                }
+                match (a.retired, b.retired) {
+                    (None, None) => {}
+                    (Some(w), Some(r)) if r.pending == 0 => assert_eq!(w, r),
+                    (Some(w), Some(r)) => {
+                        split += 1;
+                        assert_eq!((w.key, w.dropped), (r.key, r.dropped));
+                        assert_eq!(
+                            (w.unverified, w.inconsistent),
+                            (r.unverified, r.inconsistent)
+                        );
+                        assert!(r.entered < w.entered, "{w:?} {r:?}");
+                        assert_eq!(
+                            w.entered + w.unbounded + w.unfit,
+                            r.entered + r.unbounded + r.unfit + r.pending
+                        );
+                        let held: usize = (0..B).map(|k| parts.map().len(k)).sum();
+                        let all: usize = (0..B).map(|k| whole.map().len(k)).sum();
+                        assert_eq!(held + (w.entered - r.entered) as usize, all);
+                        pending = Some(r);
+                        // Now and then a range constraint (a wide one, on
+                        // the new key frame's first point, on both) enters
+                        // the rest before the next step.
+                        if split % 3 == 0 {
+                            let (ka, kb) = (whole.key_ref(), parts.key_ref());
+                            if let (Some(ka), Some(kb)) = (ka, kb) {
+                                let x = whole.constrain(ka, 0, 0, 0.0, 1.0e4);
+                                let y = parts.constrain(kb, 0, 0, 0.0, 1.0e4);
+                                assert_eq!(x, y);
+                                if y.is_ok() {
+                                    constrained += 1;
+                                    assert_eq!(whole.digest(), parts.digest());
+                                }
+                            }
+                        }
+                        continue;
+                    }
+                    (w, r) => panic!("{} frame {j}: {w:?} against {r:?}", d.spec.name),
+                }
+                assert_eq!(whole.digest(), parts.digest(), "{} frame {j}", d.spec.name);
+            }
+        }
+    }
+    println!(
+        "retirement over two steps: {split} of the retirements split, {constrained} finished by a range constraint, {steps} steps equal to a whole retirement's after the next"
+    );
+    assert!(split > 20 && constrained > 2, "{split} {constrained}");
 }
 
 #[test]
 fn the_map_holds_the_truth_in_the_vehicle_frame() {
     let mut lines = Vec::new();
-    for (name, motion, sight) in [
-        ("no motion error", None, false),
+    for (name, motion, sight, share) in [
+        ("no motion error", None, false, 375),
         (
             "motion errors (0.01, 0.1°) bounded",
             Some(MotionNoise {
@@ -715,9 +815,13 @@ fn the_map_holds_the_truth_in_the_vehicle_frame() {
                 eps: 0.1f64.to_radians(),
             }),
             false,
+            375,
         ),
         // (The sight check's widened points enter the map too.)
-        ("sight check on, no motion error", None, true),
+        ("sight check on, no motion error", None, true, 375),
+        // (A share these drives' key frames pass: 52 points of `N · B`
+        // enter in the retiring step, the rest in the next.)
+        ("retirement share 50 ‰, no motion error", None, false, 50),
     ] {
         let mut all = MapCheck::default();
         for family in DriveFamily::ALL {
@@ -727,7 +831,9 @@ fn the_map_holds_the_truth_in_the_vehicle_frame() {
                 let policy = FusionConfig::DEFAULT
                     .with_tilt(d.spec.tilt as f32)
                     .expect("tilt")
-                    .with_sight_check(sight);
+                    .with_sight_check(sight)
+                    .with_retirement_share(share)
+                    .expect("share");
                 let c = check_map(d, &input, policy);
                 // Every point that entered is still there or counted.
                 assert_eq!(
@@ -742,12 +848,16 @@ fn the_map_holds_the_truth_in_the_vehicle_frame() {
                 all.entered += c.entered;
                 all.behind += c.behind;
                 all.capacity += c.capacity;
+                all.split += c.split;
             }
         }
         lines.push(format!(
-            "map, {name}: {} map points checked over 32 drives of 24 frames, worst distance beyond the radius {:.1e} of the distance, largest radius {:.3}; {} entered, {} dropped behind, {} for room",
-            all.points, all.worst_excess, all.largest_radius, all.entered, all.behind, all.capacity
+            "map, {name}: {} map points checked over 32 drives of 24 frames, worst distance beyond the radius {:.1e} of the distance, largest radius {:.3}; {} entered, {} dropped behind, {} for room; {} retirements over two steps",
+            all.points, all.worst_excess, all.largest_radius, all.entered, all.behind, all.capacity, all.split
         ));
+        // The small share splits retirements (its points are checked
+        // between the two steps too).
+        assert!(share == 375 || all.split > 20, "{all:?}");
         assert!(all.points > 10_000, "{all:?}");
         // Within the radius outright: it carries the key frame's `e₁`
         // across the ray (at least `Z e₁/f`, far above the `f32`
@@ -780,7 +890,9 @@ fn map_capacity_exhaustion_drops_the_oldest_and_counts() {
             motion: input.given[j - 1],
         });
         let s = f.step(j as u32, &frame, m.as_ref()).expect("step");
-        if let Some(r) = s.retired {
+        // (A retirement past the step's share enters the rest, and counts
+        // it, at the start of the next step: `finished`.)
+        for r in s.finished.iter().chain(&s.retired) {
             entered += u64::from(r.entered);
             unfit += u64::from(r.unfit);
             dropped += u64::from(r.dropped);
@@ -1164,7 +1276,7 @@ fn ranges_past_the_depth_codes_stay_out_of_the_map() {
             motion: step,
         };
         let s = f.step(id, &edge(id as f32), Some(&m)).expect("step");
-        unbounded += s.retired.map_or(0, |r| r.unbounded);
+        unbounded += s.retired.map_or(0, |r| r.unbounded) + s.finished.map_or(0, |r| r.unbounded);
     }
     assert_eq!(unbounded, 1, "the constrained point is left out");
     let map = f.map();

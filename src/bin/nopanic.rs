@@ -98,6 +98,7 @@ fn main() -> ! {
         FusionConfig::new(black_box(8), black_box(500))
             .and_then(|c| c.with_tilt(black_box(0.4)))
             .and_then(|c| c.with_map_min_pairs(black_box(2)))
+            .and_then(|c| c.with_retirement_share(black_box(375)))
             .unwrap_or_default()
             .with_sight_check(black_box(true)),
     );

@@ -61,6 +61,29 @@
 //! still carried). Every frame is matched exactly once, so the fusion adds
 //! no matching work.
 //!
+//! # The retirement over two steps
+//! A retiring key frame's admitted points are copied into the map (their
+//! rays, their coded ends, the batch's bounds): the costliest part of the
+//! fusion, and all of it in one frame. So the retiring step enters at
+//! most `⌈3·N·B/8⌉` of them (boundary by boundary, in order; the share
+//! is [`FusionConfig::with_retirement_share`]'s, 375 ‰ by default) and makes
+//! room for all; the rest enter at the start of the **next** step, before
+//! its pair: the retired key frame's cells and the reconstruction of its
+//! pixels stay untouched until then (the next key frame's fusion starts
+//! with that step, and the processor pairs after it). The step after a
+//! retirement pairs a fresh key frame, whose first pair has no interval
+//! to intersect (about a third of a later pair's work), so three eighths
+//! leave the two steps about even when a key frame is full. Between the
+//! two steps the map holds the points entered so far (each point whole:
+//! bounded, carried and swept as any other), [`Fusion::key`] all of them;
+//! [`crate::map::Retired::pending`] counts the rest, and the next step's
+//! [`FusionStep::finished`] what became of them. A retirement at a motion
+//! limit is whole (the processor keeps the new frame at once), and so is
+//! every one with a share of 1000 ‰. The map after
+//! the next step is the one a whole retirement leaves (the same points,
+//! bounds and counts: `host_tests/tests/fusion.rs`,
+//! `a_retirement_over_two_steps_leaves_the_whole_ones_map`).
+//!
 //! # Range sensors
 //! [`Fusion::constrain`] intersects a key-frame point's interval with a
 //! range interval along its ray from another sensor (a lidar or radar
@@ -75,7 +98,8 @@
 //! (`O(1)` each: an intersection, or the consistency check), `O(MAP_BATCHES)`
 //! to carry the map and at most [`crate::map::SWEEP_PER_FRAME`] point tests
 //! per boundary for points the vehicle has passed; a retiring key frame
-//! one more pass to copy its points into the map. The depths of the map
+//! one more pass to copy its points into the map (at most three eighths
+//! of them in that step, the rest at the start of the next, above). The depths of the map
 //! and of the rival intervals are 16-bit codes relative to a power of two
 //! at or above the configuration's maximum depth (resolution `2⁻¹²` of the
 //! depth for depths within `2¹⁵` of it, rounded outwards). `docs/FUSION.md`
@@ -114,6 +138,7 @@ pub struct FusionConfig {
     keep_permille: u16,
     map_min_pairs: u8,
     sight_check: bool,
+    retire_permille: u16,
     tilt: f32,
     tilt_sc: (f32, f32),
 }
@@ -131,6 +156,8 @@ pub enum FusionConfigError {
     MinPairs,
     /// The tilt is NaN or beyond ±90°.
     Tilt,
+    /// The retirement's share is above 1000 permille.
+    RetireShare,
 }
 
 impl core::error::Error for FusionConfigError {}
@@ -142,6 +169,7 @@ impl fmt::Display for FusionConfigError {
             Self::KeepShare => "the share of matched points must be at most 1000 permille",
             Self::MinPairs => "the map's minimum of agreeing pairs must be in 1..=64",
             Self::Tilt => "the tilt must be finite and within 90 degrees",
+            Self::RetireShare => "the retirement's share must be at most 1000 permille",
         })
     }
 }
@@ -193,6 +221,7 @@ impl FusionConfig {
             keep_permille,
             map_min_pairs: 2,
             sight_check: false,
+            retire_permille: 375,
             tilt: 0.0,
             tilt_sc: (0.0, 1.0),
         })
@@ -250,6 +279,28 @@ impl FusionConfig {
     pub const fn with_sight_check(mut self, on: bool) -> Self {
         self.sight_check = on;
         self
+    }
+
+    /// The same policy with at most `permille` ‰ of a key frame's
+    /// capacity, `⌈N·B·permille/1000⌉` points, entering the map in the step
+    /// that retires it, 0 to 1000 (375, three eighths, by default; 1000
+    /// enters them all in that step); the rest enter at the start of the
+    /// next step, before its pair: the retiring step's work bounded by the
+    /// share, the map whole one step later ([`crate::map::Retired::pending`],
+    /// [`FusionStep::finished`]; module docs, "The retirement over two
+    /// steps").
+    pub const fn with_retirement_share(mut self, permille: u16) -> Result<Self, FusionConfigError> {
+        if permille > 1000 {
+            return Err(FusionConfigError::RetireShare);
+        }
+        self.retire_permille = permille;
+        Ok(self)
+    }
+
+    /// The share of a key frame's capacity entering the map in its
+    /// retiring step, permille.
+    pub const fn retirement_share(&self) -> u16 {
+        self.retire_permille
     }
 
     /// Whether the sight check is on.
@@ -378,8 +429,16 @@ pub struct FusionStep {
     pub paired: Option<PairFused>,
     /// The frame's place among the key frame's partners (1 = first).
     pub partner: u16,
-    /// The key frame that retired into the map, if one did.
+    /// The key frame that retired into the map, if one did. A key frame
+    /// with more admitted points than a step's share enters the rest at
+    /// the start of the next step ([`Retired::pending`], module docs).
     pub retired: Option<Retired>,
+    /// The rest of the last step's retirement, entered at the start of
+    /// this step (before its pair), if it had one: its `entered`,
+    /// `unbounded` and `unfit` counts, which add up to the last step's
+    /// [`Retired::pending`] (a [`Fusion::constrain`] in between enters it
+    /// then, and this step reports it).
+    pub finished: Option<Retired>,
     /// Why this frame became the key frame, if it did.
     pub new_key: Option<KeyReason>,
 }
@@ -407,6 +466,9 @@ pub struct Fusion<const N: usize, const B: usize, const M: usize> {
     /// `key` still shows the one that just retired (its id, its lengths).
     pending: Option<(u32, [u16; B])>,
     map: RoadMap<B, M>,
+    /// The rest of a retirement, entered ([`Fusion::settle`]) and not
+    /// reported yet ([`FusionStep::finished`]).
+    finished: Option<Retired>,
     /// The rounding of the last pair's composed motion (`Chain::config`).
     pair_rounding: Rounding,
     /// Key frames started over the fusion's life ([`KeyRef`]; a reset
@@ -457,6 +519,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             due: false,
             pending: None,
             map: RoadMap::new(config.tilt_sc, scale),
+            finished: None,
             pair_rounding: Rounding::NONE,
             keys_started: 0,
         }
@@ -473,6 +536,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         self.last = None;
         self.due = false;
         self.pending = None;
+        self.finished = None;
         self.map.clear();
     }
 
@@ -574,6 +638,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             paired: None,
             partner: 0,
             retired: None,
+            finished: None,
             new_key: None,
         };
         // 1. Validate (nothing changes on an error).
@@ -586,6 +651,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         self.last = Some(id);
         let bounds = StepBounds::of(&self.base);
         self.settle();
+        out.finished = self.finished.take();
         self.shows_retired = false;
         if !self.has_key {
             self.map.carry(&m.motion, &bounds, true);
@@ -609,8 +675,9 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         self.map
             .carry(&m.motion, &bounds, !(last_partner || limit.is_some()));
         let (Ok(motion), Ok(cfg), None) = (&motion, &cfg, limit) else {
-            // No last pair: retire what the key frame has, start anew.
-            out.retired = self.retire();
+            // No last pair: retire what the key frame has, whole (the
+            // processor keeps this frame at once), start anew.
+            out.retired = self.retire(usize::MAX);
             let shown = out.retired.is_some();
             // (`limit` is `Some` here: `None` only with both `Ok`.)
             let reason = limit.unwrap_or(KeyReason::MotionLimit);
@@ -627,7 +694,10 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         out.paired = Some(fused);
         out.partner = self.key.partners();
         if last_partner {
-            out.retired = self.retire();
+            // (The processor keeps the reconstruction of the key frame's
+            // pixels and `key` its cells until the next step: the rest of
+            // a retirement past the share enters then, `settle`.)
+            out.retired = self.retire(self.share());
             out.new_key = Some(if self.key.partners() >= self.config.max_partners {
                 KeyReason::Partners
             } else {
@@ -756,16 +826,32 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         self.keys_started = self.keys_started.wrapping_add(1);
     }
 
-    /// Start the fusion of a key frame the processor keeps.
+    /// Start the fusion of a key frame the processor keeps; first, the rest
+    /// of the last retirement enters the map, while the retired key frame's
+    /// cells and the reconstruction of its pixels are still there (every
+    /// caller settles before the processor pairs again or `key` starts).
     fn settle(&mut self) {
+        if let Some(r) = self.map.finish(&self.key, self.processor.structure()) {
+            self.finished = Some(r);
+        }
         if let Some((id, lens)) = self.pending.take() {
             self.key.start(id, lens);
         }
     }
 
+    /// Points a retiring step enters into the map, at most: the configured
+    /// share of a key frame's capacity (module docs, "The retirement over
+    /// two steps").
+    fn share(&self) -> usize {
+        (N * B)
+            .saturating_mul(usize::from(self.config.retire_permille))
+            .div_ceil(1000)
+    }
+
     /// Move the key frame's fused points into the map, posed by the chain
-    /// (the key frame's motion to the current frame).
-    fn retire(&mut self) -> Option<Retired> {
+    /// (the key frame's motion to the current frame): at most `share` now,
+    /// the rest at the next [`Self::settle`].
+    fn retire(&mut self, share: usize) -> Option<Retired> {
         if !self.has_key || self.key.partners() == 0 {
             return None;
         }
@@ -773,7 +859,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             &self.key,
             self.processor.structure(),
             &self.chain,
-            self.base.e1(),
+            (self.base.e1(), share),
         ))
     }
 

@@ -79,6 +79,9 @@ pub struct PolicyIn {
     /// case saved before it reads what follows its draws, or 0, the check
     /// off).
     pub sight: bool,
+    /// [`FusionConfig::with_retirement_share`] (drawn after the sight
+    /// check, for the same reason).
+    pub share: Option<u16>,
 }
 
 /// One call.
@@ -147,6 +150,7 @@ fn policy(src: &mut Source) -> PolicyIn {
         min_pairs,
         tilt,
         sight: false,
+        share: None,
     }
 }
 
@@ -310,6 +314,10 @@ pub fn generate(src: &mut Source) -> Case {
         }
     }
     policy.sight = !src.chance(1, 2);
+    policy.share = src.chance(1, 2).then(|| match src.below(4) {
+        0 => src.pick(&[0, 1000, 1001, u16::MAX]),
+        _ => src.below(1001) as u16,
+    });
     Case {
         large,
         config,
@@ -350,8 +358,13 @@ pub mod bit {
     /// A constraint for another key frame refused
     /// (`FusionError::KeyMismatch`).
     pub const KEY_MISMATCH: u32 = 98;
+    /// A retirement cut at its share, the rest entered the next step (or
+    /// by a constraint before it: `Fusion::settle`).
+    pub const FINISHED: u32 = 99;
+    /// A retirement share above 1000 ‰ refused.
+    pub const SHARE_ERR: u32 = 100;
     /// One past the last.
-    pub const END: u32 = 99;
+    pub const END: u32 = 101;
 }
 
 use frame::set;
@@ -401,6 +414,19 @@ fn build_policy(p: &PolicyIn, features: &mut u128) -> FusionConfig {
         }
     }
     c = c.with_sight_check(p.sight);
+    if let Some(n) = p.share {
+        match c.with_retirement_share(n) {
+            Ok(x) => {
+                assert!(n <= 1000, "share {n} accepted");
+                c = x;
+            }
+            Err(e) => {
+                assert_eq!(e, FusionConfigError::RetireShare, "share {n}");
+                assert!(n > 1000, "share {n} rejected");
+                set(features, bit::SHARE_ERR);
+            }
+        }
+    }
     if let Some(t) = p.tilt {
         let ok = t.abs() <= core::f32::consts::FRAC_PI_2;
         match c.with_tilt(t) {
@@ -827,8 +853,18 @@ fn check_step<const N: usize, const B: usize, const M: usize>(
     if let Some(r) = s.new_key {
         set(features, bit::NEW_KEY + r as u32);
     }
+    // The rest of the last step's retirement (the points it entered are
+    // the map's from then on).
+    let finished = s.finished.map_or(0, |r| {
+        set(features, bit::FINISHED);
+        assert!(
+            r.unverified == 0 && r.inconsistent == 0 && r.dropped == 0 && r.pending == 0,
+            "{at}: {r:?}"
+        );
+        u64::from(r.entered)
+    });
     let Some(r) = s.retired else {
-        return 0;
+        return finished;
     };
     set(features, bit::RETIRED);
     if r.dropped > 0 {
@@ -844,13 +880,13 @@ fn check_step<const N: usize, const B: usize, const M: usize>(
     // (unless the step's frame had no points to start a new one).
     if let Some(k) = f.key().filter(|k| k.id() == r.key) {
         let total: usize = (0..k.boundaries()).map(|b| k.len(b)).sum();
-        let counted = r.entered + r.unverified + r.inconsistent + r.unbounded + r.unfit;
+        let counted = r.entered + r.unverified + r.inconsistent + r.unbounded + r.unfit + r.pending;
         assert_eq!(
             counted as usize, total,
             "{at}: {r:?}: the retired key frame's {total} points not all accounted for"
         );
     }
-    u64::from(r.entered)
+    finished + u64::from(r.entered)
 }
 
 /// The state's invariants.

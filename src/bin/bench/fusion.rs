@@ -210,7 +210,7 @@ fn sideways(fusion: &mut Fusion<256, 2, 512>, name: &str, yaw: f32) -> bool {
             own / points.max(1),
             step.paired.is_some(),
             step.retired.is_some(),
-            step.retired.map_or(0, |r| r.entered),
+            step.retired.map_or(0, |r| r.entered) + step.finished.map_or(0, |r| r.entered),
             step.retired.map_or(0, |r| r.dropped),
             same,
             (fusion.map().len(0) + fusion.map().len(1)) as u32,

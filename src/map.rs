@@ -90,7 +90,7 @@
 //! `88 + 4·B` bytes (13 096 bytes in all for `B = 2`, `M = 512`).
 
 use crate::camera::Camera;
-use crate::fusion::code::{DepthScale, UNBOUNDED};
+use crate::fusion::code::DepthScale;
 use crate::fusion::{norm1, Chain, KeyFrame, StepBounds, STEP_ROUNDING};
 use crate::geometry::Sample;
 use crate::math::{fmax, fmin, mat3_mul, mat3_transpose, mat3_vec, sqrt, Mat3};
@@ -279,47 +279,54 @@ struct Rest<const B: usize> {
     open: [u16; B],
     extent: Extent,
     ray: f32,
-    max_far: f32,
+    far_limit: u16,
 }
 
 /// A retiring batch's bounds over its points: the smallest and largest
-/// normalised `y` of a ray, and depth of an end, before the coding's
-/// widening.
+/// normalised `y` of a ray, and the smallest near code and largest far
+/// code (the codes are monotone in the depth they stand for).
 #[derive(Debug, Clone, Copy)]
 struct Extent {
     y: (f32, f32),
-    depth: (f32, f32),
+    codes: (u16, u16),
 }
 
 impl Extent {
     const EMPTY: Self = Self {
         y: (f32::INFINITY, f32::NEG_INFINITY),
-        depth: (f32::INFINITY, f32::NEG_INFINITY),
+        codes: (u16::MAX, 0),
     };
 
-    /// Into `b`, with its points' ray bound `ray` ([`ray_bound`]) and the
-    /// camera's tilt (sine and cosine), widened for the coding: a decoded
-    /// depth is within `2⁻¹²` of the one the extent took ([`entry_of`]), so
-    /// the depths are widened by `2⁻¹¹` of themselves; the reach, `ray`
-    /// times the largest depth, by `2⁻¹⁰` (it bounds the radius's rest,
-    /// [`View`], and the products round). A ray's forward rate, `w · (x,
+    /// Into `b`, with its points' ray bound `ray` ([`ray_bound`]), the
+    /// camera's tilt (sine and cosine) and the map's depth codes `scale`:
+    /// the depths are the decoded ends' (exactly what the map's readers
+    /// use), widened by `2⁻¹¹` of themselves, slack the bound's own
+    /// rounding rests on ([`View`]); the reach, `ray` times the largest
+    /// depth, by `2⁻¹⁰` (it bounds the radius's rest, [`View`], and the
+    /// products round). (Until the twenty-first session the extent took
+    /// the fused ends, within `2⁻¹²` of the decoded ones, and the widening
+    /// covered that too.) A ray's forward rate, `w · (x,
     /// y, 1)` or `cos − sin · y`, is monotone in `y`, and so is its `f32`
     /// value (rounding is monotone): the rates at the two ends of the `y`
     /// range are the smallest and largest of the batch's, as each point's
     /// would be computed. (Nothing for an empty extent: a batch without
     /// points is never bounded.)
-    fn widen_into<const B: usize>(&self, ray: f32, (ts, tc): (f32, f32), b: &mut Batch<B>) {
+    fn widen_into<const B: usize>(
+        &self,
+        (ray, scale): (f32, &DepthScale),
+        (ts, tc): (f32, f32),
+        b: &mut Batch<B>,
+    ) {
         if !(self.y.0 <= self.y.1) {
             return;
         }
         let (d0, d1) = (tc - ts * self.y.0, tc - ts * self.y.1);
         b.dir = (fmin(d0, d1), fmax(d0, d1));
         b.ray = ray;
-        b.depth = (
-            self.depth.0 * (1.0 - 1.0 / 2048.0),
-            self.depth.1 * (1.0 + 1.0 / 2048.0),
-        );
-        b.reach = self.depth.1 * ray * (1.0 + 1.0 / 1024.0);
+        // (An entry's far code is at most `UNBOUNDED − 1`: finite.)
+        let (z0, z1) = (scale.depth(self.codes.0), scale.depth(self.codes.1));
+        b.depth = (z0 * (1.0 - 1.0 / 2048.0), z1 * (1.0 + 1.0 / 2048.0));
+        b.reach = z1 * ray * (1.0 + 1.0 / 1024.0);
     }
 }
 
@@ -480,39 +487,43 @@ fn radius(rho: f32, phi: f32, lat: f32, e: &Entry, zf: f32) -> f32 {
     (zf * lat + rho + (phi + EVAL_ROUNDING) * reach) * ROUND_UP
 }
 
+/// The largest far code an entry may have in a batch whose points may lie
+/// up to `max_far` deep ([`MAX_REACH`] over its ray bound, [`ray_bound`]):
+/// the largest code standing for a depth not above `max_far`
+/// ([`DepthScale::down`]), so at most `UNBOUNDED − 1`; 0 (no entry) for a
+/// NaN or one below the smallest far code's depth.
+fn far_limit(max_far: f32, scale: &DepthScale) -> u16 {
+    scale.down(max_far)
+}
+
 /// A retiring point's entry: its key-frame ray `[x, y]` (normalised) and
-/// fused ends, coded outwards ([`DepthScale`]), its `y` and its depths
-/// taken into `extent`. `None`: a far end the codes cannot hold, or one past
-/// `max_far`, [`MAX_REACH`] over the batch's ray bound ([`ray_bound`]; the
-/// distance bound past `MAX_REACH`, [`Retired::unbounded`]).
+/// fused ends, coded outwards ([`DepthScale`]), its `y` and its codes
+/// taken into `extent`. `None`: a far code past `limit` ([`far_limit`]): a
+/// far end the codes cannot hold, or a decoded one whose distance bound
+/// (times the batch's ray bound) is past [`MAX_REACH`]
+/// ([`Retired::unbounded`]).
 #[inline(always)]
 fn entry_of(
     [x, y]: [f32; 2],
     (z_near, z_far): (f32, f32),
-    max_far: f32,
+    limit: u16,
     scale: &DepthScale,
     extent: &mut Extent,
 ) -> Option<Entry> {
+    // (Below `2⁻¹⁵ s` a near end is code 0, depth 0, and a far end code 1,
+    // about `2⁻¹⁵ s`: the decoded ends hold the fused ones whatever they
+    // are.)
     let (near, far) = (scale.down(z_near), scale.up(z_far).max(1));
-    // The ends as the map decodes them: within `2⁻¹²` of the fused ones
-    // (the caller widens the extent by more), but below `2⁻¹⁵ s` a near end
-    // is code 0, depth 0, and a far end code 1, about `2⁻¹⁵ s` (with a huge
-    // `max_depth` far above the fused one).
-    let zn = if near == 0 { 0.0 } else { z_near };
-    let zf = if far == 1 {
-        scale.depth_inner(1)
-    } else {
-        z_far
-    };
-    // `|P_K|`'s bound on the true ray, `zf` times the batch's ray bound:
-    // past `10³⁰` (a far ray of a wide-angle camera, or such a scale) the
-    // map's `f32` arithmetic could overflow, so such a point is left out
-    // too. (A NaN fails.)
-    if far == UNBOUNDED || !(zf <= max_far) {
+    // `|P_K|`'s bound on the true ray, the decoded far end times the
+    // batch's ray bound: past `10³⁰` (a far ray of a wide-angle camera, or
+    // such a scale) the map's `f32` arithmetic could overflow, so such a
+    // point is left out too, as is one whose far end the codes cannot hold
+    // (`UNBOUNDED` is above every limit).
+    if far > limit {
         return None;
     }
     extent.y = (fmin(extent.y.0, y), fmax(extent.y.1, y));
-    extent.depth = (fmin(extent.depth.0, zn), fmax(extent.depth.1, zf));
+    extent.codes = (extent.codes.0.min(near), extent.codes.1.max(far));
     Some(Entry { x, y, near, far })
 }
 
@@ -1026,15 +1037,16 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             open: [0; B],
             extent: Extent::EMPTY,
             ray,
-            // (A NaN or infinite bound leaves every point out.)
-            max_far: MAX_REACH / ray,
+            // (A NaN bound leaves every point out, an infinite one only
+            // those the codes cannot hold.)
+            far_limit: far_limit(MAX_REACH / ray, &self.scale),
         };
         let mut left = share;
         for (k, &w) in want.iter().enumerate() {
             let now = w.min(left);
             let mut at = 0;
             let (n, unbounded) =
-                self.enter(k, now, &mut at, (key, s, rest.max_far), &mut rest.extent);
+                self.enter(k, now, &mut at, (key, s, rest.far_limit), &mut rest.extent);
             left -= n;
             out.unbounded += unbounded;
             let a = admitted.get(k).copied().unwrap_or(0);
@@ -1060,7 +1072,8 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             self.grow(&mut batch, k, n);
             out.entered += n as u32;
         }
-        rest.extent.widen_into(ray, self.tilt, &mut batch);
+        rest.extent
+            .widen_into((ray, &self.scale), self.tilt, &mut batch);
         let slot = self.slot(usize::from(self.count));
         if let Some(b) = self.batches.get_mut(slot) {
             *b = batch;
@@ -1108,7 +1121,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
                 k,
                 usize::from(w),
                 &mut at,
-                (key, s, rest.max_far),
+                (key, s, rest.far_limit),
                 &mut rest.extent,
             );
             out.unbounded += unbounded;
@@ -1116,7 +1129,8 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             self.grow(&mut batch, k, n);
             out.entered += n as u32;
         }
-        rest.extent.widen_into(rest.ray, self.tilt, &mut batch);
+        rest.extent
+            .widen_into((rest.ray, &self.scale), self.tilt, &mut batch);
         if let Some(b) = self.batches.get_mut(slot) {
             *b = batch;
         }
@@ -1167,18 +1181,21 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
     /// looked at), written into the ring after its used slots, their rays'
     /// forward rates and their depths taken into `extent`. Returns how
     /// many entered, and how many were left out for a far end the codes
-    /// cannot hold or past `max_far` (a distance bound past
-    /// [`MAX_REACH`], [`entry_of`]).
+    /// cannot hold or past `limit` (a distance bound past [`MAX_REACH`],
+    /// [`entry_of`]).
     fn enter<const N: usize>(
         &mut self,
         k: usize,
         w: usize,
         at_out: &mut usize,
-        (key, s, max_far): (&KeyFrame<N, B>, &Structure<N, B>, f32),
+        (key, s, limit): (&KeyFrame<N, B>, &Structure<N, B>, u16),
         extent: &mut Extent,
     ) -> (usize, u32) {
         let min_pairs = key.min_pairs();
-        let (cam, scale) = (s.camera1(), self.scale);
+        // (Locals, the loop's registers: through the references its stores
+        // might reach, the camera and the extent were loaded and stored
+        // again for every point.)
+        let (cam, scale, mut ext) = (*s.camera1(), self.scale, *extent);
         let start = self.tail.get(k).map_or(0, |&t| usize::from(t))
             + self.used.get(k).map_or(0, |&u| usize::from(u));
         let (Some(ring), Some(results)) = (self.entries.get_mut(k), s.boundaries().get(k)) else {
@@ -1197,7 +1214,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
                 break;
             };
             at += 1;
-            let Some(e) = entry_of(cam.normalise(r.pixel1()), c.ends(), max_far, &scale, extent)
+            let Some(e) = entry_of(cam.normalise(r.pixel1()), c.ends(), limit, &scale, &mut ext)
             else {
                 unbounded += 1;
                 continue;
@@ -1208,6 +1225,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             n += 1;
         }
         *at_out = at;
+        *extent = ext;
         (n, unbounded)
     }
 
@@ -1284,8 +1302,8 @@ mod tests {
             assert!(1.0 + 0.5 * (xl * xl + yl * yl) <= bound);
             let z_near = 0.01 + 999.0 * g.next() * g.next() * g.next();
             let z_far = z_near * (1.0 + 3.0 * g.next() * g.next() * g.next());
-            let max_far = MAX_REACH / bound;
-            let e = entry_of(ray, (z_near, z_far), max_far, &scale, &mut extent);
+            let limit = far_limit(MAX_REACH / bound, &scale);
+            let e = entry_of(ray, (z_near, z_far), limit, &scale, &mut extent);
             if let Some(e) = e {
                 map.entries[0][m] = e;
                 m += 1;
@@ -1307,7 +1325,7 @@ mod tests {
             live: [m as u16],
             ..Batch::EMPTY
         };
-        extent.widen_into(bound, (ts, tc), &mut batch);
+        extent.widen_into((bound, &scale), (ts, tc), &mut batch);
         // `Ahead` from `g0 = w · b` at the lowest end's `−lowest` on (`b`
         // still 0 here; `g0` moves the bound's rounding a little), `Behind`
         // below `−(highest + radius)`.
@@ -1567,7 +1585,7 @@ mod tests {
             let mut map = RoadMap::<1, 64>::new((ts, tc), scale);
             let mut extent = Extent::EMPTY;
             let ray = ray_bound(&cam, lat);
-            let max_far = MAX_REACH / ray;
+            let limit = far_limit(MAX_REACH / ray, &scale);
             let mut m = 0;
             let npts = 1 + (g.next() * 63.0) as usize;
             let zc = scale.scale() * logu(&mut g, 1e-6, 1.9);
@@ -1589,7 +1607,7 @@ mod tests {
                 let zn = zc * logu(&mut g, 0.2, 1.0) * if g.next() < 0.1 { 0.0 } else { 1.0 };
                 let top = 1.1 + g.next() * 4.0;
                 let zf = fmax(zn, zc * logu(&mut g, 1.0, top));
-                if let Some(e) = entry_of(r, (zn, zf), max_far, &scale, &mut extent) {
+                if let Some(e) = entry_of(r, (zn, zf), limit, &scale, &mut extent) {
                     map.entries[0][m] = e;
                     m += 1;
                 }
@@ -1608,7 +1626,7 @@ mod tests {
                 live: [m as u16],
                 ..Batch::EMPTY
             };
-            extent.widen_into(ray, (ts, tc), &mut batch);
+            extent.widen_into((ray, &scale), (ts, tc), &mut batch);
             let base = View::of(&batch, (ts, tc));
             let (lo, hi, rad) = base.extremes(&batch);
             if !(lo.is_finite() && hi.is_finite()) {

@@ -65,15 +65,17 @@
 //! A retiring key frame's admitted points are copied into the map (their
 //! rays, their coded ends, the batch's bounds): the costliest part of the
 //! fusion, and all of it in one frame. So the retiring step enters at
-//! most `⌈3·N·B/8⌉` of them (boundary by boundary, in order; the share
-//! is [`FusionConfig::with_retirement_share`]'s, 375 ‰ by default) and makes
+//! most `⌈0.35·N·B⌉` of them (boundary by boundary, in order; the share
+//! is [`FusionConfig::with_retirement_share`]'s, 350 ‰ by default) and makes
 //! room for all; the rest enter at the start of the **next** step, before
 //! its pair: the retired key frame's cells and the reconstruction of its
 //! pixels stay untouched until then (the next key frame's fusion starts
-//! with that step, and the processor pairs after it). The step after a
-//! retirement pairs a fresh key frame, whose first pair has no interval
-//! to intersect (about a third of a later pair's work), so three eighths
-//! leave the two steps about even when a key frame is full. Between the
+//! with that step, and the processor pairs after it). The retiring step
+//! also fuses its own pair (about 37 instructions a key-frame point) and
+//! makes the room; the next step pairs a fresh key frame, whose first
+//! pair has no interval to intersect (about 13), so 35 % in the first
+//! and 65 % in the second leave the two about even where a full key frame
+//! retires into a full map (measured: `docs/FUSION.md`). Between the
 //! two steps the map holds the points entered so far (each point whole:
 //! bounded, carried and swept as any other), [`Fusion::key`] all of them;
 //! [`crate::map::Retired::pending`] counts the rest, and the next step's
@@ -98,8 +100,9 @@
 //! (`O(1)` each: an intersection, or the consistency check), `O(MAP_BATCHES)`
 //! to carry the map and at most [`crate::map::SWEEP_PER_FRAME`] point tests
 //! per boundary for points the vehicle has passed; a retiring key frame
-//! one more pass to copy its points into the map (at most three eighths
-//! of them in that step, the rest at the start of the next, above). The depths of the map
+//! one more pass to copy its points into the map (at most 35 % of a key
+//! frame's capacity in that step, the rest at the start of the next,
+//! above). The depths of the map
 //! and of the rival intervals are 16-bit codes relative to a power of two
 //! at or above the configuration's maximum depth (resolution `2⁻¹²` of the
 //! depth for depths within `2¹⁵` of it, rounded outwards). `docs/FUSION.md`
@@ -221,7 +224,7 @@ impl FusionConfig {
             keep_permille,
             map_min_pairs: 2,
             sight_check: false,
-            retire_permille: 375,
+            retire_permille: 350,
             tilt: 0.0,
             tilt_sc: (0.0, 1.0),
         })
@@ -283,7 +286,7 @@ impl FusionConfig {
 
     /// The same policy with at most `permille` ‰ of a key frame's
     /// capacity, `⌈N·B·permille/1000⌉` points, entering the map in the step
-    /// that retires it, 0 to 1000 (375, three eighths, by default; 1000
+    /// that retires it, 0 to 1000 (350 by default; 1000
     /// enters them all in that step); the rest enter at the start of the
     /// next step, before its pair: the retiring step's work bounded by the
     /// share, the map whole one step later ([`crate::map::Retired::pending`],

@@ -882,7 +882,7 @@ key-frame fusion over the demo drive (2 × 256 points, 8 partners, map of 2 × 5
             num(r, "step_instr"),
             num(r, "matching_instr"),
             if paired {
-                num(r, "per_point").to_string()
+                own_per_point(r).to_string()
             } else {
                 "–".into()
             },
@@ -900,7 +900,7 @@ key-frame fusion over the demo drive (2 × 256 points, 8 partners, map of 2 × 5
             ));
         }
         if paired {
-            worst = worst.max(num(r, "per_point"));
+            worst = worst.max(own_per_point(r));
             total += own;
             points += p;
             let frame = num(r, "frame");
@@ -1142,6 +1142,14 @@ fn symbol_checks(elfs: &[&Path], misses: &mut Vec<String>) -> Result<(), String>
     Ok(())
 }
 
+/// A fusion row's own work a key-frame point, rounded **up** (the
+/// firmware's `per_point` is rounded down): `≤ budget` is then exactly
+/// `fusion_instr ≤ budget · points`. (Until the twenty-first session the
+/// budgets took the firmware's, so 80.25 passed as 80.)
+fn own_per_point(r: &[(String, String)]) -> u64 {
+    num(r, "fusion_instr").div_ceil(num(r, "points").max(1))
+}
+
 /// The sideways drives (firmware `fusion_sideways`): a drive whose road
 /// map fills, so that each retiring key frame drops the oldest points for
 /// room, straight and turning. The fusion's own work a key-frame point,
@@ -1182,7 +1190,7 @@ the fusion over a sideways drive whose road map fills (Fusion<256, 2, 512>, 80 f
             }
         }
         let by_own = mine.iter().max_by_key(|r| num(r, "fusion_instr")).copied();
-        let by_point = mine.iter().max_by_key(|r| num(r, "per_point")).copied();
+        let by_point = mine.iter().max_by_key(|r| own_per_point(r)).copied();
         let full = mine
             .iter()
             .find(|r| num(r, "dropped") > 0)
@@ -1196,14 +1204,14 @@ the fusion over a sideways drive whose road map fills (Fusion<256, 2, 512>, 80 f
             num(o, "fusion_instr"),
             num(o, "frame"),
             num(o, "points"),
-            num(o, "per_point"),
-            num(p, "per_point"),
+            own_per_point(o),
+            own_per_point(p),
             num(p, "frame"),
             num(o, "entered"),
             num(o, "dropped"),
         );
         if run != "sight_check" {
-            worst_default = worst_default.max(num(p, "per_point"));
+            worst_default = worst_default.max(own_per_point(p));
             // (A drive whose map no longer fills would measure the case it
             // is for no more, and the owned miss below would vanish: a
             // hard miss.)
@@ -1213,10 +1221,10 @@ the fusion over a sideways drive whose road map fills (Fusion<256, 2, 512>, 80 f
                 ));
             }
         }
-        if run != "sight_check" && num(p, "per_point") > b.fusion_per_point {
+        if run != "sight_check" && own_per_point(p) > b.fusion_per_point {
             misses.push(format!(
                 "{OPEN_FUSION}fusion over the sideways drive, {run} (the map full): {} instructions per key-frame point (frame {}) > budget {}",
-                num(p, "per_point"),
+                own_per_point(p),
                 num(p, "frame"),
                 b.fusion_per_point
             ));

@@ -75,8 +75,9 @@
 //!   bound on its points' forward coordinates), one wholly ahead is
 //!   skipped, and of the batches the camera is passing at most
 //!   [`SWEEP_PER_FRAME`] points per boundary are tested each frame, from
-//!   the oldest on (except in a frame where a key frame retires, which
-//!   copies its points instead): a bounded cost per frame whatever `M` is.
+//!   the oldest on (except in a frame where a key frame retires, or the
+//!   rest of one enters, which copies points instead): a bounded cost per
+//!   frame whatever `M` is.
 //! * **Capacity**: a boundary holds at most `M` points and the map at most
 //!   [`MAP_BATCHES`] batches; a retiring key frame makes room by dropping
 //!   the oldest points first (the oldest batch's, in the order they
@@ -86,8 +87,14 @@
 //!   live points as dropped for room), and leaves out its own farthest
 //!   points beyond `M`.
 //!
-//! Size: `12·B·M` bytes of points and [`MAP_BATCHES`] batches of
-//! `88 + 4·B` bytes (13 096 bytes in all for `B = 2`, `M = 512`).
+//! A retiring key frame may enter over two steps ([`Retired::pending`];
+//! [`crate::fusion`], "The retirement over two steps"): its batch holds
+//! the points entered so far, bounded over them, and is bounded again
+//! over all of them when the rest enter.
+//!
+//! Size: `12·B·M` bytes of points, [`MAP_BATCHES`] batches of `88 + 4·B`
+//! bytes and a retirement's rest (13 136 bytes in all for `B = 2`,
+//! `M = 512`).
 
 use crate::camera::Camera;
 use crate::fusion::code::DepthScale;
@@ -975,21 +982,23 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
     /// next admitted point, and what the scan does not reach is
     /// [`Retired::unfit`]).
     ///
-    /// At most `share` points enter now, boundary by boundary; room is
-    /// made for all, and the rest enter with [`Self::finish`], which must
-    /// come before anything else changes the map, `key` or `s`
+    /// Admitted points up to `permille` ‰ of the key frame's points
+    /// (rounded up) are looked at now, entered or left out, boundary by
+    /// boundary; room is made for
+    /// all, and the rest enter with [`Self::finish`], which must come
+    /// before anything else changes the map, `key` or `s`
     /// ([`Retired::pending`] counts them). Until then the batch holds the
-    /// points entered, bounded over them.
+    /// points entered, bounded over them. 1000 ‰: all now.
     ///
     /// Work: two passes over the key frame's points (`B·N`), plus the
     /// points dropped for room; the entries, the dearest part, at most
-    /// `share`.
+    /// the share of the admitted points.
     pub(crate) fn retire<const N: usize>(
         &mut self,
         key: &KeyFrame<N, B>,
         s: &Structure<N, B>,
         chain: &Chain,
-        (e1, share): (f32, usize),
+        (e1, permille): (f32, u16),
     ) -> Retired {
         // (An unfinished retirement is finished by the caller first; one
         // left is forgotten with its points, never written over a batch.)
@@ -1012,6 +1021,11 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         }
         // 2. Room: a batch slot, then ring slots, oldest first.
         let admitted = want;
+        // The share is of the key frame's points, admitted or not: with the
+        // pass over its last pair, what a step can afford a point. (At most
+        // `B·N` < 2³² of them, times at most 1000: no overflow in `u64`.)
+        let total: usize = (0..B).map(|k| key.len(k)).sum();
+        let share = (total as u64 * u64::from(permille.min(1000))).div_ceil(1000) as usize;
         self.make_room(&mut want, &mut out);
         // 3. The batch: its pose, each boundary's points (up to the share),
         // the bounds over them.
@@ -1043,15 +1057,20 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         };
         let mut left = share;
         for (k, &w) in want.iter().enumerate() {
-            let now = w.min(left);
             let mut at = 0;
-            let (n, unbounded) =
-                self.enter(k, now, &mut at, (key, s, rest.far_limit), &mut rest.extent);
-            left -= n;
+            let (n, unbounded) = self.enter(
+                k,
+                (w, left),
+                &mut at,
+                (key, s, rest.far_limit),
+                &mut rest.extent,
+            );
+            let looked = n + unbounded as usize;
+            left = left.saturating_sub(looked);
             out.unbounded += unbounded;
             let a = admitted.get(k).copied().unwrap_or(0);
-            let open = a.saturating_sub(n + unbounded as usize);
-            if now < w {
+            let open = a.saturating_sub(looked);
+            if n < w && left == 0 {
                 // Cut at the share: the rest next step.
                 if let (Some(r_at), Some(r_want), Some(r_open)) = (
                     rest.at.get_mut(k),
@@ -1119,7 +1138,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             let mut at = usize::from(at);
             let (n, unbounded) = self.enter(
                 k,
-                usize::from(w),
+                (usize::from(w), usize::MAX),
                 &mut at,
                 (key, s, rest.far_limit),
                 &mut rest.extent,
@@ -1178,15 +1197,16 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
 
     /// [`Self::retire`]'s entries on boundary `k`: the next `w` admitted
     /// points of the key frame from cell `*at` on (left after the last one
-    /// looked at), written into the ring after its used slots, their rays'
-    /// forward rates and their depths taken into `extent`. Returns how
-    /// many entered, and how many were left out for a far end the codes
-    /// cannot hold or past `limit` (a distance bound past [`MAX_REACH`],
+    /// looked at), no more than `look` looked at (entered or left out),
+    /// written into the ring after its used slots, their rays' forward
+    /// rates and their depths taken into `extent`. Returns how many
+    /// entered, and how many were left out for a far end the codes cannot
+    /// hold or past `limit` (a distance bound past [`MAX_REACH`],
     /// [`entry_of`]).
     fn enter<const N: usize>(
         &mut self,
         k: usize,
-        w: usize,
+        (w, look): (usize, usize),
         at_out: &mut usize,
         (key, s, limit): (&KeyFrame<N, B>, &Structure<N, B>, u16),
         extent: &mut Extent,
@@ -1204,7 +1224,10 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         let (mut n, mut unbounded) = (0usize, 0u32);
         let (cells, points) = (key.cells(k), results.points());
         let mut at = *at_out;
-        while n < w {
+        // (The points left out count against `look` too: checked where one
+        // is, rare.)
+        let stop = w.min(look);
+        while n < stop {
             // The next admitted point (a tight scan: on most drives most
             // are not).
             while cells.get(at).is_some_and(|c| !c.admitted(min_pairs)) {
@@ -1217,6 +1240,9 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             let Some(e) = entry_of(cam.normalise(r.pixel1()), c.ends(), limit, &scale, &mut ext)
             else {
                 unbounded += 1;
+                if n + unbounded as usize >= look {
+                    break;
+                }
                 continue;
             };
             if let Some(slot) = ring.get_mut((start + n) % M) {

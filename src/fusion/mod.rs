@@ -64,26 +64,45 @@
 //! # The retirement over two steps
 //! A retiring key frame's admitted points are copied into the map (their
 //! rays, their coded ends, the batch's bounds): the costliest part of the
-//! fusion, and all of it in one frame. So the retiring step enters at
-//! most `⌈0.35·N·B⌉` of them (boundary by boundary, in order; the share
-//! is [`FusionConfig::with_retirement_share`]'s, 350 ‰ by default) and makes
-//! room for all; the rest enter at the start of the **next** step, before
-//! its pair: the retired key frame's cells and the reconstruction of its
-//! pixels stay untouched until then (the next key frame's fusion starts
-//! with that step, and the processor pairs after it). The retiring step
-//! also fuses its own pair (about 37 instructions a key-frame point) and
-//! makes the room; the next step pairs a fresh key frame, whose first
-//! pair has no interval to intersect (about 13), so 35 % in the first
-//! and 65 % in the second leave the two about even where a full key frame
-//! retires into a full map (measured: `docs/FUSION.md`). Between the
-//! two steps the map holds the points entered so far (each point whole:
-//! bounded, carried and swept as any other), [`Fusion::key`] all of them;
-//! [`crate::map::Retired::pending`] counts the rest, and the next step's
-//! [`FusionStep::finished`] what became of them. A retirement at a motion
-//! limit is whole (the processor keeps the new frame at once), and so is
-//! every one with a share of 1000 ‰. The map after
-//! the next step is the one a whole retirement leaves (the same points,
-//! bounds and counts: `host_tests/tests/fusion.rs`,
+//! fusion, about 100 instructions a point, and all of it in one frame. So
+//! the retiring step looks at no more of them than 35.5 % of the key
+//! frame's points, rounded up (entered, or left out as
+//! [`crate::map::Retired::unbounded`]; boundary by boundary, in order; the
+//! share is [`FusionConfig::with_retirement_share`]'s, 355 ‰ by default)
+//! and makes room for all; the rest enter at the start of the **next**
+//! step, before its pair: the retired key frame's cells and the
+//! reconstruction of its pixels stay untouched until then (the next key
+//! frame's fusion starts with that step, and the processor pairs after
+//! it).
+//!
+//! Why a share of the key frame's points: the retiring step also fuses its
+//! own pair (about 37 instructions a key-frame point) and makes the room,
+//! so with 35.5 % of its points entered it stays near 80 a point whatever
+//! share of them is admitted, and a key frame with fewer admitted points
+//! (the demo drive's, about a third) retires in one step as before. The
+//! next step pairs a fresh key frame, whose first pair has no interval to
+//! intersect (about 13 a point), and enters the rest, at most 64.5 % of the
+//! retired key frame's points: where the two key frames are about as large
+//! the two steps come out even (the default evens them where a full key
+//! frame retires into a full map: `docs/FUSION.md`). Where the next key
+//! frame is much smaller, that step's work is the same, so its work a
+//! point of its own key frame is larger (a review's key frame of 4 points
+//! after one of 504: 34 006 instructions). (A share of the admitted points
+//! split the demo drive's retirements too, and moved work into the step
+//! after one, the demo's dearest matching, past the deadline; a share of
+//! the capacity `B·N` left small key frames whole, a review's 90 points a
+//! boundary at 159 a point.)
+//!
+//! Between the two steps the map holds the points entered so far (each
+//! point whole: bounded, carried and swept as any other), [`Fusion::key`]
+//! all of them; [`crate::map::Retired::pending`] counts the rest, and the
+//! next step's [`FusionStep::finished`] what became of them (a
+//! [`Fusion::constrain`] in between enters them first). The map's sweep
+//! rests in that step as in the retiring one. A retirement at a motion or
+//! error limit is whole (the processor keeps the new frame at once; such a
+//! step has no pair to match), and so is every one with a share of
+//! 1000 ‰. The map after the next step is the one a whole retirement
+//! leaves (the same points, bounds and counts: `host_tests/tests/fusion.rs`,
 //! `a_retirement_over_two_steps_leaves_the_whole_ones_map`).
 //!
 //! # Range sensors
@@ -94,15 +113,14 @@
 //! # Memory and work
 //! Beside the processor, `Fusion<N, B, M>` holds a [`KeyFrame`] (`16·B·N`
 //! bytes), a [`RoadMap`] (`12·B·M` bytes and [`crate::map::MAP_BATCHES`]
-//! batches) and a few words: 21 380 bytes for `N = 256`, `B = 2`,
+//! batches) and a few words: 21 576 bytes for `N = 256`, `B = 2`,
 //! `M = 512` on the Cortex-M4F, asserted at compile time there (at most
 //! 24 KiB). Per frame the fusion costs one pass over the key frame's points
 //! (`O(1)` each: an intersection, or the consistency check), `O(MAP_BATCHES)`
 //! to carry the map and at most [`crate::map::SWEEP_PER_FRAME`] point tests
 //! per boundary for points the vehicle has passed; a retiring key frame
-//! one more pass to copy its points into the map (at most 35 % of a key
-//! frame's capacity in that step, the rest at the start of the next,
-//! above). The depths of the map
+//! one more pass to copy its points into the map (up to 35.5 % of its
+//! points in that step, the rest at the start of the next, above). The depths of the map
 //! and of the rival intervals are 16-bit codes relative to a power of two
 //! at or above the configuration's maximum depth (resolution `2⁻¹²` of the
 //! depth for depths within `2¹⁵` of it, rounded outwards). `docs/FUSION.md`
@@ -224,7 +242,7 @@ impl FusionConfig {
             keep_permille,
             map_min_pairs: 2,
             sight_check: false,
-            retire_permille: 350,
+            retire_permille: 355,
             tilt: 0.0,
             tilt_sc: (0.0, 1.0),
         })
@@ -284,14 +302,15 @@ impl FusionConfig {
         self
     }
 
-    /// The same policy with at most `permille` ‰ of a key frame's
-    /// capacity, `⌈N·B·permille/1000⌉` points, entering the map in the step
-    /// that retires it, 0 to 1000 (350 by default; 1000
-    /// enters them all in that step); the rest enter at the start of the
-    /// next step, before its pair: the retiring step's work bounded by the
-    /// share, the map whole one step later ([`crate::map::Retired::pending`],
-    /// [`FusionStep::finished`]; module docs, "The retirement over two
-    /// steps").
+    /// The same policy with no more admitted points than `permille` ‰ of a
+    /// retiring key frame's points (rounded up), 0 to 1000, looked at in
+    /// the step that retires it (entered into the map, or left out as
+    /// unbounded), 355 by default (1000: all of them in that step); the
+    /// rest enter at the
+    /// start of the next step, before its pair: the retiring step's work
+    /// bounded by the share, the map whole one step later
+    /// ([`crate::map::Retired::pending`], [`FusionStep::finished`]; module
+    /// docs, "The retirement over two steps").
     pub const fn with_retirement_share(mut self, permille: u16) -> Result<Self, FusionConfigError> {
         if permille > 1000 {
             return Err(FusionConfigError::RetireShare);
@@ -300,8 +319,8 @@ impl FusionConfig {
         Ok(self)
     }
 
-    /// The share of a key frame's capacity entering the map in its
-    /// retiring step, permille.
+    /// The share of a retiring key frame's points, permille, up to which
+    /// its admitted points enter the map in its retiring step.
     pub const fn retirement_share(&self) -> u16 {
         self.retire_permille
     }
@@ -625,11 +644,13 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// cut: it is linear in the key frame's points plus a constant
     /// (`docs/FUSION.md`, "The fusion's own work"), so leave room for it in
     /// the limit. Measured on the emulated Cortex-M4F, `Fusion<256, 2,
-    /// 512>`, not a bound: 165 instructions a key-frame point (84 613 a
-    /// step) where a key frame retires into a full map, up to 209 (107 030)
-    /// in adversarial reviews' runs; with the sight check on
-    /// ([`FusionConfig::with_sight_check`]) 371, up to 534 (273 590); 64
-    /// and 188 on the demo drive, whose map never fills.
+    /// 512>`, not a bound: 80 instructions a key-frame point (40 967 a
+    /// step) where a key frame retires into a full map, its points
+    /// entering over that step and the next (module docs, "The retirement
+    /// over two steps"), up to 107 (53 842 a step) in an adversarial
+    /// review's drives with full key frames, more a point with small key
+    /// frames; with the sight check on ([`FusionConfig::with_sight_check`])
+    /// 287; 58 and 188 on the demo drive, whose map never fills.
     pub fn step_within<D: Deadline>(
         &mut self,
         id: u32,
@@ -653,7 +674,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         let m = chained_from(last, id, motion)?;
         self.last = Some(id);
         let bounds = StepBounds::of(&self.base);
-        self.settle();
+        let finishing = self.settle();
         out.finished = self.finished.take();
         self.shows_retired = false;
         if !self.has_key {
@@ -674,13 +695,17 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         };
         let last_partner = self.due && has_points(frame);
         // 3. The map follows the vehicle; its sweep rests in a frame where
-        // a key frame retires (that frame copies its points instead).
-        self.map
-            .carry(&m.motion, &bounds, !(last_partner || limit.is_some()));
+        // a key frame retires or the rest of one enters (that frame copies
+        // points instead).
+        self.map.carry(
+            &m.motion,
+            &bounds,
+            !(last_partner || limit.is_some() || finishing),
+        );
         let (Ok(motion), Ok(cfg), None) = (&motion, &cfg, limit) else {
             // No last pair: retire what the key frame has, whole (the
             // processor keeps this frame at once), start anew.
-            out.retired = self.retire(usize::MAX);
+            out.retired = self.retire(1000);
             let shown = out.retired.is_some();
             // (`limit` is `Some` here: `None` only with both `Ok`.)
             let reason = limit.unwrap_or(KeyReason::MotionLimit);
@@ -700,7 +725,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             // (The processor keeps the reconstruction of the key frame's
             // pixels and `key` its cells until the next step: the rest of
             // a retirement past the share enters then, `settle`.)
-            out.retired = self.retire(self.share());
+            out.retired = self.retire(self.config.retire_permille);
             out.new_key = Some(if self.key.partners() >= self.config.max_partners {
                 KeyReason::Partners
             } else {
@@ -833,28 +858,22 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// of the last retirement enters the map, while the retired key frame's
     /// cells and the reconstruction of its pixels are still there (every
     /// caller settles before the processor pairs again or `key` starts).
-    fn settle(&mut self) {
-        if let Some(r) = self.map.finish(&self.key, self.processor.structure()) {
+    /// Returns whether a rest entered now.
+    fn settle(&mut self) -> bool {
+        let rest = self.map.finish(&self.key, self.processor.structure());
+        if let Some(r) = rest {
             self.finished = Some(r);
         }
         if let Some((id, lens)) = self.pending.take() {
             self.key.start(id, lens);
         }
-    }
-
-    /// Points a retiring step enters into the map, at most: the configured
-    /// share of a key frame's capacity (module docs, "The retirement over
-    /// two steps").
-    fn share(&self) -> usize {
-        (N * B)
-            .saturating_mul(usize::from(self.config.retire_permille))
-            .div_ceil(1000)
+        rest.is_some()
     }
 
     /// Move the key frame's fused points into the map, posed by the chain
-    /// (the key frame's motion to the current frame): at most `share` now,
-    /// the rest at the next [`Self::settle`].
-    fn retire(&mut self, share: usize) -> Option<Retired> {
+    /// (the key frame's motion to the current frame): at most `permille` ‰
+    /// of its admitted points now, the rest at the next [`Self::settle`].
+    fn retire(&mut self, permille: u16) -> Option<Retired> {
         if !self.has_key || self.key.partners() == 0 {
             return None;
         }
@@ -862,7 +881,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             &self.key,
             self.processor.structure(),
             &self.chain,
-            (self.base.e1(), share),
+            (self.base.e1(), permille),
         ))
     }
 

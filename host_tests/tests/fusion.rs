@@ -1311,7 +1311,12 @@ fn the_map_radius_covers_the_key_frames_localisation_error() {
     let base = Config::DEFAULT
         .with_translation_error(1.0e-4)
         .expect("config");
-    let mut f = Box::new(HostFusion::new(base, FusionConfig::DEFAULT));
+    // (Every point enters in the retiring frame 8, where the map is read:
+    // the default share would leave 7 of 12 for frame 9.)
+    let policy = FusionConfig::DEFAULT
+        .with_retirement_share(1000)
+        .expect("share");
+    let mut f = Box::new(HostFusion::new(base, policy));
     // True points (-1, 1, 7 + i) in the frame-0 camera; the camera moves
     // 0.05 right and 0.25 forward a frame.
     let truth: Vec<[f64; 3]> = (0..12).map(|i| [-1.0, 1.0, 7.0 + f64::from(i)]).collect();
@@ -2030,4 +2035,70 @@ fn road_geometry_from_the_fused_map() {
         }
     }
     println!("{}", lines.join("\n"));
+}
+
+/// Found by a review of the retirement over two steps: a retirement that
+/// looked at its whole share, half of it left out as unbounded, said
+/// nothing was pending (`Retired::pending` 0) and the next step still
+/// reported a rest of it (`finished`, every count 0). Key frame 0 has 12
+/// points, each given a range (6 bounded, 6 past the map's depth codes:
+/// `max_depth` 30), one empty partner and one that matches nothing.
+#[test]
+fn a_retirement_with_nothing_pending_reports_no_rest() {
+    let cam = roadstereo::Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480).expect("camera");
+    let mut key_frame = Frame::<16, 1>::new(cam);
+    let pts: Vec<Pixel> = (0..12)
+        .map(|i| {
+            let (x, z) = (-1.0f32, 5.0 + i as f32);
+            Pixel::new(255.5 + 800.0 * x / z, 239.5 + 800.0 / z)
+        })
+        .collect();
+    key_frame.push_boundary(&pts).expect("valid");
+    let mut stub = Frame::<16, 1>::new(cam);
+    stub.push_boundary(&[Pixel::new(505.0, 470.0), Pixel::new(500.0, 460.0)])
+        .expect("valid");
+    let base = Config::new(0.5, 0.5, 10.0, 30.0).expect("config");
+    for share in [1000, 500] {
+        let policy = FusionConfig::new(2, 0)
+            .and_then(|p| p.with_map_min_pairs(1))
+            .and_then(|p| p.with_retirement_share(share))
+            .expect("policy");
+        let mut f = Box::new(Fusion::<16, 1, 64>::new(base, policy));
+        f.step(0, &key_frame, None).expect("key");
+        let key = f.key_ref().expect("key");
+        for i in 0..12 {
+            let far = if i < 6 { 20.0 } else { 1.0e4 };
+            f.constrain(key, 0, i, 0.0, far).expect("range");
+        }
+        let m = Motion::new([0.0, 0.0, 0.25], [0.0; 3]).expect("motion");
+        let chained = |from| Some(ChainedMotion { from, motion: m });
+        f.step(1, &Frame::new(cam), chained(0).as_ref())
+            .expect("step");
+        let r = f
+            .step(2, &stub, chained(1).as_ref())
+            .expect("step")
+            .retired
+            .expect("key frame 0 retires");
+        let next = f.step(3, &stub, chained(2).as_ref()).expect("step");
+        let rest = next
+            .finished
+            .map_or(0, |x| x.entered + x.unbounded + x.unfit);
+        // Every point accounted for over the two steps, once.
+        assert_eq!(
+            (
+                r.entered + next.finished.map_or(0, |x| x.entered),
+                r.unbounded + next.finished.map_or(0, |x| x.unbounded)
+            ),
+            (6, 6),
+            "share {share}: {r:?} {next:?}"
+        );
+        assert_eq!(rest, r.pending, "share {share}: {r:?} {next:?}");
+        // A rest is reported exactly when one was pending.
+        assert_eq!(
+            next.finished.is_some(),
+            r.pending > 0,
+            "share {share}: {r:?} {next:?}"
+        );
+        assert_eq!(r.pending, if share == 1000 { 0 } else { 6 }, "{r:?}");
+    }
 }

@@ -87,7 +87,7 @@
 //! frame retires into a full map: `docs/FUSION.md`). Where the next key
 //! frame is much smaller, that step's work is the same, so its work a
 //! point of its own key frame is larger (a review's key frame of 4 points
-//! after one of 504: 34 006 instructions). (A share of the admitted points
+//! after one of 504: 34 670 instructions). (A share of the admitted points
 //! split the demo drive's retirements too, and moved work into the step
 //! after one, the demo's dearest matching, past the deadline; a share of
 //! the capacity `B·N` left small key frames whole, a review's 90 points a
@@ -98,7 +98,8 @@
 //! all of them; [`crate::map::Retired::pending`] counts the rest, and the
 //! next step's [`FusionStep::finished`] what became of them (a
 //! [`Fusion::constrain`] in between enters them first). The map's sweep
-//! rests in that step as in the retiring one. A retirement at a motion or
+//! rests in the step after a retirement as in the retiring one, whether
+//! the retirement was cut or not. A retirement at a motion or
 //! error limit is whole (the processor keeps the new frame at once; such a
 //! step has no pair to match), and so is every one with a share of
 //! 1000 ‰. The map after the next step is the one a whole retirement
@@ -491,6 +492,9 @@ pub struct Fusion<const N: usize, const B: usize, const M: usize> {
     /// The rest of a retirement, entered ([`Fusion::settle`]) and not
     /// reported yet ([`FusionStep::finished`]).
     finished: Option<Retired>,
+    /// The last step retired a key frame: the map's sweep rests in the
+    /// next too.
+    rest_sweep: bool,
     /// The rounding of the last pair's composed motion (`Chain::config`).
     pair_rounding: Rounding,
     /// Key frames started over the fusion's life ([`KeyRef`]; a reset
@@ -542,6 +546,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             pending: None,
             map: RoadMap::new(config.tilt_sc, scale),
             finished: None,
+            rest_sweep: false,
             pair_rounding: Rounding::NONE,
             keys_started: 0,
         }
@@ -559,6 +564,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         self.due = false;
         self.pending = None;
         self.finished = None;
+        self.rest_sweep = false;
         self.map.clear();
     }
 
@@ -644,13 +650,13 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// cut: it is linear in the key frame's points plus a constant
     /// (`docs/FUSION.md`, "The fusion's own work"), so leave room for it in
     /// the limit. Measured on the emulated Cortex-M4F, `Fusion<256, 2,
-    /// 512>`, not a bound: 80 instructions a key-frame point (40 967 a
+    /// 512>`, not a bound: 80 instructions a key-frame point (40 970 a
     /// step) where a key frame retires into a full map, its points
     /// entering over that step and the next (module docs, "The retirement
-    /// over two steps"), up to 107 (53 842 a step) in an adversarial
-    /// review's drives with full key frames, more a point with small key
-    /// frames; with the sight check on ([`FusionConfig::with_sight_check`])
-    /// 287; 58 and 188 on the demo drive, whose map never fills.
+    /// over two steps"), up to 102 in a paired step and 108 (55 400 a
+    /// step) in an unpaired one at a motion limit in an adversarial
+    /// review's drives, more a point with small key frames; with the sight check on ([`FusionConfig::with_sight_check`])
+    /// 287; 58 and 182 on the demo drive, whose map never fills.
     pub fn step_within<D: Deadline>(
         &mut self,
         id: u32,
@@ -674,11 +680,12 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         let m = chained_from(last, id, motion)?;
         self.last = Some(id);
         let bounds = StepBounds::of(&self.base);
-        let finishing = self.settle();
+        self.settle();
         out.finished = self.finished.take();
+        let after_retirement = core::mem::take(&mut self.rest_sweep);
         self.shows_retired = false;
         if !self.has_key {
-            self.map.carry(&m.motion, &bounds, true);
+            self.map.carry(&m.motion, &bounds, !after_retirement);
             out.new_key = self.start_key(id, frame, KeyReason::First, false);
             return Ok(out);
         }
@@ -695,12 +702,14 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         };
         let last_partner = self.due && has_points(frame);
         // 3. The map follows the vehicle; its sweep rests in a frame where
-        // a key frame retires or the rest of one enters (that frame copies
-        // points instead).
+        // a key frame retires and in the next (they copy points instead,
+        // the next the rest of a retirement cut at its share; resting in
+        // it whether cut or not leaves a cut retirement's map the whole
+        // one's).
         self.map.carry(
             &m.motion,
             &bounds,
-            !(last_partner || limit.is_some() || finishing),
+            !(last_partner || limit.is_some() || after_retirement),
         );
         let (Ok(motion), Ok(cfg), None) = (&motion, &cfg, limit) else {
             // No last pair: retire what the key frame has, whole (the
@@ -858,16 +867,13 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// of the last retirement enters the map, while the retired key frame's
     /// cells and the reconstruction of its pixels are still there (every
     /// caller settles before the processor pairs again or `key` starts).
-    /// Returns whether a rest entered now.
-    fn settle(&mut self) -> bool {
-        let rest = self.map.finish(&self.key, self.processor.structure());
-        if let Some(r) = rest {
+    fn settle(&mut self) {
+        if let Some(r) = self.map.finish(&self.key, self.processor.structure()) {
             self.finished = Some(r);
         }
         if let Some((id, lens)) = self.pending.take() {
             self.key.start(id, lens);
         }
-        rest.is_some()
     }
 
     /// Move the key frame's fused points into the map, posed by the chain
@@ -877,6 +883,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         if !self.has_key || self.key.partners() == 0 {
             return None;
         }
+        self.rest_sweep = true;
         Some(self.map.retire(
             &self.key,
             self.processor.structure(),

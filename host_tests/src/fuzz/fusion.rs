@@ -870,6 +870,10 @@ fn check_step<const N: usize, const B: usize, const M: usize>(
     // the map's from then on).
     let finished = s.finished.map_or(0, |r| {
         set(features, bit::FINISHED);
+        // (A cut retirement counts its unfit points with its rest.)
+        if r.unfit > 0 {
+            set(features, bit::UNFIT);
+        }
         assert!(
             r.unverified == 0 && r.inconsistent == 0 && r.dropped == 0 && r.pending == 0,
             "{at}: {r:?}"

@@ -984,15 +984,15 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
     ///
     /// Admitted points up to `permille` ‰ of the key frame's points
     /// (rounded up) are looked at now, entered or left out, boundary by
-    /// boundary; room is made for
-    /// all, and the rest enter with [`Self::finish`], which must come
-    /// before anything else changes the map, `key` or `s`
-    /// ([`Retired::pending`] counts them). Until then the batch holds the
-    /// points entered, bounded over them. 1000 ‰: all now.
+    /// boundary; room is made for all, and the rest enter with
+    /// [`Self::finish`], which must come before anything else changes the
+    /// map, `key` or `s` ([`Retired::pending`] counts them). Until then
+    /// the batch holds the points entered, bounded over them. 1000 ‰: all
+    /// now.
     ///
     /// Work: two passes over the key frame's points (`B·N`), plus the
     /// points dropped for room; the entries, the dearest part, at most
-    /// the share of the admitted points.
+    /// the share of the key frame's points.
     pub(crate) fn retire<const N: usize>(
         &mut self,
         key: &KeyFrame<N, B>,

@@ -99,10 +99,9 @@
 //! next step's [`FusionStep::finished`] what became of them (a
 //! [`Fusion::constrain`] in between enters them first). The map's sweep
 //! rests in the step after a retirement as in the retiring one, whether
-//! the retirement was cut or not. A retirement at a motion or
-//! error limit is whole (the processor keeps the new frame at once; such a
-//! step has no pair to match), and so is every one with a share of
-//! 1000 ‰. The map after the next step is the one a whole retirement
+//! the retirement was cut or not. A retirement at a motion or error limit
+//! is whole (the processor keeps the new frame at once; such a step has
+//! no pair to match), and so is every one with a share of 1000 ‰. The map after the next step is the one a whole retirement
 //! leaves (the same points, bounds and counts: `host_tests/tests/fusion.rs`,
 //! `a_retirement_over_two_steps_leaves_the_whole_ones_map`).
 //!
@@ -121,11 +120,12 @@
 //! to carry the map and at most [`crate::map::SWEEP_PER_FRAME`] point tests
 //! per boundary for points the vehicle has passed; a retiring key frame
 //! one more pass to copy its points into the map (up to 35.5 % of its
-//! points in that step, the rest at the start of the next, above). The depths of the map
-//! and of the rival intervals are 16-bit codes relative to a power of two
-//! at or above the configuration's maximum depth (resolution `2⁻¹²` of the
-//! depth for depths within `2¹⁵` of it, rounded outwards). `docs/FUSION.md`
-//! ("What the fusion tests show") gives the instructions measured.
+//! points in that step, the rest at the start of the next, above). The
+//! depths of the map and of the rival intervals are 16-bit codes relative
+//! to a power of two at or above the configuration's maximum depth
+//! (resolution `2⁻¹²` of the depth for depths within `2¹⁵` of it, rounded
+//! outwards). `docs/FUSION.md` ("What the fusion tests show") gives the
+//! instructions measured.
 
 mod chain;
 pub(crate) mod code;
@@ -307,11 +307,10 @@ impl FusionConfig {
     /// retiring key frame's points (rounded up), 0 to 1000, looked at in
     /// the step that retires it (entered into the map, or left out as
     /// unbounded), 355 by default (1000: all of them in that step); the
-    /// rest enter at the
-    /// start of the next step, before its pair: the retiring step's work
-    /// bounded by the share, the map whole one step later
-    /// ([`crate::map::Retired::pending`], [`FusionStep::finished`]; module
-    /// docs, "The retirement over two steps").
+    /// rest enter at the start of the next step, before its pair: the
+    /// retiring step's work bounded by the share, the map whole one step
+    /// later ([`crate::map::Retired::pending`], [`FusionStep::finished`];
+    /// module docs, "The retirement over two steps").
     pub const fn with_retirement_share(mut self, permille: u16) -> Result<Self, FusionConfigError> {
         if permille > 1000 {
             return Err(FusionConfigError::RetireShare);
@@ -655,8 +654,9 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// entering over that step and the next (module docs, "The retirement
     /// over two steps"), up to 102 in a paired step and 108 (55 400 a
     /// step) in an unpaired one at a motion limit in an adversarial
-    /// review's drives, more a point with small key frames; with the sight check on ([`FusionConfig::with_sight_check`])
-    /// 287; 58 and 182 on the demo drive, whose map never fills.
+    /// review's drives, more a point with small key frames; with the sight
+    /// check on ([`FusionConfig::with_sight_check`]) 287; 58 and 182 on the
+    /// demo drive, whose map never fills.
     pub fn step_within<D: Deadline>(
         &mut self,
         id: u32,
@@ -877,8 +877,9 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     }
 
     /// Move the key frame's fused points into the map, posed by the chain
-    /// (the key frame's motion to the current frame): at most `permille` ‰
-    /// of its admitted points now, the rest at the next [`Self::settle`].
+    /// (the key frame's motion to the current frame): admitted points up to
+    /// `permille` ‰ of its points now, the rest at the next
+    /// [`Self::settle`].
     fn retire(&mut self, permille: u16) -> Option<Retired> {
         if !self.has_key || self.key.partners() == 0 {
             return None;

@@ -520,15 +520,17 @@ fn entry_of(
     // (Below `2⁻¹⁵ s` a near end is code 0, depth 0, and a far end code 1,
     // about `2⁻¹⁵ s`: the decoded ends hold the fused ones whatever they
     // are.)
-    let (near, far) = (scale.down(z_near), scale.up(z_far).max(1));
+    let (near, far) = (scale.down(z_near), scale.up_unclamped(z_far).max(1));
     // `|P_K|`'s bound on the true ray, the decoded far end times the
     // batch's ray bound: past `10³⁰` (a far ray of a wide-angle camera, or
     // such a scale) the map's `f32` arithmetic could overflow, so such a
     // point is left out too, as is one whose far end the codes cannot hold
     // (`UNBOUNDED` is above every limit).
-    if far > limit {
+    if far > i32::from(limit) {
         return None;
     }
+    // (At most `limit`, below `UNBOUNDED`: a `u16`.)
+    let far = far as u16;
     extent.y = (fmin(extent.y.0, y), fmax(extent.y.1, y));
     extent.codes = (extent.codes.0.min(near), extent.codes.1.max(far));
     Some(Entry { x, y, near, far })

@@ -87,12 +87,21 @@ impl DepthScale {
     /// `codes_agree_with_their_definition` checks every exponent.)
     #[inline]
     pub(crate) fn up(&self, z: f32) -> u16 {
+        self.up_unclamped(z).clamp(0, i32::from(UNBOUNDED)) as u16
+    }
+
+    /// [`Self::up`] before its clamp to `UNBOUNDED` (from `2 s` on, and
+    /// for a NaN, above it; 0 for `z ≤ 0`, at least 1 for `z > 0`): for a
+    /// caller that compares the code with a limit below `UNBOUNDED` anyway
+    /// (the map's far-code limit).
+    #[inline]
+    pub(crate) fn up_unclamped(&self, z: f32) -> i32 {
         if !(z > 0.0) {
-            return if z.is_nan() { UNBOUNDED } else { 0 };
+            return if z.is_nan() { i32::MAX } else { 0 };
         }
         let b = (z * self.inv).to_bits();
         let c = (b >> 11) as i32 - CODE_BASE + i32::from(b & 0x7FF != 0);
-        c.clamp(1, i32::from(UNBOUNDED)) as u16
+        c.max(1)
     }
 
     /// The depth a code stands for (0 for code 0, infinity for
@@ -221,6 +230,16 @@ mod tests {
                             // `z = q·s` (exact but at the ends of the range).
                             let z = q * sc.scale();
                             assert_eq!((sc.down(z), sc.up(z)), reference(&sc, z), "{z:e}");
+                            // The unclamped far code (the map's limit
+                            // test): the clamped one wherever that is
+                            // below `UNBOUNDED`, at or above it (and so
+                            // past every far-code limit) where it is not.
+                            let (u, raw) = (sc.up(z), sc.up_unclamped(z));
+                            if z > 0.0 && u < UNBOUNDED {
+                                assert_eq!(raw, i32::from(u), "{z:e}");
+                            } else if u == UNBOUNDED {
+                                assert!(raw >= i32::from(UNBOUNDED), "{z:e}");
+                            }
                         }
                     }
                 }
@@ -230,6 +249,8 @@ mod tests {
             assert!(sc.depth(sc.up(edge)) >= edge);
             let nan = f32::NAN;
             assert_eq!((sc.down(nan), sc.up(nan)), (0, UNBOUNDED));
+            assert!(sc.up_unclamped(nan) > i32::from(UNBOUNDED));
+            assert_eq!(sc.up_unclamped(-0.0).max(1), 1);
         }
     }
 

@@ -649,13 +649,13 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// cut: it is linear in the key frame's points plus a constant
     /// (`docs/FUSION.md`, "The fusion's own work"), so leave room for it in
     /// the limit. Measured on the emulated Cortex-M4F, `Fusion<256, 2,
-    /// 512>`, not a bound: 80 instructions a key-frame point (40 970 a
+    /// 512>`, not a bound: 79 instructions a key-frame point (40 021 a
     /// step) where a key frame retires into a full map, its points
     /// entering over that step and the next (module docs, "The retirement
     /// over two steps"), up to 102 in a paired step and 108 (55 400 a
     /// step) in an unpaired one at a motion limit in an adversarial
     /// review's drives, more a point with small key frames; with the sight
-    /// check on ([`FusionConfig::with_sight_check`]) 287; 58 and 182 on the
+    /// check on ([`FusionConfig::with_sight_check`]) 290; 57 and 185 on the
     /// demo drive, whose map never fills.
     pub fn step_within<D: Deadline>(
         &mut self,

@@ -710,97 +710,206 @@ fn check_map(d: &Drive, input: &host_tests::drives::Input, policy: FusionConfig)
     c
 }
 
+/// What a lockstep run of a split and a whole retirement counted
+/// ([`lockstep_split_and_whole`]).
+#[derive(Default)]
+struct Lockstep {
+    /// Retirements cut at their share, and those of them at a motion or
+    /// error limit (a step without a pair).
+    split: u32,
+    split_at_limit: u32,
+    /// Rests a range constraint between the two steps entered.
+    constrained: u32,
+    steps: u32,
+}
+
+/// One drive through two fusions in lockstep, one retiring whole (share
+/// 1000 ‰), one at a share of 30 ‰, with the motion `motion(j, key)` for
+/// frame `j` (`key`: the whole one's key frame, [`Fusion::key_id`]): the
+/// same steps, each retirement's counts adding up across its two steps,
+/// the map between them holding the points entered so far, and after the
+/// next step (or a range constraint in between) the same fusion (its key
+/// frame, map and counters: the digest).
+fn lockstep_split_and_whole(
+    d: &Drive,
+    seed: u64,
+    mut motion: impl FnMut(usize, Option<u32>) -> Option<ChainedMotion>,
+    c: &mut Lockstep,
+) {
+    let input = d.input(Noise::Disc, None, seed);
+    let policy = FusionConfig::DEFAULT
+        .with_tilt(d.spec.tilt as f32)
+        .expect("tilt");
+    let whole_policy = policy.with_retirement_share(1000).expect("share");
+    let mut whole = Box::new(HostFusion::new(input.config(), whole_policy));
+    let mut parts = Box::new(HostFusion::new(
+        input.config(),
+        policy.with_retirement_share(30).expect("share"),
+    ));
+    let mut pending: Option<roadstereo::map::Retired> = None;
+    for j in 0..d.frames.len() {
+        let frame = input.frame(&d.spec.intrinsics, j);
+        let m = motion(j, whole.key_id());
+        let a = whole.step(j as u32, &frame, m.as_ref()).expect("step");
+        let b = parts.step(j as u32, &frame, m.as_ref()).expect("step");
+        c.steps += 1;
+        assert_eq!(a.paired, b.paired, "{} frame {j}", d.spec.name);
+        assert_eq!(a.new_key, b.new_key);
+        assert!(a.finished.is_none() && a.retired.is_none_or(|r| r.pending == 0));
+        // The rest of the last step's retirement, and what it added up to.
+        match (pending.take(), b.finished) {
+            (None, None) => {}
+            (Some(p), Some(f)) => {
+                assert_eq!(f.key, p.key);
+                assert_eq!(f.entered + f.unbounded + f.unfit, p.pending, "{f:?} {p:?}");
+            }
+            (p, f) => panic!("{} frame {j}: pending {p:?}, finished {f:?}", d.spec.name),
+        }
+        match (a.retired, b.retired) {
+            (None, None) => {}
+            (Some(w), Some(r)) if r.pending == 0 => assert_eq!(w, r),
+            (Some(w), Some(r)) => {
+                c.split += 1;
+                if b.paired.is_none() {
+                    c.split_at_limit += 1;
+                }
+                assert_eq!((w.key, w.dropped), (r.key, r.dropped));
+                assert_eq!(
+                    (w.unverified, w.inconsistent),
+                    (r.unverified, r.inconsistent)
+                );
+                assert!(r.entered < w.entered, "{w:?} {r:?}");
+                assert_eq!(
+                    w.entered + w.unbounded + w.unfit,
+                    r.entered + r.unbounded + r.unfit + r.pending
+                );
+                let held: usize = (0..B).map(|k| parts.map().len(k)).sum();
+                let all: usize = (0..B).map(|k| whole.map().len(k)).sum();
+                assert_eq!(held + (w.entered - r.entered) as usize, all);
+                pending = Some(r);
+                // Now and then a range constraint (a wide one, on the new
+                // key frame's first point, on both) enters the rest before
+                // the next step.
+                if c.split.is_multiple_of(3) {
+                    let (ka, kb) = (whole.key_ref(), parts.key_ref());
+                    if let (Some(ka), Some(kb)) = (ka, kb) {
+                        let x = whole.constrain(ka, 0, 0, 0.0, 1.0e4);
+                        let y = parts.constrain(kb, 0, 0, 0.0, 1.0e4);
+                        assert_eq!(x, y);
+                        if y.is_ok() {
+                            c.constrained += 1;
+                            assert_eq!(whole.digest(), parts.digest());
+                        }
+                    }
+                }
+                continue;
+            }
+            (w, r) => panic!("{} frame {j}: {w:?} against {r:?}", d.spec.name),
+        }
+        assert_eq!(whole.digest(), parts.digest(), "{} frame {j}", d.spec.name);
+    }
+}
+
+/// The drive's own motion into frame `j` (none into the first).
+fn given_into(input_given: &[Motion], j: usize) -> Option<ChainedMotion> {
+    let motion = *input_given.get(j.checked_sub(1)?)?;
+    Some(ChainedMotion {
+        from: j as u32 - 1,
+        motion,
+    })
+}
+
 /// A retirement cut at its share ([`FusionConfig::with_retirement_share`])
 /// enters the rest at the start of the next step: after that step the
-/// fusion (its key frame, map and counters: the digest) is the one a
-/// whole retirement leaves, and the counts add up; between the two steps
-/// the map holds the points entered so far. Also with a range constraint
-/// between the two steps, which enters the rest then.
+/// fusion is the one a whole retirement leaves, and the counts add up
+/// ([`lockstep_split_and_whole`]). Also with a range constraint between
+/// the two steps, which enters the rest then.
 #[test]
 fn a_retirement_over_two_steps_leaves_the_whole_ones_map() {
-    let (mut split, mut constrained, mut steps) = (0, 0, 0);
+    let mut c = Lockstep::default();
     for family in DriveFamily::ALL {
         let (ds, _) = drives(family, 3, 24);
         for (seed, d) in &ds {
-            let input = d.input(Noise::Disc, None, *seed);
-            let policy = FusionConfig::DEFAULT
-                .with_tilt(d.spec.tilt as f32)
-                .expect("tilt");
-            let whole_policy = policy.with_retirement_share(1000).expect("share");
-            let mut whole = Box::new(HostFusion::new(input.config(), whole_policy));
-            let mut parts = Box::new(HostFusion::new(
-                input.config(),
-                policy.with_retirement_share(30).expect("share"),
-            ));
-            let mut pending: Option<roadstereo::map::Retired> = None;
-            for j in 0..d.frames.len() {
-                let frame = input.frame(&d.spec.intrinsics, j);
-                let m = (j > 0).then(|| ChainedMotion {
-                    from: j as u32 - 1,
-                    motion: input.given[j - 1],
-                });
-                let a = whole.step(j as u32, &frame, m.as_ref()).expect("step");
-                let b = parts.step(j as u32, &frame, m.as_ref()).expect("step");
-                steps += 1;
-                assert_eq!(a.paired, b.paired, "{} frame {j}", d.spec.name);
-                assert_eq!(a.new_key, b.new_key);
-                assert!(a.finished.is_none() && a.retired.is_none_or(|r| r.pending == 0));
-                // The rest of the last step's retirement, and what it
-                // added up to.
-                match (pending.take(), b.finished) {
-                    (None, None) => {}
-                    (Some(p), Some(f)) => {
-                        assert_eq!(f.key, p.key);
-                        assert_eq!(f.entered + f.unbounded + f.unfit, p.pending, "{f:?} {p:?}");
-                    }
-                    (p, f) => panic!("{} frame {j}: pending {p:?}, finished {f:?}", d.spec.name),
-                }
-                match (a.retired, b.retired) {
-                    (None, None) => {}
-                    (Some(w), Some(r)) if r.pending == 0 => assert_eq!(w, r),
-                    (Some(w), Some(r)) => {
-                        split += 1;
-                        assert_eq!((w.key, w.dropped), (r.key, r.dropped));
-                        assert_eq!(
-                            (w.unverified, w.inconsistent),
-                            (r.unverified, r.inconsistent)
-                        );
-                        assert!(r.entered < w.entered, "{w:?} {r:?}");
-                        assert_eq!(
-                            w.entered + w.unbounded + w.unfit,
-                            r.entered + r.unbounded + r.unfit + r.pending
-                        );
-                        let held: usize = (0..B).map(|k| parts.map().len(k)).sum();
-                        let all: usize = (0..B).map(|k| whole.map().len(k)).sum();
-                        assert_eq!(held + (w.entered - r.entered) as usize, all);
-                        pending = Some(r);
-                        // Now and then a range constraint (a wide one, on
-                        // the new key frame's first point, on both) enters
-                        // the rest before the next step.
-                        if split % 3 == 0 {
-                            let (ka, kb) = (whole.key_ref(), parts.key_ref());
-                            if let (Some(ka), Some(kb)) = (ka, kb) {
-                                let x = whole.constrain(ka, 0, 0, 0.0, 1.0e4);
-                                let y = parts.constrain(kb, 0, 0, 0.0, 1.0e4);
-                                assert_eq!(x, y);
-                                if y.is_ok() {
-                                    constrained += 1;
-                                    assert_eq!(whole.digest(), parts.digest());
-                                }
-                            }
-                        }
-                        continue;
-                    }
-                    (w, r) => panic!("{} frame {j}: {w:?} against {r:?}", d.spec.name),
-                }
-                assert_eq!(whole.digest(), parts.digest(), "{} frame {j}", d.spec.name);
-            }
+            let given = d.input(Noise::Disc, None, *seed).given;
+            lockstep_split_and_whole(d, *seed, |j, _| given_into(&given, j), &mut c);
         }
     }
     println!(
-        "retirement over two steps: {split} of the retirements split, {constrained} finished by a range constraint, {steps} steps equal to a whole retirement's after the next"
+        "retirement over two steps: {} of the retirements split, {} finished by a range constraint, {} steps equal to a whole retirement's after the next",
+        c.split, c.constrained, c.steps
     );
-    assert!(split > 20 && constrained > 2, "{split} {constrained}");
+    assert!(
+        c.split > 20 && c.constrained > 2,
+        "{} {}",
+        c.split,
+        c.constrained
+    );
+}
+
+/// The inverse of motion `m` (`Rᵀ`, `−Rᵀ T`; its angles recovered in
+/// `f64` in the convention of [`Motion::new`], `R = R_y(β) R_x(α)
+/// R_z(γ)`).
+fn inverse(m: &Motion) -> Motion {
+    let r = m.rotation_matrix();
+    let t = m.translation();
+    // Rᵀ's entries: rt[i][j] = r[j][i].
+    let rt = |i: usize, j: usize| f64::from(r[j][i]);
+    let alpha = (-rt(1, 2)).asin();
+    let beta = rt(0, 2).atan2(rt(2, 2));
+    let gamma = rt(1, 0).atan2(rt(1, 1));
+    let mut back = [0.0f32; 3];
+    for (i, b) in back.iter_mut().enumerate() {
+        *b = -(0..3).map(|k| rt(i, k) * f64::from(t[k])).sum::<f64>() as f32;
+    }
+    Motion::new(back, [alpha as f32, beta as f32, gamma as f32]).expect("inverse")
+}
+
+/// A retirement at a motion limit (a step without a pair: the motion from
+/// the key frame composes to no translation) is cut at the share too, its
+/// rest entered at the start of the next step, and leaves the whole
+/// one's fusion after it ([`lockstep_split_and_whole`]). Every fifth
+/// frame comes back to the key frame (the inverse of the drive's motions
+/// since it), then the drive goes on from there (the next motion is the
+/// drive's own, from the frame that came back, the new key frame).
+#[test]
+fn a_retirement_at_a_motion_limit_over_two_steps_leaves_the_whole_ones_map() {
+    let mut c = Lockstep::default();
+    let mut limits = 0u32;
+    for family in DriveFamily::ALL {
+        let (ds, _) = drives(family, 2, 24);
+        for (seed, d) in &ds {
+            let given = d.input(Noise::Disc, None, *seed).given;
+            lockstep_split_and_whole(
+                d,
+                *seed,
+                |j, key| {
+                    let own = given_into(&given, j);
+                    let Some(key) = key.map(|k| k as usize).filter(|&k| k + 1 < j) else {
+                        return own;
+                    };
+                    if !j.is_multiple_of(5) {
+                        return own;
+                    }
+                    // The chain from the key frame to frame j − 1, undone.
+                    let mut chain = given[key];
+                    for g in &given[key + 1..j - 1] {
+                        chain = chain.then(g).expect("composed");
+                    }
+                    limits += 1;
+                    Some(ChainedMotion {
+                        from: j as u32 - 1,
+                        motion: inverse(&chain),
+                    })
+                },
+                &mut c,
+            );
+        }
+    }
+    println!(
+        "retirement at a motion limit over two steps: {} of {limits} limits split ({} retirements split in all), {} finished by a range constraint, {} steps",
+        c.split_at_limit, c.split, c.constrained, c.steps
+    );
+    assert!(c.split_at_limit > 10, "{} of {limits}", c.split_at_limit);
 }
 
 #[test]

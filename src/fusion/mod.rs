@@ -100,10 +100,18 @@
 //! [`Fusion::constrain`] in between enters them first). The map's sweep
 //! rests in the step after a retirement as in the retiring one, whether
 //! the retirement was cut or not. A retirement at a motion or error limit
-//! is whole (the processor keeps the new frame at once; such a step has
-//! no pair to match), and so is every one with a share of 1000 ‰. The map after the next step is the one a whole retirement
-//! leaves (the same points, bounds and counts: `host_tests/tests/fusion.rs`,
-//! `a_retirement_over_two_steps_leaves_the_whole_ones_map`).
+//! (a step without a pair) is cut at the same share: the processor keeps
+//! the new frame at once, but its reconstruction of the retired key
+//! frame's pixels stays until it pairs again (keeping a frame touches
+//! only the kept frame), so the rest enters at the start of the next
+//! step as after a last pair. Such a step has no pair to fuse, so it is
+//! the lighter of the two (until the twenty-second session it retired
+//! whole, a review's 108 instructions a key-frame point). A share of
+//! 1000 ‰ retires every key frame whole. The map after the next step is
+//! the one a whole retirement leaves (the same points, bounds and counts:
+//! `host_tests/tests/fusion.rs`,
+//! `a_retirement_over_two_steps_leaves_the_whole_ones_map` and
+//! `a_retirement_at_a_motion_limit_over_two_steps_leaves_the_whole_ones_map`).
 //!
 //! # Range sensors
 //! [`Fusion::constrain`] intersects a key-frame point's interval with a
@@ -652,9 +660,10 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// 512>`, not a bound: 79 instructions a key-frame point (40 021 a
     /// step) where a key frame retires into a full map, its points
     /// entering over that step and the next (module docs, "The retirement
-    /// over two steps"), up to 102 in a paired step and 108 (55 400 a
-    /// step) in an unpaired one at a motion limit in an adversarial
-    /// review's drives, more a point with small key frames; with the sight
+    /// over two steps"), up to 102 in a paired step in an adversarial
+    /// review's drives (a retirement at a motion limit, 108 a point when
+    /// it was whole, now 42 in its step and 77 in the next in the same
+    /// review's harness), more a point with small key frames; with the sight
     /// check on ([`FusionConfig::with_sight_check`]) 290; 57 and 185 on the
     /// demo drive, whose map never fills.
     pub fn step_within<D: Deadline>(
@@ -712,9 +721,13 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             !(last_partner || limit.is_some() || after_retirement),
         );
         let (Ok(motion), Ok(cfg), None) = (&motion, &cfg, limit) else {
-            // No last pair: retire what the key frame has, whole (the
-            // processor keeps this frame at once), start anew.
-            out.retired = self.retire(1000);
+            // No last pair: retire what the key frame has, at the same
+            // share as after a last pair, and start anew. (The processor
+            // keeps this frame at once, but its reconstruction of the
+            // key frame's pixels stays until it pairs again, and `key`
+            // the retired cells until `settle`: the rest enters then, as
+            // after a last pair.)
+            out.retired = self.retire(self.config.retire_permille);
             let shown = out.retired.is_some();
             // (`limit` is `Some` here: `None` only with both `Ok`.)
             let reason = limit.unwrap_or(KeyReason::MotionLimit);

@@ -1405,6 +1405,74 @@ fn ranges_past_the_depth_codes_stay_out_of_the_map() {
     }
 }
 
+/// A retirement looks at no more of the key frame's points than its share
+/// (entered or left out as unbounded), whatever their order: here the
+/// first points of the boundary have ranges past the depth codes (left
+/// out), the rest are bounded by the pairs. A review found the share
+/// passed by as many points as were left out before the entries (the
+/// count of looked-at points was checked only where one was left out).
+#[test]
+fn a_retirement_looks_at_no_more_than_its_share() {
+    let cam = synth::Intrinsics::default().camera();
+    // A ground edge from far to near, its first `far` points near the
+    // horizon (no pair bounds them: only a range fuses them).
+    let edge = |n: f32, far: usize| {
+        let mut f = Frame::<N, B>::new(cam);
+        let pts: Vec<Pixel> = (0..40)
+            .map(|i| {
+                let z = if i < far {
+                    4000.0 - 200.0 * i as f32
+                } else {
+                    16.75 - 0.25 * (i - far) as f32
+                } - 0.25 * n;
+                Pixel::new(255.5 - 800.0 * (1.0 + 0.05 * n) / z, 239.5 + 800.0 / z)
+            })
+            .collect();
+        f.push_boundary(&pts).expect("valid");
+        f
+    };
+    let step = Motion::new([0.05, 0.0, 0.25], [0.0; 3]).expect("motion");
+    for (share, left_out) in [(100, 3), (200, 6), (300, 10), (500, 12), (1000, 5)] {
+        let edge = |n: f32| edge(n, left_out);
+        let policy = FusionConfig::new(2, 0)
+            .and_then(|p| p.with_map_min_pairs(1))
+            .and_then(|p| p.with_retirement_share(share))
+            .expect("policy");
+        let mut f = Box::new(HostFusion::new(Config::DEFAULT, policy));
+        f.step(0, &edge(0.0), None).expect("key");
+        let key = f.key_ref().expect("key");
+        for i in 0..left_out {
+            f.constrain(key, 0, i, 1.0, 1.0e30).expect("a valid range");
+        }
+        let total = f.key().expect("key").len(0) as u32;
+        let allowed = (total * u32::from(share)).div_ceil(1000);
+        let (mut looked, mut rest, mut retired) = (0, 0, 0);
+        for id in 1..=3u32 {
+            let m = ChainedMotion {
+                from: id - 1,
+                motion: step,
+            };
+            let s = f.step(id, &edge(id as f32), Some(&m)).expect("step");
+            if let Some(r) = s.retired {
+                retired += 1;
+                looked = r.entered + r.unbounded;
+                assert!(looked <= allowed, "share {share}: {r:?}, {allowed} allowed");
+                assert_eq!(r.unbounded, left_out.min(allowed as usize) as u32, "{r:?}");
+                rest = r.pending;
+            }
+            if let Some(r) = s.finished {
+                assert_eq!(r.entered + r.unbounded + r.unfit, rest, "{r:?}");
+                rest = 0;
+            }
+        }
+        assert_eq!(retired, 1, "share {share}");
+        assert_eq!(rest, 0, "share {share}: the rest entered");
+        if share < 1000 {
+            assert_eq!(looked, allowed, "share {share}: the whole share used");
+        }
+    }
+}
+
 /// Found by an adversarial review: the map's radius bounded the carried
 /// motion's error only, but the stick lies on the detected key-frame
 /// pixel's ray, and the true point on the true pixel's, up to `e₁` away:

@@ -143,6 +143,7 @@ mod sight;
 use core::fmt;
 
 pub(crate) use chain::{norm1, Chain, StepBounds, STEP_ROUNDING};
+pub(crate) use key::Cell;
 pub use key::{FusedCounts, FusedPoint, FusedStatus, KeyFrame, KeyPoint, PairFused};
 
 use crate::boundary::Frame;
@@ -657,7 +658,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// cut: it is linear in the key frame's points plus a constant
     /// (`docs/FUSION.md`, "The fusion's own work"), so leave room for it in
     /// the limit. Measured on the emulated Cortex-M4F, `Fusion<256, 2,
-    /// 512>`, not a bound: 79 instructions a key-frame point (40 021 a
+    /// 512>`, not a bound: 79 instructions a key-frame point (40 210 a
     /// step) where a key frame retires into a full map, its points
     /// entering over that step and the next (module docs, "The retirement
     /// over two steps"), up to 102 in a paired step in an adversarial

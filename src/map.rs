@@ -267,7 +267,9 @@ pub struct Retired {
     /// next step, which reports them as
     /// [`crate::fusion::FusionStep::finished`] (`entered + unbounded +
     /// unfit` there is this count; [`crate::fusion`], "The retirement over
-    /// two steps"). 0 when the retirement is whole.
+    /// two steps"). 0 when the retirement is whole. A
+    /// [`crate::fusion::Fusion::reset`] before the next step forgets them
+    /// with the map: no step reports them then.
     pub pending: u32,
 }
 

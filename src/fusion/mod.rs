@@ -103,11 +103,12 @@
 //! (a step without a pair) is cut at the same share: the processor keeps
 //! the new frame at once, but its reconstruction of the retired key
 //! frame's pixels stays until it pairs again (keeping a frame touches
-//! only the kept frame), so the rest enters at the start of the next
-//! step as after a last pair. Such a step has no pair to fuse, so it is
-//! the lighter of the two (until the twenty-second session it retired
-//! whole, a review's 108 instructions a key-frame point). A share of
-//! 1000 ‰ retires every key frame whole. The map after the next step is
+//! only the kept frame and the flag of an expired deadline), so the rest
+//! enters at the start of the next step as after a last pair. Such a
+//! step has no pair to fuse, so it is the lighter of the two (until the
+//! twenty-second session it retired whole, a review's 108 instructions a
+//! key-frame point). A share of 1000 ‰ retires every key frame whole.
+//! The map after the next step is
 //! the one a whole retirement leaves (the same points, bounds and counts:
 //! `host_tests/tests/fusion.rs`,
 //! `a_retirement_over_two_steps_leaves_the_whole_ones_map` and
@@ -468,7 +469,8 @@ pub struct FusionStep {
     /// this step (before its pair), if it had one: its `entered`,
     /// `unbounded` and `unfit` counts, which add up to the last step's
     /// [`Retired::pending`] (a [`Fusion::constrain`] in between enters it
-    /// then, and this step reports it).
+    /// then, and this step reports it; a [`Fusion::reset`] in between
+    /// forgets it with the map, and no step reports it).
     pub finished: Option<Retired>,
     /// Why this frame became the key frame, if it did.
     pub new_key: Option<KeyReason>,
@@ -658,14 +660,17 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// cut: it is linear in the key frame's points plus a constant
     /// (`docs/FUSION.md`, "The fusion's own work"), so leave room for it in
     /// the limit. Measured on the emulated Cortex-M4F, `Fusion<256, 2,
-    /// 512>`, not a bound: 79 instructions a key-frame point (40 210 a
+    /// 512>`, not a bound: 79 instructions a key-frame point (40 211 a
     /// step) where a key frame retires into a full map, its points
     /// entering over that step and the next (module docs, "The retirement
-    /// over two steps"), up to 102 in a paired step in an adversarial
-    /// review's drives (a retirement at a motion limit, 108 a point when
-    /// it was whole, now 42 in its step and 77 in the next in the same
-    /// review's harness), more a point with small key frames; with the sight
-    /// check on ([`FusionConfig::with_sight_check`]) 290; 57 and 185 on the
+    /// over two steps"), on the bench's sideways drives; 99 (43 946) on
+    /// its forward drive, whose room is made in a batch the camera is
+    /// passing; up to 102 in a paired step in an adversarial
+    /// review's drives, and at a retirement at a motion limit, in a step
+    /// without a pair, 42 in its step and 77 in the next in the same
+    /// review's harness (108 when it was whole); more a point with small
+    /// key frames; with the sight
+    /// check on ([`FusionConfig::with_sight_check`]) 291; 57 and 185 on the
     /// demo drive, whose map never fills.
     pub fn step_within<D: Deadline>(
         &mut self,

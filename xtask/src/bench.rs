@@ -24,7 +24,7 @@ pub const BENCH_USAGE: &str =
   as \"budget NOT MET: [open: issue N] ...\" on every run and not enforced until the issue
   lands (today, issue 11: the per-point budgets, the 2 x 256 frame with and without the fusion,
   the adversarial worst case and scaling, the worst-case bound; issue 13: the fusion's own work
-  per key-frame point on the sideways drive, whose map fills);
+  per key-frame point on the drives whose map fills);
   the deadline is share-percent of a
   frame-ms frame at cpu-mhz, one instruction = one cycle (default 277 200 instructions).
   The representative pair (the Fig. 6 set-up, one detector point per row, N = 32 ... 512):
@@ -46,7 +46,8 @@ pub const BENCH_USAGE: &str =
     - fusion state + road map (Fusion<256, 2, 512> beside its Processor) <= 24 KiB
     - the demo's matching (the processor call of each paired step) within the deadline in every
       frame, and its steps with the fusion (the matching, the fusion and the map) too
-  The fusion over a sideways drive whose road map fills (issue 13; 80 frames, 2 x 256 points):
+  The fusion over drives whose road map fills (issue 13; 80 frames, 2 x 256 points: sideways,
+  straight and turning, and forwards zigzagging):
     - the fusion's own instructions per key-frame point <= fusion-per-point in every paired frame
       (the demo drive's map never fills, so its retiring frames drop nothing for room)
     (reported: the worst step's own work in instructions, and the same with the sight check on)
@@ -154,8 +155,8 @@ pub fn bench(b: &Budget) -> Result<(), String> {
     drive_within(&log, b.deadline(), &mut misses);
     drive_counted(&log, b.deadline(), &mut misses);
     drive_sighted(&log, &mut misses);
-    let sideways = fusion_sideways(&log, b, &mut misses);
-    fusion_table(&log, &per, b, sideways, &mut misses);
+    let filling = fusion_filling(&log, b, &mut misses);
+    fusion_table(&log, &per, b, filling, &mut misses);
     memory_table(&log, &demo_elf, b, &mut misses)?;
     wire_table(&log, &mut misses);
     symbol_checks(&[&elf, &demo_elf], &mut misses)?;
@@ -850,10 +851,10 @@ fn adversarial(log: &str, b: &Budget, misses: &mut Vec<String>) {
 /// the step, the processor call inside it and the difference; the
 /// per-point budget on every paired frame, the replay's agreement, the
 /// representative frame plus the fusion against the deadline.
-/// `sideways`: the fusion's own work a key-frame point at its worst on the
-/// sideways drive ([`fusion_sideways`]), which the representative frame
+/// `filling`: the fusion's own work a key-frame point at its worst on the
+/// drives whose map fills ([`fusion_filling`]), which the representative frame
 /// with the fusion takes when it is the larger.
-fn fusion_table(log: &str, per: &PerN, b: &Budget, sideways: u64, misses: &mut Vec<String>) {
+fn fusion_table(log: &str, per: &PerN, b: &Budget, filling: u64, misses: &mut Vec<String>) {
     let rows = records(log, "fusion frame=");
     if rows.is_empty() {
         misses.push("no fusion rows in the bench log".into());
@@ -949,10 +950,10 @@ key-frame fusion over the demo drive (2 × 256 points, 8 partners, map of 2 × 5
             b.fusion_per_point
         ));
     }
-    // The fusion at its worst over both drives (the sideways drive's map
-    // fills, the demo drive's does not).
-    let (worst, of) = if sideways > worst {
-        (sideways, "the sideways drive's")
+    // The fusion at its worst over every drive (the filling drives' maps
+    // fill, the demo drive's does not).
+    let (worst, of) = if filling > worst {
+        (filling, "a drive whose map fills")
     } else {
         (worst, "the demo drive's")
     };
@@ -970,12 +971,12 @@ key-frame fusion over the demo drive (2 × 256 points, 8 partners, map of 2 × 5
         if with > deadline {
             // While the matching alone misses the deadline, issue 11 owns
             // this miss too; once it fits, the fusion must fit with it:
-            // issue 13 owns it while its worst is the sideways drive's
+            // issue 13 owns it while its worst is a filling drive's
             // (its own budget missed there), and with the demo drive's it
             // is a hard miss.
             let owner = if *i256 > deadline {
                 OPEN
-            } else if of == "the sideways drive's" {
+            } else if of == "a drive whose map fills" {
                 OPEN_FUSION
             } else {
                 ""
@@ -1150,41 +1151,42 @@ fn own_per_point(r: &[(String, String)]) -> u64 {
     num(r, "fusion_instr").div_ceil(num(r, "points").max(1))
 }
 
-/// The sideways drives (firmware `fusion_sideways`): a drive whose road
-/// map fills, so that each retiring key frame drops the oldest points for
-/// room, straight and turning. The fusion's own work a key-frame point,
-/// its worst over the paired steps of both, against the same budget as the
+/// The drives whose road map fills (firmware `fusion_filling`), so that
+/// each retiring key frame drops the oldest points for room: sideways,
+/// straight and turning, and forwards zigzagging (the room made in a batch
+/// the camera is passing). The fusion's own work a key-frame point, its
+/// worst over the paired steps of each, against the same budget as the
 /// demo drive's (issue 13 owns it: the demo drive's map never fills), and
 /// the worst step's own work in instructions (what a caller of
 /// `Fusion::step_within` leaves room for); with the sight check, reported.
-/// Returns the default policy's worst per key-frame point over both drives
+/// Returns the default policy's worst per key-frame point over the drives
 /// (0 if none).
-fn fusion_sideways(log: &str, b: &Budget, misses: &mut Vec<String>) -> u64 {
-    let rows = records(log, "fusion_sideways run=");
+fn fusion_filling(log: &str, b: &Budget, misses: &mut Vec<String>) -> u64 {
+    let rows = records(log, "fusion_filling run=");
     if rows.is_empty() {
-        misses.push("no fusion_sideways rows in the bench log".into());
+        misses.push("no fusion_filling rows in the bench log".into());
         return 0;
     }
     let mut worst_default = 0;
     println!(
         "
-the fusion over a sideways drive whose road map fills (Fusion<256, 2, 512>, 80 frames, 0.05 a frame across a straight road, turning back every 8 frames; `turning`: the camera also turns 0.005 rad a frame, back and forth with the motion):"
+the fusion over drives whose road map fills (Fusion<256, 2, 512>, 80 frames, turning back every 8 frames; `default`, `sight_check`: 0.05 a frame across a straight road; `turning`: the camera also turns 0.005 rad a frame, back and forth with the motion; `forward`: 0.2 forwards and 0.12 across a frame over a road 2.4 wide, turning 0.003 rad a frame):"
     );
     println!("| policy | paired steps | map full from frame | worst own work a step (frame) | its key-frame points | per point | worst per point (frame) | of a retiring step: entered / dropped |");
     println!("|---|---:|---:|---:|---:|---:|---:|---|");
-    for run in ["default", "sight_check", "turning"] {
+    for run in ["default", "sight_check", "turning", "forward"] {
         let mine: Vec<_> = rows
             .iter()
             .filter(|r| field(r, "run") == Some(run) && field(r, "paired") == Some("true"))
             .collect();
         if mine.is_empty() {
-            misses.push(format!("no paired fusion_sideways rows of {run}"));
+            misses.push(format!("no paired fusion_filling rows of {run}"));
             continue;
         }
         for r in &mine {
             if field(r, "same_structure") != Some("true") {
                 misses.push(format!(
-                    "fusion_sideways {run} frame {}: the replayed processor call gave another structure",
+                    "fusion_filling {run} frame {}: the replayed processor call gave another structure",
                     num(r, "frame")
                 ));
             }
@@ -1217,13 +1219,13 @@ the fusion over a sideways drive whose road map fills (Fusion<256, 2, 512>, 80 f
             // hard miss.)
             if full == "–" {
                 misses.push(format!(
-                    "fusion_sideways {run}: no retiring key frame dropped points for room (the map never filled)"
+                    "fusion_filling {run}: no retiring key frame dropped points for room (the map never filled)"
                 ));
             }
         }
         if run != "sight_check" && own_per_point(p) > b.fusion_per_point {
             misses.push(format!(
-                "{OPEN_FUSION}fusion over the sideways drive, {run} (the map full): {} instructions per key-frame point (frame {}) > budget {}",
+                "{OPEN_FUSION}fusion over a drive whose map fills, {run}: {} instructions per key-frame point (frame {}) > budget {}",
                 own_per_point(p),
                 num(p, "frame"),
                 b.fusion_per_point

@@ -108,9 +108,8 @@
 //! step has no pair to fuse, so it is the lighter of the two (until the
 //! twenty-second session it retired whole, a review's 108 instructions a
 //! key-frame point). A share of 1000 ‰ retires every key frame whole.
-//! The map after the next step is
-//! the one a whole retirement leaves (the same points, bounds and counts:
-//! `host_tests/tests/fusion.rs`,
+//! The map after the next step is the one a whole retirement leaves (the
+//! same points, bounds and counts: `host_tests/tests/fusion.rs`,
 //! `a_retirement_over_two_steps_leaves_the_whole_ones_map` and
 //! `a_retirement_at_a_motion_limit_over_two_steps_leaves_the_whole_ones_map`).
 //!
@@ -669,9 +668,9 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// review's drives, and at a retirement at a motion limit, in a step
     /// without a pair, 42 in its step and 77 in the next in the same
     /// review's harness (108 when it was whole); more a point with small
-    /// key frames; with the sight
-    /// check on ([`FusionConfig::with_sight_check`]) 291; 57 and 185 on the
-    /// demo drive, whose map never fills.
+    /// key frames; with the sight check on
+    /// ([`FusionConfig::with_sight_check`]) 291; 57 and 185 on the demo
+    /// drive, whose map never fills.
     pub fn step_within<D: Deadline>(
         &mut self,
         id: u32,

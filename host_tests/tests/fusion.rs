@@ -810,9 +810,10 @@ fn lockstep_split_and_whole(
     }
 }
 
-/// The drive's own motion into frame `j` (none into the first).
-fn given_into(input_given: &[Motion], j: usize) -> Option<ChainedMotion> {
-    let motion = *input_given.get(j.checked_sub(1)?)?;
+/// The motion into frame `j` of a drive whose motions from each frame to
+/// the next are `motions` (none into the first).
+fn given_into(motions: &[Motion], j: usize) -> Option<ChainedMotion> {
+    let motion = *motions.get(j.checked_sub(1)?)?;
     Some(ChainedMotion {
         from: j as u32 - 1,
         motion,
@@ -994,10 +995,7 @@ fn map_capacity_exhaustion_drops_the_oldest_and_counts() {
     let mut newest = None;
     for j in 0..d.frames.len() {
         let frame = input.frame(&d.spec.intrinsics, j);
-        let m = (j > 0).then(|| ChainedMotion {
-            from: j as u32 - 1,
-            motion: input.given[j - 1],
-        });
+        let m = given_into(&input.given, j);
         let s = f.step(j as u32, &frame, m.as_ref()).expect("step");
         // (A retirement past the step's share enters the rest, and counts
         // it, at the start of the next step: `finished`.)
@@ -1869,10 +1867,7 @@ fn limit_two_wrong_pairs_at_a_side_exit_pass_the_sight_check() {
             for b in boundaries {
                 fr.push_boundary(b).expect("valid");
             }
-            let m = (j > 0).then(|| ChainedMotion {
-                from: j as u32 - 1,
-                motion: motions[j - 1],
-            });
+            let m = given_into(&motions, j);
             f.step(j as u32, &fr, m.as_ref()).expect("step");
             if let Some(k) = f.key().filter(|k| k.id() == 0) {
                 last = k.point(0, 10);
@@ -2041,10 +2036,7 @@ fn range_constraints_narrow_or_flag() {
     let cam = d.spec.intrinsics.camera();
     let mut f = Box::new(HostFusion::new(input.config(), FusionConfig::DEFAULT));
     for j in 0..3 {
-        let m = (j > 0).then(|| ChainedMotion {
-            from: j as u32 - 1,
-            motion: input.given[j - 1],
-        });
+        let m = given_into(&input.given, j);
         f.step(j as u32, &input.frame(&d.spec.intrinsics, j), m.as_ref())
             .expect("step");
     }

@@ -71,8 +71,9 @@ impl DepthScale {
     /// end. No branch on the exponent.
     #[inline]
     pub(crate) fn down(&self, z: f32) -> u16 {
-        // (A NaN fails the comparison.)
+        // (A NaN fails the comparison. Rare: laid out of the way.)
         if !(z > 0.0) {
+            core::hint::cold_path();
             return 0;
         }
         let c = ((z * self.inv).to_bits() >> 11) as i32 - CODE_BASE;
@@ -97,6 +98,7 @@ impl DepthScale {
     #[inline]
     pub(crate) fn up_unclamped(&self, z: f32) -> i32 {
         if !(z > 0.0) {
+            core::hint::cold_path();
             return if z.is_nan() { i32::MAX } else { 0 };
         }
         let b = (z * self.inv).to_bits();

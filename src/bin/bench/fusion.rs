@@ -171,30 +171,13 @@ struct Filling {
 /// policy: the room a retirement makes is in a batch the camera is
 /// passing, each dropped point tested against it).
 const FILLING: [Filling; 4] = [
-    Filling {
-        name: "default",
-        policy: FusionConfig::DEFAULT,
-        step: (0.05, 0.0),
-        turn: 0.0,
-        edges: [-0.6, 0.6],
-        x0: 0.0,
-    },
-    Filling {
-        name: "sight_check",
-        policy: FusionConfig::DEFAULT.with_sight_check(true),
-        step: (0.05, 0.0),
-        turn: 0.0,
-        edges: [-0.6, 0.6],
-        x0: 0.0,
-    },
-    Filling {
-        name: "turning",
-        policy: FusionConfig::DEFAULT,
-        step: (0.05, 0.0),
-        turn: 0.005,
-        edges: [-0.6, 0.6],
-        x0: 0.0,
-    },
+    Filling::sideways("default", FusionConfig::DEFAULT, 0.0),
+    Filling::sideways(
+        "sight_check",
+        FusionConfig::DEFAULT.with_sight_check(true),
+        0.0,
+    ),
+    Filling::sideways("turning", FusionConfig::DEFAULT, 0.005),
     Filling {
         name: "forward",
         policy: FusionConfig::DEFAULT,
@@ -204,6 +187,21 @@ const FILLING: [Filling; 4] = [
         x0: -0.5,
     },
 ];
+
+impl Filling {
+    /// A sideways drive: 0.05 across a frame over a road 1.2 wide, from
+    /// its middle, turning `turn` a frame.
+    const fn sideways(name: &'static str, policy: FusionConfig, turn: f32) -> Self {
+        Self {
+            name,
+            policy,
+            step: (0.05, 0.0),
+            turn,
+            edges: [-0.6, 0.6],
+            x0: 0.0,
+        }
+    }
+}
 
 /// One drive whose road map fills ([`FILLING`]): per frame the step, the
 /// processor call inside it (replayed as [`fusion_bench`] does) and the

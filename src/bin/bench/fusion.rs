@@ -169,7 +169,8 @@ struct Filling {
 /// a frame over a road 2.4 wide, turning 0.003 rad a frame (`fwd_zz02c` of
 /// the twenty-first session's review, its dearest with the default
 /// policy: the room a retirement makes is in a batch the camera is
-/// passing, each dropped point tested against it).
+/// passing, whose dropped points were each tested against it until the
+/// twenty-third session).
 const FILLING: [Filling; 4] = [
     Filling::sideways("default", FusionConfig::DEFAULT, 0.0),
     Filling::sideways(

@@ -553,7 +553,8 @@ fn entry_of(
     // (Below `2⁻¹⁵ s` a near end is code 0, depth 0, and a far end code 1,
     // about `2⁻¹⁵ s`: the decoded ends hold the fused ones whatever they
     // are.)
-    let (near, far) = (scale.down(z_near), scale.up_unclamped(z_far).max(1));
+    // (The ends are never NaN: a cell's, `DepthScale::down_no_nan`.)
+    let (near, far) = (scale.down_no_nan(z_near), scale.up_no_nan(z_far));
     // `|P_K|`'s bound on the true ray, the decoded far end times the
     // batch's ray bound: past `10³⁰` (a far ray of a wide-angle camera, or
     // such a scale) the map's `f32` arithmetic could overflow, so such a

@@ -439,7 +439,10 @@ impl Cell {
     /// widened to a finite depth, so a fused interval is bounded.)
     #[inline(always)]
     pub(crate) fn admitted(&self, min_pairs: u8) -> bool {
-        (u32::from(min_pairs.max(1))..=0xFF).contains(&self.counts)
+        // `lo ≤ counts ≤ 0xFF` in one comparison (`lo` from 1 to 255):
+        // below `lo` the difference wraps past `0xFF − lo`.
+        let lo = u32::from(min_pairs.max(1));
+        self.counts.wrapping_sub(lo) <= 0xFF - lo
     }
 
     /// The fused interval's ends: meaningful only when there is one (an

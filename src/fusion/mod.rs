@@ -659,17 +659,17 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// cut: it is linear in the key frame's points plus a constant
     /// (`docs/FUSION.md`, "The fusion's own work"), so leave room for it in
     /// the limit. Measured on the emulated Cortex-M4F, `Fusion<256, 2,
-    /// 512>`, not a bound: 77 instructions a key-frame point (39 356 a
+    /// 512>`, not a bound: 75 instructions a key-frame point (38 071 a
     /// step) where a key frame retires into a full map, its points
     /// entering over that step and the next (module docs, "The retirement
-    /// over two steps"), on the bench's sideways drives; 74 (32 231) on
+    /// over two steps"), on the bench's sideways drives; 72 (31 207) on
     /// its forward drive, whose room is made in a batch the camera is
-    /// passing; up to 79 in a paired step in an adversarial review's
+    /// passing; up to 77 in a paired step in an adversarial review's
     /// drives with full key frames, and at a retirement at a motion
-    /// limit, in a step without a pair, 40 in its step and 76 in the
+    /// limit, in a step without a pair, 39 in its step and 74 in the
     /// next in the same review's harness (108 when it was whole); more a
-    /// point with smaller key frames (82–107 with 90–184 points); with
-    /// the sight check on ([`FusionConfig::with_sight_check`]) 284; 56
+    /// point with smaller key frames (80–105 with 90–184 points); with
+    /// the sight check on ([`FusionConfig::with_sight_check`]) 283; 56
     /// and 184 on the demo drive, whose map never fills.
     pub fn step_within<D: Deadline>(
         &mut self,

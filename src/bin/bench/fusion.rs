@@ -154,6 +154,9 @@ struct Filling {
     /// The road's two edges, `X` on the ground, and the camera's first `X`.
     edges: [f32; 2],
     x0: f32,
+    /// Both edges moved by this across, outwards and back: `+` on odd
+    /// frames, `−` on even ones (0: a still road).
+    wobble: f32,
 }
 
 /// The drives whose road map fills, each an adversarial review's (issue
@@ -170,8 +173,13 @@ struct Filling {
 /// the twenty-first session's review, its dearest with the default
 /// policy: the room a retirement makes is in a batch the camera is
 /// passing, whose dropped points were each tested against it until the
-/// twenty-third session).
-const FILLING: [Filling; 4] = [
+/// twenty-third session); `wobbling`, the default drive on a road whose
+/// two edges move 0.1 across every frame, out and back (the twenty-third
+/// session's review's `g_wob_all_0.1`: a world that does not stand still,
+/// or a detector or a motion that is wrong, so that the pairs of a key
+/// frame disagree and nearly every matched point takes the pass's path
+/// for a conflict).
+const FILLING: [Filling; 5] = [
     Filling::sideways("default", FusionConfig::DEFAULT, 0.0),
     Filling::sideways(
         "sight_check",
@@ -186,6 +194,11 @@ const FILLING: [Filling; 4] = [
         turn: 0.003,
         edges: [-1.2, 1.2],
         x0: -0.5,
+        wobble: 0.0,
+    },
+    Filling {
+        wobble: 0.1,
+        ..Filling::sideways("wobbling", FusionConfig::DEFAULT, 0.0)
     },
 ];
 
@@ -200,6 +213,7 @@ impl Filling {
             turn,
             edges: [-0.6, 0.6],
             x0: 0.0,
+            wobble: 0.0,
         }
     }
 }
@@ -233,7 +247,13 @@ fn filling(fusion: &mut Fusion<256, 2, 512>, drive: &Filling) -> bool {
         if i > 0 && i % 8 == 0 {
             dir = -dir;
         }
-        filling_frame(&mut frame, drive.edges, x, psi);
+        // (A wobbling road moves between frames: the pairs disagree.)
+        let w = if i % 2 == 1 {
+            drive.wobble
+        } else {
+            -drive.wobble
+        };
+        filling_frame(&mut frame, drive.edges.map(|e| e + w), x, psi);
         let Some(Measured {
             step,
             step_instr,

@@ -665,10 +665,13 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// over two steps"), on the bench's sideways drives; 72 (31 207) on
     /// its forward drive, whose room is made in a batch the camera is
     /// passing; up to 77 in a paired step in an adversarial review's
-    /// drives with full key frames, and at a retirement at a motion
+    /// drives with full key frames on a still road (78 in a second
+    /// review's search of about 500), and at a retirement at a motion
     /// limit, in a step without a pair, 39 in its step and 74 in the
     /// next in the same review's harness (108 when it was whole); more a
-    /// point with smaller key frames (80–105 with 90–184 points); with
+    /// point with smaller key frames (80–105 with 90–184 points), and
+    /// where the pairs disagree (166, 84 664, on the bench's wobbling road:
+    /// every matched point a conflict); with
     /// the sight check on ([`FusionConfig::with_sight_check`]) 283; 56
     /// and 184 on the demo drive, whose map never fills.
     pub fn step_within<D: Deadline>(

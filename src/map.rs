@@ -1460,6 +1460,50 @@ mod tests {
         }
     }
 
+    /// The two other places a drop is counted wrap too: the room a
+    /// retirement makes (`make_room`, every slot wanted, so the whole
+    /// batch goes: its live points for room) and the sweep (`sweep_boundary`
+    /// over a batch the camera is passing: the points of its first
+    /// [`SWEEP_PER_FRAME`] slots behind the camera), each with its count one
+    /// below `u32::MAX` (saturating, either fails).
+    #[test]
+    fn the_drop_counts_wrap_in_the_room_and_the_sweep() {
+        let mut g = Rng(0x0D20_95EF);
+        let (mut rooms, mut sweeps) = (0, 0);
+        for case in 0..400 {
+            let (map, batch, m) = batch_at_the_edge(&mut g, case);
+            let live = batch.live_total();
+            if live < 2 {
+                continue;
+            }
+            let mut room = map.clone();
+            room.drops.capacity = u32::MAX - 1;
+            let mut out = Retired::default();
+            room.make_room(&mut [M], &mut out);
+            assert_eq!(
+                (out.dropped, room.drops().capacity),
+                (live, live - 2),
+                "case {case}"
+            );
+            rooms += 1;
+            let view = View::of(&batch, map.tilt);
+            let behind = map.entries[0][..m.min(SWEEP_PER_FRAME)]
+                .iter()
+                .filter(|e| e.live() && view.behind(e, &map.scale))
+                .count() as u32;
+            if behind >= 2 {
+                let mut swept = map.clone();
+                swept.drops.behind = u32::MAX - 1;
+                let mut passing = [false; MAP_BATCHES];
+                passing[usize::from(swept.first)] = true;
+                swept.sweep_boundary(0, &passing);
+                assert_eq!(swept.drops().behind, behind - 2, "case {case}");
+                sweeps += 1;
+            }
+        }
+        assert!(rooms > 100 && sweeps > 10, "{rooms} {sweeps}");
+    }
+
     /// [`ray_bound`] at the corners of the image and its margin (where
     /// `|x|` and `|y|` are largest) of cameras with the principal point
     /// off centre, narrow and wide, with and without `λ`.

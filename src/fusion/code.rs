@@ -288,8 +288,10 @@ mod tests {
     /// [`DepthScale::down_no_nan`] and [`DepthScale::up_no_nan`] against
     /// [`DepthScale::down`] and [`DepthScale::up_unclamped`] (at least 1)
     /// for every exponent of either sign, mantissas at the cut's edges and
-    /// random ones, over scales from `2⁻¹²⁰` to `2¹²⁰`: the same codes for
-    /// everything but a NaN (zeros and infinities included).
+    /// 64 random ones an exponent, each as it is and times the scale, over
+    /// scales from `2⁻¹²⁰` to `2¹²⁰` (about half a million values): the
+    /// same codes for everything but a NaN (zeros and infinities
+    /// included).
     #[test]
     fn codes_without_their_test_agree() {
         let mut g = Rng(0x0C0D_E5EE);
@@ -298,26 +300,26 @@ mod tests {
             let sc = DepthScale::for_max_depth(max_depth);
             for sign in [0u32, 1 << 31] {
                 for e in 0..256u32 {
-                    let mut ms = [0, 1, 0x7FF, 0x800, 0x7F_F800, 0x7F_FFFF, 0x40_0000, 0];
-                    for m in 0..64 {
+                    let edges = [0, 1, 0x7FF, 0x800, 0x7F_F800, 0x7F_FFFF, 0x40_0000];
+                    let random = (0..64).map(|m| {
                         let r = (g.next() * 8_388_608.0) as u32 & 0x7F_FFFF;
-                        ms[7] = [r, r & !0x7FF, r | 0x7FF][m % 3];
-                        for m in ms {
-                            let q = f32::from_bits(sign | e << 23 | m);
-                            for z in [q, q * sc.scale()] {
-                                if z.is_nan() {
-                                    continue;
-                                }
-                                assert_eq!(sc.down_no_nan(z), sc.down(z), "{z:e}");
-                                assert_eq!(sc.up_no_nan(z), sc.up_unclamped(z).max(1), "{z:e}");
-                                checked += 1;
+                        [r, r & !0x7FF, r | 0x7FF][m % 3]
+                    });
+                    for m in edges.into_iter().chain(random) {
+                        let q = f32::from_bits(sign | e << 23 | m);
+                        for z in [q, q * sc.scale()] {
+                            if z.is_nan() {
+                                continue;
                             }
+                            assert_eq!(sc.down_no_nan(z), sc.down(z), "{z:e}");
+                            assert_eq!(sc.up_no_nan(z), sc.up_unclamped(z).max(1), "{z:e}");
+                            checked += 1;
                         }
                     }
                 }
             }
         }
-        assert!(checked > 1_000_000, "{checked}");
+        assert!(checked > 450_000, "{checked}");
     }
 
     #[test]

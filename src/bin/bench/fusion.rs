@@ -154,8 +154,8 @@ struct Filling {
     /// The road's two edges, `X` on the ground, and the camera's first `X`.
     edges: [f32; 2],
     x0: f32,
-    /// Both edges moved by this across, outwards and back: `+` on odd
-    /// frames, `−` on even ones (0: a still road).
+    /// The road (both edges) shifted by this across: `+` on odd frames,
+    /// `−` on even ones (0: a still road).
     wobble: f32,
 }
 

@@ -1,5 +1,6 @@
-//! Depths in 16 bits, rounded outwards: the compact intervals of the fusion
-//! state (the rival interval of a point) and of the road map.
+//! Depths in 16 bits, rounded outwards: the compact intervals of the road
+//! map. (The fusion's cells kept their rival intervals in these codes until
+//! the twenty-fourth session; they are exact `f32` now, [`super::key`].)
 //!
 //! A code is the top of an `f32`'s bits relative to a power of two `s` at
 //! or above the configuration's maximum depth: for `z/s` in `[2⁻¹⁵, 2)` the
@@ -86,16 +87,17 @@ impl DepthScale {
     /// (Until a twentieth session's rewrite the exponent's tests gave code
     /// 0 to `z = 2⁻¹⁵ s` exactly, a far end rounded down to depth 0;
     /// `codes_agree_with_their_definition` checks every exponent.)
-    #[inline]
+    #[cfg(test)]
     pub(crate) fn up(&self, z: f32) -> u16 {
         self.up_unclamped(z).clamp(0, i32::from(UNBOUNDED)) as u16
     }
 
     /// [`Self::up`] before its clamp to `UNBOUNDED` (from `2 s` on, and
-    /// for a NaN, above it; 0 for `z ≤ 0`, at least 1 for `z > 0`): for a
-    /// caller that compares the code with a limit below `UNBOUNDED` anyway
-    /// (the map's far-code limit).
-    #[inline]
+    /// for a NaN, above it; 0 for `z ≤ 0`, at least 1 for `z > 0`). With
+    /// [`Self::up`], the reference the tests hold [`Self::up_no_nan`] to
+    /// (the map's far ends; the fusion's cells keep exact depths since the
+    /// twenty-fourth session, [`super::key`]).
+    #[cfg(test)]
     pub(crate) fn up_unclamped(&self, z: f32) -> i32 {
         if !(z > 0.0) {
             core::hint::cold_path();

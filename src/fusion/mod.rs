@@ -119,9 +119,9 @@
 //! return), checked for consistency like a pair.
 //!
 //! # Memory and work
-//! Beside the processor, `Fusion<N, B, M>` holds a [`KeyFrame`] (`16·B·N`
+//! Beside the processor, `Fusion<N, B, M>` holds a [`KeyFrame`] (`20·B·N`
 //! bytes), a [`RoadMap`] (`12·B·M` bytes and [`crate::map::MAP_BATCHES`]
-//! batches) and a few words: 21 576 bytes for `N = 256`, `B = 2`,
+//! batches) and a few words: 23 624 bytes for `N = 256`, `B = 2`,
 //! `M = 512` on the Cortex-M4F, asserted at compile time there (at most
 //! 24 KiB). Per frame the fusion costs one pass over the key frame's points
 //! (`O(1)` each: an intersection, or the consistency check), `O(MAP_BATCHES)`
@@ -129,7 +129,7 @@
 //! per boundary for points the vehicle has passed; a retiring key frame
 //! one more pass to copy its points into the map (up to 35.5 % of its
 //! points in that step, the rest at the start of the next, above). The
-//! depths of the map and of the rival intervals are 16-bit codes relative
+//! depths of the map are 16-bit codes relative
 //! to a power of two at or above the configuration's maximum depth
 //! (resolution `2⁻¹²` of the depth for depths within `2¹⁵` of it, rounded
 //! outwards). `docs/FUSION.md` ("What the fusion tests show") gives the

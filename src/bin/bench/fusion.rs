@@ -102,7 +102,13 @@ pub fn fusion_bench() -> bool {
 /// vertical axis, seen on image rows 250 … 478 (256 points a boundary,
 /// depths 4.3 to 80; a straight road along `Z`: the forward position does
 /// not change the image).
-fn filling_frame(frame: &mut Frame<256, 2>, edges: [f32; 2], x: f32, yaw: f32) {
+fn filling_frame(
+    frame: &mut Frame<256, 2>,
+    edges: [f32; 2],
+    x: f32,
+    yaw: f32,
+    (offset, shifted): (f32, u16),
+) {
     frame.clear();
     let cam = *frame.camera();
     let (s, c) = sin_cos_small(yaw);
@@ -112,6 +118,7 @@ fn filling_frame(frame: &mut Frame<256, 2>, edges: [f32; 2], x: f32, yaw: f32) {
         for i in 0..256u16 {
             let v = 250.0 + 228.0 * f32::from(i) / 255.0;
             let z = cam.fy() * 1.2 / (v - cam.cy());
+            let edge = if i < shifted { edge + offset } else { edge };
             // (World `X − x = c x_c + s z`: the camera's `x_c` at depth `z`.)
             let u = cam.cx() + cam.fx() * (edge - x - s * z) / (c * z);
             if (0.0..=511.0).contains(&u) {
@@ -154,9 +161,11 @@ struct Filling {
     /// The road's two edges, `X` on the ground, and the camera's first `X`.
     edges: [f32; 2],
     x0: f32,
-    /// The road (both edges) shifted by this across: `+` on odd frames,
-    /// `−` on even ones (0: a still road).
-    wobble: f32,
+    /// The road (both edges) shifted across by `offsets[i % 8]` in frame
+    /// `i` (all 0: a still road), its first `shifted` points a boundary
+    /// (from the far rows; 256: all).
+    offsets: [f32; 8],
+    shifted: u16,
 }
 
 /// The drives whose road map fills, each an adversarial review's (issue
@@ -178,8 +187,13 @@ struct Filling {
 /// session's review's `g_wob_all_0.1`: a world that does not stand still,
 /// or a detector or a motion that is wrong, so that the pairs of a key
 /// frame disagree and nearly every matched point takes the pass's path
-/// for a conflict).
-const FILLING: [Filling; 5] = [
+/// for a conflict); `jumping`, 0.08 a frame sideways on a road whose
+/// edges jump by a table of up to 0.25 across within each 8 frames, all
+/// but their 22 nearest points (the twenty-third session's review's
+/// `c2_44`: most points conflict in a key frame's retiring step too,
+/// while a few agree and enter the map, so the retirement's own work
+/// comes on top of the conflicts').
+const FILLING: [Filling; 6] = [
     Filling::sideways("default", FusionConfig::DEFAULT, 0.0),
     Filling::sideways(
         "sight_check",
@@ -194,11 +208,19 @@ const FILLING: [Filling; 5] = [
         turn: 0.003,
         edges: [-1.2, 1.2],
         x0: -0.5,
-        wobble: 0.0,
+        offsets: [0.0; 8],
+        shifted: 0,
     },
     Filling {
-        wobble: 0.1,
+        offsets: [-0.1, 0.1, -0.1, 0.1, -0.1, 0.1, -0.1, 0.1],
+        shifted: 256,
         ..Filling::sideways("wobbling", FusionConfig::DEFAULT, 0.0)
+    },
+    Filling {
+        step: (0.08, 0.0),
+        offsets: [0.0, 0.12, 0.12, 0.0, 0.12, -0.2455, -0.12, 0.24],
+        shifted: 234,
+        ..Filling::sideways("jumping", FusionConfig::DEFAULT, 0.0)
     },
 ];
 
@@ -213,7 +235,8 @@ impl Filling {
             turn,
             edges: [-0.6, 0.6],
             x0: 0.0,
-            wobble: 0.0,
+            offsets: [0.0; 8],
+            shifted: 0,
         }
     }
 }
@@ -247,13 +270,9 @@ fn filling(fusion: &mut Fusion<256, 2, 512>, drive: &Filling) -> bool {
         if i > 0 && i % 8 == 0 {
             dir = -dir;
         }
-        // (A wobbling road moves between frames: the pairs disagree.)
-        let w = if i % 2 == 1 {
-            drive.wobble
-        } else {
-            -drive.wobble
-        };
-        filling_frame(&mut frame, drive.edges.map(|e| e + w), x, psi);
+        // (A road that moves between frames: the pairs disagree.)
+        let offset = drive.offsets.get(i as usize % 8).copied().unwrap_or(0.0);
+        filling_frame(&mut frame, drive.edges, x, psi, (offset, drive.shifted));
         let Some(Measured {
             step,
             step_instr,

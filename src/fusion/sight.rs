@@ -74,9 +74,12 @@
 //!
 //! A point's `U` is set by probing: each pair `j` asks whether its partner
 //! sees the ray from `H/2` (`H` counting this pair's stick); a yes makes
-//! `H/2` partner `j`'s depth, a no the exact one ([`Sight::seen_from`]),
-//! each rounded up to a code (a partner that sees none of the ray: `U`
-//! unbounded, and the pair that brings `H` below it flags). So `U_j` is
+//! `H/2` partner `j`'s depth, a no the exact one ([`Sight::seen_from`],
+//! rounded up over its own terms' rounding; a partner that sees none of
+//! the ray: `U` infinite, and the pair that brings `H` below it flags).
+//! `H` and `U` are kept as exact `f32` in the cell's rival slot since the
+//! twenty-fourth session (16-bit codes, `H` rounded down and `U` up,
+//! before: `src/fusion/key.rs`, `Cell`). So `U_j` is
 //! partner `j`'s depth or above it, never below: the rule errs towards
 //! widening (a larger `U` only widens). That makes it depend a little on
 //! the pairs' order after all: a later, lower `H` is compared with an

@@ -913,6 +913,103 @@ fn a_retirement_at_a_motion_limit_over_two_steps_leaves_the_whole_ones_map() {
     assert!(c.split_at_limit > 10, "{} of {limits}", c.split_at_limit);
 }
 
+/// A road whose edges, all but their `still` nearest points of `n` a
+/// boundary, are moved `offset` across (`f64`; the paper's camera at
+/// height 1.2 over a flat road, its rows 250–478, the camera at `x` across,
+/// looking along the road).
+fn moved_road_frame(x: f64, offset: f64, n: usize, still: usize) -> Frame<N, B> {
+    let cam = synth::Intrinsics::default().camera();
+    let mut f = Frame::new(cam);
+    for edge in [-0.6f64, 0.6] {
+        let pts: Vec<Pixel> = (0..n)
+            .filter_map(|i| {
+                let v = 250.0 + 228.0 * i as f64 / (n - 1) as f64;
+                let z = 800.0 * 1.2 / (v - 239.5);
+                let e = if i < n - still { edge + offset } else { edge };
+                let u = 255.5 + 800.0 * (e - x) / z;
+                (0.0..=511.0)
+                    .contains(&u)
+                    .then(|| Pixel::new(u as f32, v as f32))
+            })
+            .collect();
+        f.push_boundary(&pts).expect("valid");
+    }
+    f
+}
+
+/// A retiring step whose pass conflicts enters fewer points (the share
+/// less half the conflicts, `RoadMap::retire`), and the rest no more than
+/// the share leaves without the cut (a conflicting point is not admitted):
+/// the bench's `jumping` drive (0.08 a frame sideways, both edges but
+/// their 22 nearest points jumping by a table within each 8 frames, the
+/// pairs disagreeing), in lockstep with the same fusion retiring whole
+/// (1000 ‰, which the conflicts do not cut): the same steps, the counts
+/// adding up across the two steps, and after the next step the same
+/// fusion (the digest).
+#[test]
+fn a_retiring_step_whose_pass_conflicts_enters_less_and_the_rest_next() {
+    const OFFSETS: [f64; 8] = [0.0, 0.12, 0.12, 0.0, 0.12, -0.2455, -0.12, 0.24];
+    let mut whole = Box::new(HostFusion::new(
+        Config::DEFAULT,
+        FusionConfig::DEFAULT
+            .with_retirement_share(1000)
+            .expect("share"),
+    ));
+    let mut parts = Box::new(HostFusion::new(Config::DEFAULT, FusionConfig::DEFAULT));
+    let permille = FusionConfig::DEFAULT.retirement_share();
+    let (mut x, mut dir) = (0.0f64, 1.0f64);
+    let (mut cut, mut all_next, mut pending) = (0u32, 0u32, None);
+    for j in 0..48u32 {
+        let m = (j > 0).then(|| {
+            x += 0.08 * dir;
+            ChainedMotion {
+                from: j - 1,
+                motion: Motion::new([(0.08 * dir) as f32, 0.0, 0.0], [0.0; 3]).expect("motion"),
+            }
+        });
+        if j > 0 && j % 8 == 0 {
+            dir = -dir;
+        }
+        let frame = moved_road_frame(x, OFFSETS[j as usize % 8], 256, 22);
+        let a = whole.step(j, &frame, m.as_ref()).expect("step");
+        let b = parts.step(j, &frame, m.as_ref()).expect("step");
+        assert_eq!((a.paired, a.new_key), (b.paired, b.new_key), "frame {j}");
+        if let Some(p) = pending.take() {
+            let (p, rest_bound): (roadstereo::map::Retired, u32) = p;
+            let f = b.finished.expect("the rest of the retirement");
+            assert_eq!(f.entered + f.unbounded + f.unfit, p.pending);
+            assert!(p.pending <= rest_bound, "{p:?}: {rest_bound}");
+            assert_eq!(whole.digest(), parts.digest(), "frame {j}");
+        }
+        let (Some(w), Some(r)) = (a.retired, b.retired) else {
+            assert_eq!(a.retired, b.retired);
+            continue;
+        };
+        let conflicts = b.paired.map_or(0, |p| p.conflicts);
+        // The key frame that retired: `key` shows its final state.
+        let total: u32 = (0..B)
+            .map(|k| parts.key().map_or(0, |kf| kf.len(k)) as u32)
+            .sum();
+        let share = (total * u32::from(permille)).div_ceil(1000);
+        let looked = r.entered + r.unbounded;
+        assert!(
+            looked <= share.saturating_sub(conflicts.div_ceil(2)),
+            "frame {j}: {r:?}, {conflicts} conflicts, share {share}"
+        );
+        assert_eq!(
+            w.entered + w.unbounded + w.unfit,
+            r.entered + r.unbounded + r.unfit + r.pending
+        );
+        if conflicts > 0 && r.pending > 0 {
+            cut += 1;
+            all_next += u32::from(looked == 0);
+        }
+        pending = (r.pending > 0).then_some((r, total - share));
+    }
+    println!("retirements cut by their pass's conflicts: {cut} ({all_next} with every entry in the next step)");
+    assert!(cut >= 3, "{cut}");
+}
+
 /// `RoadMap::samples` shows exactly the points `RoadMap::points` shows,
 /// batch by batch, after every frame: over 5 drives of each family, 30
 /// frames, with and without motion errors (the camera's tilt given). A

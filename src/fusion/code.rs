@@ -117,7 +117,8 @@ impl DepthScale {
     /// (`codes_without_their_test_agree` checks every exponent of either
     /// sign). For the map's entries, whose ends are never NaN (a cell's
     /// ends are a pair's finite stick, a range's validated ends, their
-    /// intersections and decoded codes, [`super::key`]): about 3
+    /// intersections, and a widened point's `H` and finite `U`,
+    /// [`super::key`]): about 3
     /// instructions an entry fewer than the test and its branch.
     ///
     /// (Not the body of [`Self::down`] behind its test: there the unsigned
@@ -140,6 +141,15 @@ impl DepthScale {
         let b = (z * self.inv).to_bits();
         let c = (b as i32 >> 11) - CODE_BASE + i32::from(b & 0x7FF != 0);
         c.max(1)
+    }
+
+    /// `2 s`: from here on a far end's code is [`UNBOUNDED`] (and a near
+    /// end's the top one). The fusion's sight check takes a partner that
+    /// sees a ray only from here on as seeing none of it
+    /// (`super::key::SEEN_NONE`).
+    #[inline]
+    pub(crate) fn unbounded_from(&self) -> f32 {
+        2.0 * self.s
     }
 
     /// The depth a code stands for (0 for code 0, infinity for

@@ -126,9 +126,10 @@ pub struct FusedPoint {
     /// The status.
     pub status: FusedStatus,
     /// The fused interval (the majority's for an inconsistent point), if
-    /// any: finite, the exact intersection of the intervals it counts (or,
-    /// for a [`FusedStatus::Widened`] point, that widened as the sight
-    /// check says).
+    /// any: finite, the exact intersection of the intervals it counts,
+    /// widened where the sight check widened it (a
+    /// [`FusedStatus::Widened`] point, and one flagged after it was
+    /// widened keeps the widened ends).
     pub interval: Option<DepthInterval>,
     /// Pairs (and range constraints) that gave the point an interval.
     pub pairs: u8,
@@ -193,7 +194,9 @@ const UNSEEN: u32 = 1 << 24;
 /// The depth from which a partner sees a point's ray, for an interval
 /// from no partner (a range constraint): no partner to see.
 pub(crate) const SEEN_ANY: f32 = 0.0;
-/// The same for a partner shown to see none of the ray worth having.
+/// The same for a partner shown to see none of the ray worth having: none
+/// of it, or only from [`DepthScale::unbounded_from`] on, where the map's
+/// codes hold no far end ([`sight_exact`]).
 pub(crate) const SEEN_NONE: f32 = f32::INFINITY;
 
 /// The state of one point (20 bytes). An unmatched cell (no interval:
@@ -211,7 +214,7 @@ pub(crate) struct Cell {
     near: f32,
     far: f32,
     /// Rival interval, exact like the majority's (a conflict costs a few
-    /// comparisons and moves, no depth codes: "Pairs that disagree" in
+    /// comparisons and moves, no depth codes: "Exact rival intervals" in
     /// `docs/PERFORMANCE.md`). While no interval has missed the majority
     /// (no rival yet), the sight's state instead ([`super::sight`]): `H`,
     /// the lowest near end of the point's intervals, and `U`, a depth from
@@ -388,8 +391,9 @@ impl Cell {
     #[inline(never)]
     fn conflict(&mut self, near: f32, far: f32) {
         // (On the packed counts, [`Cell::counts`]: the rival's byte is bits
-        // 8–15, the others' 16–23, each saturating at 255.)
-        let mut counts = self.counts;
+        // 8–15, the others' 16–23, each saturating at 255. [`UNSEEN`] goes:
+        // an inconsistent point's status does not read it.)
+        let mut counts = self.counts & !UNSEEN;
         if counts & 0xFF00 == 0 {
             self.rival = [near, far];
             counts += 0x100;
@@ -522,7 +526,7 @@ fn count(added: Added, c: &Cell, min: u8, admitted: &mut u16, inconsistent: &mut
 /// is no longer watched gets `(0, SEEN_ANY)` (not looked at); a partner
 /// that sees nothing of the boundary (`sight` `None`), `(near, SEEN_NONE)`.
 #[inline(always)]
-fn sight_of(c: &Cell, r: &PointResult, sight: Option<&Sight>) -> (f32, f32) {
+fn sight_of(c: &Cell, r: &PointResult, sight: Option<&Sight>, scale: &DepthScale) -> (f32, f32) {
     if !c.watches() {
         return (0.0, SEEN_ANY);
     }
@@ -535,15 +539,24 @@ fn sight_of(c: &Cell, r: &PointResult, sight: Option<&Sight>) -> (f32, f32) {
     if sight.sees_from(r.pixel1, half) {
         return (near, half);
     }
-    (near, sight_exact(r.pixel1, sight))
+    (near, sight_exact(r.pixel1, sight, scale))
 }
 
-/// [`sight_of`] where the probe failed: the exact depth (infinite,
-/// [`SEEN_NONE`], where the partner sees none of the ray; out of line:
-/// rare).
+/// [`sight_of`] where the probe failed: the exact depth, or
+/// [`SEEN_NONE`] where the partner sees none of the ray (`seen_from`
+/// infinite) or only from [`DepthScale::unbounded_from`] on, beyond any
+/// far end the map can hold (as the coded `U` was until the
+/// twenty-fourth session: such a point is flagged `PartlyUnseen`, not
+/// widened to a depth the map would leave out as unbounded). Out of
+/// line: rare.
 #[inline(never)]
-fn sight_exact(p: Pixel, sight: &Sight) -> f32 {
-    sight.seen_from(p)
+pub(super) fn sight_exact(p: Pixel, sight: &Sight, scale: &DepthScale) -> f32 {
+    let e = sight.seen_from(p);
+    if e >= scale.unbounded_from() {
+        SEEN_NONE
+    } else {
+        e
+    }
 }
 
 /// The first pair of a fresh key frame on one boundary ([`KeyFrame::fuse`]):
@@ -639,6 +652,8 @@ pub struct KeyFrame<const N: usize, const B: usize> {
     partners: u16,
     /// The most points any of its pairs matched.
     best_matched: u32,
+    /// The map's depth scale: from its [`DepthScale::unbounded_from`] on a
+    /// partner's sight is worth nothing ([`sight_exact`]).
     scale: DepthScale,
     /// Since [`KeyFrame::start`], no pair and no range constraint: every
     /// point is unmatched, whatever its cell holds.
@@ -801,7 +816,7 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
         sights: &[Option<Sight>; B],
     ) -> PairFused {
         let mut out = PairFused::default();
-        let min = self.min_pairs;
+        let (scale, min) = (self.scale, self.min_pairs);
         let fresh = core::mem::replace(&mut self.fresh, false);
         for (k, ((((cells, len), adm), inc), sight)) in self
             .cells
@@ -823,7 +838,7 @@ impl<const N: usize, const B: usize> KeyFrame<N, B> {
                     continue;
                 };
                 out.matched += 1;
-                let sight = sight_of(c, r, sight.as_ref());
+                let sight = sight_of(c, r, sight.as_ref(), &scale);
                 let added = c.add_sighted(r.z_near, r.z_far, sight);
                 if let Added::Conflict { .. } = added {
                     out.conflicts += 1;
@@ -1097,6 +1112,16 @@ mod tests {
         assert!(matches!(added, Added::Unseen { .. }));
         assert_eq!(c4.status(), FusedStatus::PartlyUnseen);
         assert!(c4.status().is_flagged() && !c4.admitted(2));
+        // A conflict after it: inconsistent, the flag's bit gone from the
+        // counts (as the packed counts were rebuilt before the
+        // twenty-fourth session: the same digest).
+        let mut c6 = c4;
+        assert!(matches!(
+            c6.add_sighted(30.0, 31.0, (0.0, SEEN_ANY)),
+            Added::Conflict { .. }
+        ));
+        assert_eq!(c6.status(), FusedStatus::Inconsistent);
+        assert_eq!(c6.counts, pack(3, 1, 0));
         let (mut adm, mut inc) = (1u16, 0u16);
         count(added, &c4, 2, &mut adm, &mut inc);
         assert_eq!((adm, inc), (0, 0));

@@ -735,7 +735,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             // key frame's pixels stays until it pairs again, and `key`
             // the retired cells until `settle`: the rest enters then, as
             // after a last pair.)
-            out.retired = self.retire(self.config.retire_permille);
+            out.retired = self.retire(self.config.retire_permille, 0);
             let shown = out.retired.is_some();
             // (`limit` is `Some` here: `None` only with both `Ok`.)
             let reason = limit.unwrap_or(KeyReason::MotionLimit);
@@ -755,7 +755,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             // (The processor keeps the reconstruction of the key frame's
             // pixels and `key` its cells until the next step: the rest of
             // a retirement past the share enters then, `settle`.)
-            out.retired = self.retire(self.config.retire_permille);
+            out.retired = self.retire(self.config.retire_permille, fused.conflicts);
             out.new_key = Some(if self.key.partners() >= self.config.max_partners {
                 KeyReason::Partners
             } else {
@@ -899,9 +899,9 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
 
     /// Move the key frame's fused points into the map, posed by the chain
     /// (the key frame's motion to the current frame): admitted points up to
-    /// `permille` ‰ of its points now, the rest at the next
-    /// [`Self::settle`].
-    fn retire(&mut self, permille: u16) -> Option<Retired> {
+    /// `permille` ‰ of its points, less half the `conflicts` of the pair
+    /// fused in this step, now, the rest at the next [`Self::settle`].
+    fn retire(&mut self, permille: u16, conflicts: u32) -> Option<Retired> {
         if !self.has_key || self.key.partners() == 0 {
             return None;
         }
@@ -910,7 +910,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             &self.key,
             self.processor.structure(),
             &self.chain,
-            (self.base.e1(), permille),
+            (self.base.e1(), permille, conflicts),
         ))
     }
 

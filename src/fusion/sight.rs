@@ -336,6 +336,43 @@ mod tests {
         Motion::new(t, r).unwrap()
     }
 
+    /// A partner that sees a ray only from [`DepthScale::unbounded_from`]
+    /// (`2 s`) on sees none of it worth having: `sight_exact` gives
+    /// `SEEN_NONE` there (the point is flagged `PartlyUnseen`, as when `U`
+    /// was coded, whose codes end there), and the exact depth below it.
+    /// (A review of the twenty-fourth session's exact `U` found such
+    /// depths widening points to beyond what the map can hold.)
+    #[test]
+    fn a_partner_seen_only_from_beyond_the_codes_sees_none() {
+        use super::super::code::DepthScale;
+        use super::super::key::{sight_exact, SEEN_NONE};
+        let cfg = Config::DEFAULT;
+        let scale = DepthScale::for_max_depth(cfg.max_depth());
+        let limit = scale.unbounded_from();
+        let mut g = Rng(0x5EED_0007);
+        let (mut beyond, mut within) = (0, 0);
+        for _ in 0..100_000 {
+            let m = motion(&mut g);
+            let rows = [
+                Pixel::new(100.0, 80.0 + 200.0 * g.next()),
+                Pixel::new(300.0, 300.0 + 180.0 * g.next()),
+            ];
+            let Some(s) = Sight::new(&cam(), &cam(), &rows, &m, &cfg) else {
+                continue;
+            };
+            let p = Pixel::new(512.0 * g.next(), 480.0 * g.next());
+            let (e, got) = (s.seen_from(p), sight_exact(p, &s, &scale));
+            if e.is_finite() && e >= limit {
+                beyond += 1;
+                assert_eq!(got, SEEN_NONE, "{e}");
+            } else {
+                within += usize::from(e.is_finite());
+                assert_eq!(got.to_bits(), e.to_bits());
+            }
+        }
+        assert!(beyond > 10 && within > 1000, "{beyond} {within}");
+    }
+
     /// The exact depth from which the partner sees a ray is where the probe
     /// turns from no to yes: the probe says yes just above it and at every
     /// depth beyond (up to 10⁴ times it), no 10 % below (and 0.1 % below

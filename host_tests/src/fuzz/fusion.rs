@@ -820,12 +820,14 @@ fn check_point(p: &roadstereo::fusion::FusedPoint, at: &str) {
         other => panic!("{at}: a status this check does not know: {other:?}"),
     }
     if let Some(iv) = p.interval {
-        // An inconsistent point's majority may be a coded interval whose
-        // far end is unbounded (`FusedPoint::interval`).
-        let far_ok = iv.z_far.is_finite()
-            || (p.status == FusedStatus::Inconsistent && iv.z_far == f32::INFINITY);
+        // (Finite for every status since the twenty-fourth session's
+        // exact rival intervals; an inconsistent point's majority could be
+        // a coded interval with an unbounded far end before.)
         assert!(
-            iv.z_near.is_finite() && far_ok && 0.0 <= iv.z_near && iv.z_near <= iv.z_far,
+            iv.z_near.is_finite()
+                && iv.z_far.is_finite()
+                && 0.0 <= iv.z_near
+                && iv.z_near <= iv.z_far,
             "{at}: {p:?}: interval"
         );
     }

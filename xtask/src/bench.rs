@@ -24,8 +24,7 @@ pub const BENCH_USAGE: &str =
   as \"budget NOT MET: [open: issue N] ...\" on every run and not enforced until the issue
   lands (today, issue 11: the per-point budgets, the 2 x 256 frame with and without the fusion,
   the adversarial worst case and scaling, the worst-case bound; issue 13: the 2 x 256 frame with
-  the fusion once the matching alone fits, while the fusion's worst is a filling drive's; the
-  fusion's own work on the jumping road, whose pairs disagree in its retiring steps too);
+  the fusion once the matching alone fits, while the fusion's worst is a filling drive's);
   the deadline is share-percent of a
   frame-ms frame at cpu-mhz, one instruction = one cycle (default 277 200 instructions).
   The representative pair (the Fig. 6 set-up, one detector point per row, N = 32 ... 512):
@@ -49,7 +48,7 @@ pub const BENCH_USAGE: &str =
       frame, and its steps with the fusion (the matching, the fusion and the map) too
   The fusion over drives whose road map fills (issue 13; 80 frames, 2 x 256 points: sideways,
   straight and turning, forwards zigzagging, sideways on a wobbling road and on a jumping road,
-  whose miss issue 13 owns; the last two adversarial, outside the representative figure):
+  the last two adversarial, outside the representative figure):
     - the fusion's own instructions per key-frame point <= fusion-per-point in every paired frame
       (the demo drive's map never fills, so its retiring frames drop nothing for room)
     (reported: the worst step's own work in instructions, and the same with the sight check on)
@@ -1176,7 +1175,7 @@ fn fusion_filling(log: &str, b: &Budget, misses: &mut Vec<String>) -> u64 {
     let mut worst_default = 0;
     println!(
         "
-the fusion over drives whose road map fills (Fusion<256, 2, 512>, 80 frames, turning back every 8 frames; `default`, `sight_check`: 0.05 a frame across a straight road; `turning`: the camera also turns 0.005 rad a frame, back and forth with the motion; `forward`: 0.2 forwards and 0.12 across a frame over a road 2.4 wide, turning 0.003 rad a frame; `wobbling`: `default` on a road whose edges move 0.1 across every frame, out and back, so the pairs disagree (adversarial); `jumping`: 0.08 a frame across a road whose edges but their 22 nearest points jump by up to 0.25 within each 8 frames, so most pairs disagree in a retiring step too (adversarial, owned by issue 13)):"
+the fusion over drives whose road map fills (Fusion<256, 2, 512>, 80 frames, turning back every 8 frames; `default`, `sight_check`: 0.05 a frame across a straight road; `turning`: the camera also turns 0.005 rad a frame, back and forth with the motion; `forward`: 0.2 forwards and 0.12 across a frame over a road 2.4 wide, turning 0.003 rad a frame; `wobbling`: `default` on a road whose edges move 0.1 across every frame, out and back, so the pairs disagree (adversarial); `jumping`: 0.08 a frame across a road whose edges but their 22 nearest points jump by up to 0.25 within each 8 frames, so most pairs disagree in a retiring step too (adversarial)):"
     );
     println!("| policy | paired steps | map full from frame | worst own work a step (frame) | its key-frame points | per point | worst per point (frame) | of a retiring step: entered / dropped |");
     println!("|---|---:|---:|---:|---:|---:|---:|---|");
@@ -1227,9 +1226,9 @@ the fusion over drives whose road map fills (Fusion<256, 2, 512>, 80 frames, tur
         );
         // (The wobbling and jumping roads' pairs disagree: adversarial
         // inputs, kept out of the representative frame's figure with the
-        // fusion, as the sight check is. The wobbling road's budget is
-        // enforced since the twenty-fourth session's exact rival
-        // intervals; the jumping road's miss issue 13 owns.)
+        // fusion, as the sight check is; their budget is enforced since
+        // the twenty-fourth session's exact rival intervals and a
+        // retirement's share cut by its pass's conflicts.)
         let adversarial = run == "wobbling" || run == "jumping";
         if run != "sight_check" && !adversarial {
             worst_default = worst_default.max(own_per_point(p));
@@ -1245,9 +1244,8 @@ the fusion over drives whose road map fills (Fusion<256, 2, 512>, 80 frames, tur
             }
         }
         if run != "sight_check" && own_per_point(p) > b.fusion_per_point {
-            let owner = if run == "jumping" { OPEN_FUSION } else { "" };
             misses.push(format!(
-                "{owner}fusion over a drive whose map fills, {run}: {} instructions per key-frame point (frame {}) > budget {}",
+                "fusion over a drive whose map fills, {run}: {} instructions per key-frame point (frame {}) > budget {}",
                 own_per_point(p),
                 num(p, "frame"),
                 b.fusion_per_point

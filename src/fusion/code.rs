@@ -131,11 +131,12 @@ impl DepthScale {
         c.clamp(0, i32::from(UNBOUNDED - 1)) as u16
     }
 
-    /// [`Self::up_unclamped`] at least 1 (a far end's code, the map's
-    /// entries) of a `z` that is not a NaN, without the comparison: as
-    /// [`Self::down_no_nan`], every `z ≤ 0` (`−0.0` included) gets a
-    /// negative code before the clamp to 1, as [`Self::up_unclamped`]'s
-    /// 0 does. The same for every `z` but a NaN (`codes_without_their_test_agree`).
+    /// `up_unclamped` (the tests' reference) at least 1 (a far end's
+    /// code, the map's entries) of a `z` that is not a NaN, without the
+    /// comparison: as [`Self::down_no_nan`], every `z ≤ 0` (`−0.0`
+    /// included) gets a negative code before the clamp to 1, as
+    /// `up_unclamped`'s 0 does. The same for every `z` but a NaN
+    /// (`codes_without_their_test_agree`).
     #[inline(always)]
     pub(crate) fn up_no_nan(&self, z: f32) -> i32 {
         let b = (z * self.inv).to_bits();

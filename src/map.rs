@@ -320,6 +320,13 @@ impl Extent {
         codes: (u16::MAX, 0),
     };
 
+    /// Take entry `e`'s `y` and codes in.
+    #[inline(always)]
+    fn take(&mut self, e: &Entry) {
+        self.y = (fmin(self.y.0, e.y), fmax(self.y.1, e.y));
+        self.codes = (self.codes.0.min(e.near), self.codes.1.max(e.far));
+    }
+
     /// Into `b`, with its points' ray bound `ray` ([`ray_bound`]), the
     /// camera's tilt (sine and cosine) and the map's depth codes `scale`:
     /// the depths are the decoded ends' (exactly what the map's readers
@@ -529,7 +536,6 @@ fn next_entry(
     at: &mut usize,
     min_pairs: u8,
     (cam, limit, scale): (&Camera, u16, &DepthScale),
-    ext: &mut Extent,
 ) -> Option<Option<Entry>> {
     // (A tight scan: on most drives most points are not admitted.)
     while cells.get(*at).is_some_and(|c| !c.admitted(min_pairs)) {
@@ -537,28 +543,22 @@ fn next_entry(
     }
     let (c, r) = (cells.get(*at)?, points.get(*at)?);
     *at += 1;
-    Some(entry_of(
-        cam.normalise(r.pixel1()),
-        c.ends(),
-        limit,
-        scale,
-        ext,
-    ))
+    Some(entry_of(cam.normalise(r.pixel1()), c.ends(), limit, scale))
 }
 
 /// A retiring point's entry: its key-frame ray `[x, y]` (normalised) and
-/// fused ends, coded outwards ([`DepthScale`]), its `y` and its codes
-/// taken into `extent`. `None`: a far code past `limit` ([`far_limit`]): a
-/// far end the codes cannot hold, or a decoded one whose distance bound
-/// (times the batch's ray bound) is past [`MAX_REACH`]
-/// ([`Retired::unbounded`]).
+/// fused ends, coded outwards ([`DepthScale`]). `None`: a far code past
+/// `limit` ([`far_limit`]): a far end the codes cannot hold, or a decoded
+/// one whose distance bound (times the batch's ray bound) is past
+/// [`MAX_REACH`] ([`Retired::unbounded`]). The batch's extent takes the
+/// entries' `y` and codes in a pass of their own after them
+/// ([`RoadMap::enter`], [`Extent::take`]).
 #[inline(always)]
 fn entry_of(
     [x, y]: [f32; 2],
     (z_near, z_far): (f32, f32),
     limit: u16,
     scale: &DepthScale,
-    extent: &mut Extent,
 ) -> Option<Entry> {
     // (Below `2⁻¹⁵ s` a near end is code 0, depth 0, and a far end code 1,
     // about `2⁻¹⁵ s`: the decoded ends hold the fused ones whatever they
@@ -575,8 +575,6 @@ fn entry_of(
     }
     // (At most `limit`, below `UNBOUNDED`: a `u16`.)
     let far = far as u16;
-    extent.y = (fmin(extent.y.0, y), fmax(extent.y.1, y));
-    extent.codes = (extent.codes.0.min(near), extent.codes.1.max(far));
     Some(Entry { x, y, near, far })
 }
 
@@ -1271,7 +1269,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         // (Locals, the loop's registers: through the references its stores
         // might reach, the camera and the extent were loaded and stored
         // again for every point.)
-        let (cam, scale, mut ext) = (*s.camera1(), self.scale, *extent);
+        let (cam, scale) = (*s.camera1(), self.scale);
         let start = self.tail.get(k).map_or(0, |&t| usize::from(t))
             + self.used.get(k).map_or(0, |&u| usize::from(u));
         let (Some(ring), Some(results)) = (self.entries.get_mut(k), s.boundaries().get(k)) else {
@@ -1280,14 +1278,13 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         let (mut n, mut unbounded) = (0usize, 0u32);
         let (cells, points) = (key.cells(k), results.points());
         let mut at = *at_out;
-        let next = |at: &mut usize, ext: &mut Extent| {
-            next_entry((cells, points), at, min_pairs, (&cam, limit, &scale), ext)
-        };
+        let next =
+            |at: &mut usize| next_entry((cells, points), at, min_pairs, (&cam, limit, &scale));
         // Until a point is left out, the points looked at are the ones
         // entered: `n` alone is tested.
         let stop = w.min(look);
         while n < stop {
-            let Some(next) = next(&mut at, &mut ext) else {
+            let Some(next) = next(&mut at) else {
                 break;
             };
             let Some(e) = next else {
@@ -1305,7 +1302,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         // past them. A bound lowered in that loop measured 3 instructions
         // an entered point dearer on the bench's drives.)
         while unbounded > 0 && n < w && n + (unbounded as usize) < look {
-            let Some(next) = next(&mut at, &mut ext) else {
+            let Some(next) = next(&mut at) else {
                 break;
             };
             let Some(e) = next else {
@@ -1318,6 +1315,15 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             n += 1;
         }
         *at_out = at;
+        // The entries' extent, in a pass of their own: in the loops above
+        // it cost the loop's registers, about 3 instructions an entry
+        // more. (They are `start .. start + n`, in order.)
+        let mut ext = *extent;
+        for j in start..start + n {
+            if let Some(e) = ring.get(j % M) {
+                ext.take(e);
+            }
+        }
         *extent = ext;
         (n, unbounded)
     }
@@ -1396,8 +1402,8 @@ mod tests {
             let z_near = 0.01 + 999.0 * g.next() * g.next() * g.next();
             let z_far = z_near * (1.0 + 3.0 * g.next() * g.next() * g.next());
             let limit = far_limit(MAX_REACH / bound, &scale);
-            let e = entry_of(ray, (z_near, z_far), limit, &scale, &mut extent);
-            if let Some(e) = e {
+            if let Some(e) = entry_of(ray, (z_near, z_far), limit, &scale) {
+                extent.take(&e);
                 map.entries[0][m] = e;
                 m += 1;
             }
@@ -1768,7 +1774,8 @@ mod tests {
                 let zn = zc * logu(&mut g, 0.2, 1.0) * if g.next() < 0.1 { 0.0 } else { 1.0 };
                 let top = 1.1 + g.next() * 4.0;
                 let zf = fmax(zn, zc * logu(&mut g, 1.0, top));
-                if let Some(e) = entry_of(r, (zn, zf), limit, &scale, &mut extent) {
+                if let Some(e) = entry_of(r, (zn, zf), limit, &scale) {
+                    extent.take(&e);
                     map.entries[0][m] = e;
                     m += 1;
                 }

@@ -141,7 +141,11 @@ pub fn profile(args: ProfileArgs) -> Result<(), String> {
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let (log, trace_path) = trace(&elf, &dir)?;
     let dis = disassemble(&elf)?;
-    let windows = count(&trace_path, &dis, &log)?;
+    let counted = count(&trace_path, &dis, &log);
+    // (The trace is several GB, 11 with `--fusion`, and read only here: it
+    // goes either way, so that runs do not fill the disk.)
+    let _ = std::fs::remove_file(&trace_path);
+    let windows = counted?;
     let mut funcs = Vec::new();
     for w in &windows {
         summary(w);
@@ -239,8 +243,8 @@ fn window_table(windows: &[Window]) {
 }
 
 /// Run the firmware on QEMU, one trace line per executed instruction into
-/// `dir/trace.log`; return the decoded defmt log (echoed) and the trace's
-/// path.
+/// `dir/trace.log` (removed once counted, [`profile`]); return the
+/// decoded defmt log (echoed) and the trace's path.
 fn trace(elf: &Path, dir: &Path) -> Result<(String, PathBuf), String> {
     let elf_s = elf.to_string_lossy().to_string();
     let trace = dir.join("trace.log");
@@ -343,7 +347,8 @@ fn count(trace: &Path, dis: &Disassembly, log: &str) -> Result<Vec<Window>, Stri
     }
     if entries < 2 * windows.len() {
         return Err(format!(
-            "the trace holds {entries} marker calls, the {} logged windows need {}",
+            "the trace holds {entries} marker calls, the {} logged windows need {} \
+             (a truncated trace: it takes several GB, 11 with --fusion; is the disk full?)",
             windows.len(),
             2 * windows.len()
         ));

@@ -75,9 +75,14 @@
 //!   bound on its points' forward coordinates), one wholly ahead is
 //!   skipped, and of the batches the camera is passing at most
 //!   [`SWEEP_PER_FRAME`] points per boundary are tested each frame, from
-//!   the oldest on (except in a frame where a key frame retires and the
-//!   next, which copy points instead): a bounded cost per frame whatever
-//!   `M` is.
+//!   the oldest on (`RoadMap::sweep`, after `RoadMap::carry`; the
+//!   fusion sweeps after its pass, and not in a frame where a key frame
+//!   retires or the next, which copy points instead, nor in one whose
+//!   pass had more conflicts than agreeing intervals, [`crate::fusion`],
+//!   "The sweep after the pass"): a bounded cost per frame whatever `M`
+//!   is. A point behind the camera that no sweep has reached is still
+//!   left out of every query, and goes for room when its batch is the
+//!   oldest.
 //! * **Capacity**: a boundary holds at most `M` points and the map at most
 //!   [`MAP_BATCHES`] batches; a retiring key frame makes room by dropping
 //!   the oldest points first (the oldest batch's, in the order they
@@ -598,6 +603,9 @@ pub struct RoadMap<const B: usize, const M: usize> {
     drops: MapDrops,
     /// A retirement cut at its share, to finish ([`RoadMap::finish`]).
     rest: Option<Rest<B>>,
+    /// By batch slot, the batches the last [`RoadMap::carry`] found the
+    /// camera passing, for the [`RoadMap::sweep`] after it (taken by it).
+    passing: [bool; MAP_BATCHES],
 }
 
 impl<const B: usize, const M: usize> RoadMap<B, M> {
@@ -623,6 +631,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
                 capacity: 0,
             },
             rest: None,
+            passing: [false; MAP_BATCHES],
         }
     }
 
@@ -642,6 +651,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         self.sweep = [0; B];
         self.drops = MapDrops::default();
         self.rest = None;
+        self.passing = [false; MAP_BATCHES];
     }
 
     /// Points stored on `boundary` now: those [`RoadMap::points`] gives and
@@ -790,12 +800,12 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
 
     /// Carry every batch into the next frame by the motion `m` (from the
     /// current frame to the next) with per-frame error bounds `bounds`,
-    /// and reclaim points behind the vehicle (module docs); the
-    /// point-by-point sweep only if `sweep`.
+    /// and reclaim the batches wholly behind the vehicle (module docs);
+    /// the batches the camera is passing are kept for a [`Self::sweep`]
+    /// of this frame.
     ///
-    /// Work: `O(MAP_BATCHES)` plus at most [`SWEEP_PER_FRAME`] point tests
-    /// per boundary.
-    pub(crate) fn carry(&mut self, m: &Motion, bounds: &StepBounds, sweep: bool) {
+    /// Work: `O(MAP_BATCHES)`.
+    pub(crate) fn carry(&mut self, m: &Motion, bounds: &StepBounds) {
         let rt = mat3_transpose(&m.rotation_matrix());
         let t = m.translation();
         let widen = bounds.any();
@@ -831,12 +841,23 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             }
         }
         self.pop_dead();
-        if sweep {
-            for k in 0..B {
-                self.sweep_boundary(k, &passing);
-            }
-            self.pop_dead();
+        self.passing = passing;
+    }
+
+    /// The point-by-point sweep of the frame the last [`Self::carry`]
+    /// carried the map into: in the batches it found the camera passing,
+    /// test up to [`SWEEP_PER_FRAME`] points a boundary and drop those
+    /// behind (module docs). Nothing in between may add or retire a batch
+    /// (the fusion sweeps after its pass, before any retirement, or not at
+    /// all); a second sweep before the next carry tests nothing.
+    ///
+    /// Work: at most [`SWEEP_PER_FRAME`] point tests per boundary.
+    pub(crate) fn sweep(&mut self) {
+        let passing = core::mem::take(&mut self.passing);
+        for k in 0..B {
+            self.sweep_boundary(k, &passing);
         }
+        self.pop_dead();
     }
 
     /// Test up to [`SWEEP_PER_FRAME`] points of `boundary` in the batches
@@ -1473,7 +1494,7 @@ mod tests {
             let t = forward_axis(map.tilt).map(|w| w * d);
             let step = Motion::new(t, [0.0; 3]).expect("motion");
             let bounds = crate::fusion::StepBounds::of(&crate::Config::DEFAULT);
-            map.carry(&step, &bounds, false);
+            map.carry(&step, &bounds);
             assert_eq!(map.drops().behind, live - 2, "case {case}: {m}");
             assert_eq!(map.batches(), 0, "case {case}");
         }

@@ -129,6 +129,31 @@
 //! `a_retirement_over_two_steps_leaves_the_whole_ones_map` and
 //! `a_retirement_at_a_motion_limit_over_two_steps_leaves_the_whole_ones_map`).
 //!
+//! # The sweep after the pass
+//! The map's sweep for points behind the vehicle (`crate::map`, "What
+//! leaves the map") runs after the pair is fused, not with the carry
+//! before the matching, so that a step can tell what its pass cost: it
+//! rests where the pass had more conflicts than agreeing intervals
+//! (twice the conflicts above the matched points), as it does where a key
+//! frame retires and in the next step. Each conflict costs the pass about
+//! 40 instructions more than an agreeing point, so a pass where most
+//! conflict has spent what the sweep's tests would (up to
+//! [`crate::map::SWEEP_PER_FRAME`] a boundary, about 40 each); where at
+//! most half conflict, the pass is at most about 20 a point dearer and
+//! the sweep fits. Resting loses nothing: a point behind the camera is
+//! left out of every query whether swept or not, and one no sweep
+//! reaches goes for room when its batch is the oldest (and a point whose
+//! interval conflicted is never admitted, so a key frame whose passes
+//! mostly conflict brings few points to make room for). The bench's `wobbling_forward` drive (every matched
+//! point conflicting in steps whose map has batches the camera is
+//! passing; a review's, simplified): 82 instructions a key-frame point
+//! with the sweep after every pass, 76 with the rest. Since the sweep
+//! runs after the matching, a caller's clock no longer sees its work
+//! before the matching's last question (at most [`crate::map::SWEEP_PER_FRAME`]
+//! tests a boundary, about 2 600 instructions for two): part of the
+//! fusion's own work after the matching, which the deadline's margin
+//! must leave room for ([`Fusion::step_within`]).
+//!
 //! # Range sensors
 //! [`Fusion::constrain`] intersects a key-frame point's interval with a
 //! range interval along its ray from another sensor (a lidar or radar
@@ -718,7 +743,10 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         let after_retirement = core::mem::take(&mut self.rest_sweep);
         self.shows_retired = false;
         if !self.has_key {
-            self.map.carry(&m.motion, &bounds, !after_retirement);
+            self.map.carry(&m.motion, &bounds);
+            if !after_retirement {
+                self.map.sweep();
+            }
             out.new_key = self.start_key(id, frame, KeyReason::First, false);
             return Ok(out);
         }
@@ -734,16 +762,14 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             (Ok(_), Ok(_)) => None,
         };
         let last_partner = self.due && has_points(frame);
-        // 3. The map follows the vehicle; its sweep rests in a frame where
-        // a key frame retires and in the next (they copy points instead,
-        // the next the rest of a retirement cut at its share; resting in
-        // it whether cut or not leaves a cut retirement's map the whole
-        // one's).
-        self.map.carry(
-            &m.motion,
-            &bounds,
-            !(last_partner || limit.is_some() || after_retirement),
-        );
+        // 3. The map follows the vehicle; its sweep, after the pass, rests
+        // in a frame where a key frame retires and in the next (they copy
+        // points instead, the next the rest of a retirement cut at its
+        // share; resting in it whether cut or not leaves a cut
+        // retirement's map the whole one's), and where the pass had more
+        // conflicts than agreeing intervals (below).
+        self.map.carry(&m.motion, &bounds);
+        let sweep = !(last_partner || limit.is_some() || after_retirement);
         let (Ok(motion), Ok(cfg), None) = (&motion, &cfg, limit) else {
             // No last pair: retire what the key frame has, at the same
             // share as after a last pair, and start anew. (The processor
@@ -764,6 +790,13 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         self.processor.set_config(cfg);
         let fused = self.fuse_pair(frame, motion, rounding, last_partner, deadline);
         let cut = self.processor.deadline_expired();
+        // The sweep rests where more of the pass's intervals conflicted
+        // than agreed: each conflict cost the pass about 40 instructions
+        // more, about what the sweep's tests would (module docs, "The
+        // sweep after the pass").
+        if sweep && fused.conflicts.saturating_mul(2) <= fused.matched {
+            self.map.sweep();
+        }
         // 4. The pair fused; a last partner retires the key frame.
         out.paired = Some(fused);
         out.partner = self.key.partners();

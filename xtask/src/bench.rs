@@ -1175,7 +1175,7 @@ fn fusion_filling(log: &str, b: &Budget, misses: &mut Vec<String>) -> u64 {
     let mut worst_default = 0;
     println!(
         "
-the fusion over drives whose road map fills (Fusion<256, 2, 512>, 80 frames, turning back every 8 frames; `default`, `sight_check`: 0.05 a frame across a straight road; `turning`: the camera also turns 0.005 rad a frame, back and forth with the motion; `forward`: 0.2 forwards and 0.12 across a frame over a road 2.4 wide, turning 0.003 rad a frame; `wobbling`: `default` on a road whose edges move 0.1 across every frame, out and back, so the pairs disagree (adversarial); `jumping`: 0.08 a frame across a road whose edges but their 22 nearest points jump by up to 0.25 within each 8 frames, so most pairs disagree in a retiring step too (adversarial)):"
+the fusion over drives whose road map fills (Fusion<256, 2, 512>, 80 frames, turning back every 8 frames; `default`, `sight_check`: 0.05 a frame across a straight road; `turning`: the camera also turns 0.005 rad a frame, back and forth with the motion; `forward`: 0.2 forwards and 0.12 across a frame over a road 2.4 wide, turning 0.003 rad a frame; `wobbling`: `default` on a road whose edges move 0.1 across every frame, out and back, so the pairs disagree (adversarial); `jumping`: 0.08 a frame across a road whose edges but their 22 nearest points jump by up to 0.25 within each 8 frames, so most pairs disagree in a retiring step too (adversarial); `wobbling_forward`: 0.094 across and 0.067 forwards a frame, turning, on a road still for 32 frames and wobbling as `wobbling`'s after (adversarial)):"
     );
     println!("| policy | paired steps | map full from frame | worst own work a step (frame) | its key-frame points | per point | worst per point (frame) | of a retiring step: entered / dropped |");
     println!("|---|---:|---:|---:|---:|---:|---:|---|");
@@ -1186,6 +1186,7 @@ the fusion over drives whose road map fills (Fusion<256, 2, 512>, 80 frames, tur
         "forward",
         "wobbling",
         "jumping",
+        "wobbling_forward",
     ] {
         let mine: Vec<_> = rows
             .iter()
@@ -1229,7 +1230,7 @@ the fusion over drives whose road map fills (Fusion<256, 2, 512>, 80 frames, tur
         // fusion, as the sight check is; their budget is enforced since
         // the twenty-fourth session's exact rival intervals and a
         // retirement's share cut by its pass's conflicts.)
-        let adversarial = run == "wobbling" || run == "jumping";
+        let adversarial = matches!(run, "wobbling" | "jumping" | "wobbling_forward");
         if run != "sight_check" && !adversarial {
             worst_default = worst_default.max(own_per_point(p));
         }

@@ -166,6 +166,8 @@ struct Filling {
     /// (from the far rows; 256: all).
     offsets: [f32; 8],
     shifted: u16,
+    /// The first frame the road moves in (0: from the start).
+    moves_from: u32,
 }
 
 /// The drives whose road map fills, each an adversarial review's (issue
@@ -192,8 +194,13 @@ struct Filling {
 /// but their 22 nearest points (the twenty-third session's review's
 /// `c2_44`: most points conflict in a key frame's retiring step too,
 /// while a few agree and enter the map, so the retirement's own work
-/// comes on top of the conflicts').
-const FILLING: [Filling; 6] = [
+/// comes on top of the conflicts'); `wobbling_forward`, 0.094 across and
+/// 0.067 forwards a frame, turning 0.0015 rad a frame, on a road still
+/// for 32 frames (the map fills) and wobbling as `wobbling`'s from then
+/// on (the twenty-fourth session's review's `h5_7_15`, simplified: every
+/// matched point conflicts in steps where the sweep has batches the
+/// camera is passing to test).
+const FILLING: [Filling; 7] = [
     Filling::sideways("default", FusionConfig::DEFAULT, 0.0),
     Filling::sideways(
         "sight_check",
@@ -210,6 +217,7 @@ const FILLING: [Filling; 6] = [
         x0: -0.5,
         offsets: [0.0; 8],
         shifted: 0,
+        moves_from: 0,
     },
     Filling {
         offsets: [-0.1, 0.1, -0.1, 0.1, -0.1, 0.1, -0.1, 0.1],
@@ -221,6 +229,14 @@ const FILLING: [Filling; 6] = [
         offsets: [0.0, 0.12, 0.12, 0.0, 0.12, -0.2455, -0.12, 0.24],
         shifted: 234,
         ..Filling::sideways("jumping", FusionConfig::DEFAULT, 0.0)
+    },
+    Filling {
+        step: (0.094, 0.067),
+        turn: -0.0015,
+        offsets: [-0.1, 0.1, -0.1, 0.1, -0.1, 0.1, -0.1, 0.1],
+        shifted: 256,
+        moves_from: 32,
+        ..Filling::sideways("wobbling_forward", FusionConfig::DEFAULT, 0.0)
     },
 ];
 
@@ -237,6 +253,7 @@ impl Filling {
             x0: 0.0,
             offsets: [0.0; 8],
             shifted: 0,
+            moves_from: 0,
         }
     }
 }
@@ -271,7 +288,11 @@ fn filling(fusion: &mut Fusion<256, 2, 512>, drive: &Filling) -> bool {
             dir = -dir;
         }
         // (A road that moves between frames: the pairs disagree.)
-        let offset = drive.offsets.get(i as usize % 8).copied().unwrap_or(0.0);
+        let offset = if i < drive.moves_from {
+            0.0
+        } else {
+            drive.offsets.get(i as usize % 8).copied().unwrap_or(0.0)
+        };
         filling_frame(&mut frame, drive.edges, x, psi, (offset, drive.shifted));
         let Some(Measured {
             step,

@@ -336,6 +336,20 @@ mod tests {
         Motion::new(t, r).unwrap()
     }
 
+    /// A random partner's sight under `cfg` (a random motion; the
+    /// partner's boundary from a row in the upper half to one in the
+    /// lower) and a random key-frame pixel; `None` where the partner's
+    /// window is empty.
+    fn random_sight(g: &mut Rng, cfg: &Config) -> Option<(Sight, Pixel)> {
+        let m = motion(g);
+        let rows = [
+            Pixel::new(100.0, 80.0 + 200.0 * g.next()),
+            Pixel::new(300.0, 300.0 + 180.0 * g.next()),
+        ];
+        let s = Sight::new(&cam(), &cam(), &rows, &m, cfg)?;
+        Some((s, Pixel::new(512.0 * g.next(), 480.0 * g.next())))
+    }
+
     /// A partner that sees a ray only from [`DepthScale::unbounded_from`]
     /// (`2 s`) on sees none of it worth having: `sight_exact` gives
     /// `SEEN_NONE` there (the point is flagged `PartlyUnseen`, as when `U`
@@ -352,15 +366,9 @@ mod tests {
         let mut g = Rng(0x5EED_0007);
         let (mut beyond, mut within) = (0, 0);
         for _ in 0..100_000 {
-            let m = motion(&mut g);
-            let rows = [
-                Pixel::new(100.0, 80.0 + 200.0 * g.next()),
-                Pixel::new(300.0, 300.0 + 180.0 * g.next()),
-            ];
-            let Some(s) = Sight::new(&cam(), &cam(), &rows, &m, &cfg) else {
+            let Some((s, p)) = random_sight(&mut g, &cfg) else {
                 continue;
             };
-            let p = Pixel::new(512.0 * g.next(), 480.0 * g.next());
             let (e, got) = (s.seen_from(p), sight_exact(p, &s, &scale));
             if e.is_finite() && e >= limit {
                 beyond += 1;
@@ -388,15 +396,9 @@ mod tests {
                 .unwrap()
                 .with_rotation_error([0.002 * g.next(); 3])
                 .unwrap();
-            let m = motion(&mut g);
-            let rows = [
-                Pixel::new(100.0, 80.0 + 200.0 * g.next()),
-                Pixel::new(300.0, 300.0 + 180.0 * g.next()),
-            ];
-            let Some(s) = Sight::new(&cam(), &cam(), &rows, &m, &cfg) else {
+            let Some((s, p)) = random_sight(&mut g, &cfg) else {
                 continue;
             };
-            let p = Pixel::new(512.0 * g.next(), 480.0 * g.next());
             let e = s.seen_from(p);
             if e == f32::INFINITY {
                 unseen += 1;

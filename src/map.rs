@@ -104,8 +104,8 @@
 //! over all of them when the rest enter.
 //!
 //! Size: `12·B·M` bytes of points, [`MAP_BATCHES`] batches of `88 + 4·B`
-//! bytes and a retirement's rest (13 136 bytes in all for `B = 2`,
-//! `M = 512`).
+//! bytes, a retirement's rest and the batches the camera is passing
+//! (13 144 bytes in all for `B = 2`, `M = 512`).
 
 use crate::camera::Camera;
 use crate::fusion::code::DepthScale;

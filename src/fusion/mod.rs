@@ -130,29 +130,28 @@
 //! `a_retirement_at_a_motion_limit_over_two_steps_leaves_the_whole_ones_map`).
 //!
 //! # The sweep after the pass
-//! The map's sweep for points behind the vehicle (`crate::map`, "What
-//! leaves the map") runs after the pair is fused, not with the carry
-//! before the matching, so that a step can tell what its pass cost: it
-//! rests where the pass had more conflicts than agreeing intervals
-//! (twice the conflicts above the matched points), as it does where a key
-//! frame retires and in the next step. Each conflict costs the pass about
-//! 40 instructions more than an agreeing point, so a pass where most
-//! conflict has spent what the sweep's tests would (up to
-//! [`crate::map::SWEEP_PER_FRAME`] a boundary, about 40 each); where at
-//! most half conflict, the pass is at most about 20 a point dearer and
-//! the sweep fits. Resting loses nothing: a point behind the camera is
-//! left out of every query whether swept or not, and one no sweep
-//! reaches goes for room when its batch is the oldest (and a point whose
-//! interval conflicted is never admitted, so a key frame whose passes
-//! mostly conflict brings few points to make room for). The bench's `wobbling_forward` drive (every matched
-//! point conflicting in steps whose map has batches the camera is
-//! passing; a review's, simplified): 82 instructions a key-frame point
-//! with the sweep after every pass, 76 with the rest. Since the sweep
-//! runs after the matching, a caller's clock no longer sees its work
-//! before the matching's last question (at most [`crate::map::SWEEP_PER_FRAME`]
-//! tests a boundary, about 2 600 instructions for two): part of the
-//! fusion's own work after the matching, which the deadline's margin
-//! must leave room for ([`Fusion::step_within`]).
+//! The map's sweep for points behind the vehicle (`crate::map`, "What leaves
+//! the map") runs after the pair is fused, not with the carry before the
+//! matching, so that a step can tell what its pass cost: it rests where the
+//! pass had more conflicts than agreeing intervals (twice the conflicts above
+//! the matched points), as it does where a key frame retires and in the next
+//! step. Each conflict costs the pass about 40 instructions more than an
+//! agreeing point, so a pass where most conflict has spent what the sweep's
+//! tests would (up to [`crate::map::SWEEP_PER_FRAME`] a boundary, about 40
+//! each); where at most half conflict, the pass is at most about 20 a point
+//! dearer and the sweep fits. Resting loses nothing: a point behind the camera
+//! is left out of every query whether swept or not, and one no sweep reaches
+//! goes for room when its batch is the oldest (and a point whose interval
+//! conflicted is never admitted, so a key frame whose passes mostly conflict
+//! brings few points to make room for). The bench's `wobbling_forward` drive
+//! (every matched point conflicting in steps whose map has batches the camera
+//! is passing; a review's, simplified): 82 instructions a key-frame point with
+//! the sweep after every pass, 76 with the rest. Since the sweep runs after the
+//! matching, a caller's clock no longer sees its work before the matching's
+//! last question (at most [`crate::map::SWEEP_PER_FRAME`] tests a boundary,
+//! about 2 600 instructions for two): part of the fusion's own work after the
+//! matching, which the deadline's margin must leave room for
+//! ([`Fusion::step_within`]).
 //!
 //! # Range sensors
 //! [`Fusion::constrain`] intersects a key-frame point's interval with a

@@ -258,6 +258,31 @@ impl<const N: usize, const B: usize> Frame<N, B> {
         }
     }
 
+    /// Boundary `k` overwritten with the boundary `src` thinned with the
+    /// tolerance `eps` ([`crate::thin`]: a subsequence of `src`, so again
+    /// a boundary), and the thinned points; `None` (nothing changed) when
+    /// the frame has no boundary `k` or `src` is not thinned (too short,
+    /// `eps` not positive, more than `N` points).
+    /// Under a caller's deadline `tick` is asked between parts of the
+    /// pass; `None` when it says the time is up (boundary `k` then holds
+    /// what the pass wrote: the caller makes this frame another anyway).
+    #[inline(never)]
+    pub(crate) fn thin_into(
+        &mut self,
+        k: usize,
+        src: &[Pixel],
+        eps: f32,
+        tick: &mut crate::search::Tick<'_>,
+    ) -> Option<&[Pixel]> {
+        if k >= self.count {
+            return None;
+        }
+        let slot = self.slots.get_mut(k)?;
+        let m = crate::thin::thin(src, eps, slot.points.storage_mut(), tick)?;
+        slot.points.set_len(m);
+        Some(slot.points.as_slice())
+    }
+
     /// Start filling this frame in place for `camera`: no boundaries yet.
     /// (The wire decoder writes points straight into the slots.)
     pub(crate) fn restart(&mut self, camera: Camera) {

@@ -92,6 +92,7 @@ mod pencil;
 pub mod processor;
 mod search;
 mod structure;
+pub mod thin;
 mod wedge;
 pub mod wire;
 

@@ -15,7 +15,12 @@
 //!    the test is decided from the keys in `O(1)` per point
 //!    (`fold::folds_by_hulls`); only otherwise (a point without a key, or
 //!    pseudo-angle keys) is the polyline indexed and queried.
-//! 3. **Index** the corresponding frame-2 polyline (`crate::search`).
+//! 3. **Thin** the corresponding frame-2 polyline where the call may
+//!    (`crate::thin`: [`Processor::process`] and
+//!    [`Processor::process_within`] on the wedge path, moving forwards
+//!    without a translation error, over the previous frame's boundary,
+//!    which step 1 has read; the pair's `e₂` then holds the thinning's
+//!    `ε = e₂/256`), and **index** it (`crate::search`).
 //! 4. **Match** every remaining point: its error band ([`crate::depth`]),
 //!    or, moving forwards without a translation error, the wedge that
 //!    holds it (`crate::wedge`; half-plane keys, or pseudo-angle keys
@@ -244,6 +249,18 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     /// The first frame (or the first after [`Processor::reset`]) is kept and
     /// [`Step::First`] returned; `motion` is then ignored. On error nothing
     /// changes. On success the new frame becomes the previous one.
+    ///
+    /// Moving forwards without a translation error (the wedge path), each
+    /// boundary of `frame` is **thinned** before it is searched
+    /// ([`crate::thin`]): the vertices within `ε = e₂/256` of the chord
+    /// between their neighbours dropped (on a detector's rounded straight
+    /// stretches, most of them), and the search's `e₂` widened by `ε`, so
+    /// every guarantee holds as before, each stick is a few tenths of a per
+    /// cent wider, and a match lies within `ε` of the polyline given. The
+    /// thinned boundary is written over the previous frame's, which the
+    /// call replaces anyway; [`Self::process_against_kept`] keeps its
+    /// frame and so searches `frame`'s boundaries as given (its results
+    /// may differ from this call's by that much).
     pub fn process(
         &mut self,
         frame: &Frame<N, B>,
@@ -287,7 +304,13 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             return Ok(Step::First);
         }
         let motion = motion.ok_or(ProcessError::MissingMotion)?;
-        self.reconstruct(frame, motion, Matcher::Indexed, Rounding::NONE, deadline);
+        self.reconstruct(
+            frame,
+            motion,
+            (Matcher::Indexed, true),
+            Rounding::NONE,
+            deadline,
+        );
         self.previous.assign(frame);
         Ok(Step::Structure(&self.output))
     }
@@ -309,7 +332,9 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     /// eq. 3.4) and the sticks shrink with it, which is how
     /// [`crate::geometry::road_geometry`] fuses frames. Errors leave the kept
     /// state unchanged; with no kept frame this is
-    /// [`ProcessError::NoKeptFrame`].
+    /// [`ProcessError::NoKeptFrame`]. `frame`'s boundaries are searched as
+    /// given: the thinning of [`Self::process`] needs the room of a frame
+    /// the call replaces, and this call replaces none.
     pub fn process_against_kept(
         &mut self,
         frame: &Frame<N, B>,
@@ -346,7 +371,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         if !self.has_previous {
             return Err(ProcessError::NoKeptFrame);
         }
-        self.reconstruct(frame, motion, Matcher::Indexed, rounding, deadline);
+        self.reconstruct(frame, motion, (Matcher::Indexed, false), rounding, deadline);
         if !keep {
             self.previous.assign(frame);
         }
@@ -378,10 +403,46 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         self.reconstruct(
             frame,
             motion,
-            Matcher::Reference,
+            (Matcher::Reference, false),
             Rounding::NONE,
             &mut NoDeadline,
         );
+        Ok(&self.output)
+    }
+
+    /// [`Processor::process`] (frame 2's boundaries thinned as it thins
+    /// them, [`crate::thin`]; the frame kept as the previous one after)
+    /// with the reference matcher of [`Self::reference_against_kept`] when
+    /// `reference`, and step 2's fold test switched off unless `fold_test`:
+    /// for the tests that the indexed search changes nothing on thinned
+    /// boundaries either; behind the private `_reference` feature. Needs a
+    /// previous frame ([`ProcessError::NoKeptFrame`] without one).
+    #[cfg(any(test, feature = "_reference"))]
+    #[doc(hidden)]
+    pub fn process_checked(
+        &mut self,
+        frame: &Frame<N, B>,
+        motion: &Motion,
+        (reference, fold_test): (bool, bool),
+    ) -> Result<&Structure<N, B>, ProcessError> {
+        if !self.has_previous {
+            return Err(ProcessError::NoKeptFrame);
+        }
+        let matcher = if reference {
+            Matcher::Reference
+        } else {
+            Matcher::Indexed
+        };
+        self.fold_test = fold_test;
+        self.reconstruct(
+            frame,
+            motion,
+            (matcher, true),
+            Rounding::NONE,
+            &mut NoDeadline,
+        );
+        self.fold_test = true;
+        self.previous.assign(frame);
         Ok(&self.output)
     }
 
@@ -413,7 +474,13 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             Matcher::Indexed
         };
         self.fold_test = false;
-        self.reconstruct(frame, motion, matcher, Rounding::NONE, &mut NoDeadline);
+        self.reconstruct(
+            frame,
+            motion,
+            (matcher, false),
+            Rounding::NONE,
+            &mut NoDeadline,
+        );
         self.fold_test = true;
         Ok(&self.output)
     }
@@ -441,7 +508,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         &mut self,
         frame: &Frame<N, B>,
         motion: &Motion,
-        matcher: Matcher,
+        (matcher, thin): (Matcher, bool),
         rounding: Rounding,
         deadline: &mut D,
     ) {
@@ -469,7 +536,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         } else {
             config
         };
-        let pair = Pair::new(
+        let mut pair = Pair::new(
             point_config,
             config.rotation_error,
             previous.camera(),
@@ -477,20 +544,22 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             motion,
             rounding,
         );
+        if thin && step4::wedge_path(&pair) {
+            pair.thin = crate::thin::epsilon(config.e2);
+        }
+        let pair = pair;
         output.camera1 = *previous.camera();
         // (At most `B`, below 2¹⁶: `Structure::EMPTY`.)
         output.count = u16::try_from(previous.boundaries().len()).unwrap_or(u16::MAX);
         let mut work = Work::new();
         let mut guard = Guard::new(deadline, config.work_per_point);
-        for (k, (b1, out)) in previous
-            .boundaries()
-            .iter()
-            .zip(output.slots.iter_mut())
-            .enumerate()
-        {
+        let boundaries = previous.boundaries().len();
+        for (k, out) in output.slots.iter_mut().enumerate().take(boundaries) {
+            let Some(b1) = previous.boundaries().get(k).map(|b| b.points()) else {
+                break;
+            };
             let b2 = frame.boundaries().get(k).map(|b| b.points());
             let keying = pair.keying(b2);
-            let b1 = b1.points();
             out.points.set_len(b1.len());
             let slots = out.points.as_mut_slice();
             if guard.check() {
@@ -615,12 +684,23 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             } else {
                 Some(&mut ask)
             };
-            let built = frame2_keys(index, &keying, b2, (orient, checking), &mut tick).is_some_and(
-                |builder| {
+            // Frame 2's boundary thinned ([`crate::thin`]) over frame 1's,
+            // whose points step 1 took (the call makes this frame the
+            // previous one at its end); the pair's `e₂` holds the `ε`. (A
+            // pass the clock stopped leaves `b2` as it is: the build's
+            // first question stops it too.)
+            let thinned = if pair.thin > 0.0 {
+                previous.thin_into(k, b2, pair.thin, &mut tick)
+            } else {
+                None
+            };
+            let b2 = thinned.unwrap_or(b2);
+            let thinned = thinned.is_some();
+            let built = frame2_keys(index, &keying, b2, (orient, checking, thinned), &mut tick)
+                .is_some_and(|builder| {
                     let radius = near_foe + 2.0 * (r1_max + pair.e2());
                     frame2_index(builder, &pair, &keying, b2, radius, &mut tick)
-                },
-            );
+                });
             if !built {
                 // The time ran out in the build: the index unfit, unused
                 // (as above with the counting rule).
@@ -635,7 +715,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
                 index,
                 (&mut work, &mut guard),
                 matcher,
-                (*fold_counting, checking),
+                (*fold_counting, checking, thinned),
             );
         }
         // (With the counting rule, a boundary the clock cut has its points
@@ -867,10 +947,12 @@ fn frame2_keys<'a, const N: usize>(
     index: &'a mut Index<N>,
     keying: &Keying,
     b2: &[Pixel],
-    (orient, checking): (f32, bool),
+    (orient, checking, thinned): (f32, bool, bool),
     tick: &mut Tick<'_>,
 ) -> Option<Builder<'a, N>> {
-    let mut builder = index.builder((keying.period, orient), Unkeyed::MeetAll);
+    let mut builder = index
+        .builder((keying.period, orient), Unkeyed::MeetAll)
+        .uneven(thinned);
     // (Without a clock one part: the whole polyline.)
     let part = if tick.is_some() {
         CHUNK

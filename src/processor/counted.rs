@@ -75,7 +75,7 @@ pub(super) fn counted_search<const N: usize, D: Deadline>(
     (slots, b2): (&mut [PointResult], &[Pixel]),
     index: &mut Index<N>,
     (work, guard): (&mut Work, &mut Guard<'_, D>),
-    (matcher, checking): (Matcher, bool),
+    (matcher, checking, thinned): (Matcher, bool, bool),
 ) {
     let Pencil::Half { foe, side, min_t } = keying.pencil else {
         return;
@@ -168,7 +168,9 @@ pub(super) fn counted_search<const N: usize, D: Deadline>(
     // The frame-2 index again (its block tree built at once: the tree the
     // walks would build), and the points given back searched.
     let ks = keying.key_scale;
-    let mut builder = index.builder((keying.period, orient), Unkeyed::MeetAll);
+    let mut builder = index
+        .builder((keying.period, orient), Unkeyed::MeetAll)
+        .uneven(thinned);
     for part in b2.chunks(CHUNK) {
         if guard.check() {
             stopped = true;

@@ -41,6 +41,9 @@ pub(super) struct Pair<'c> {
     /// composition's rounding"), by which the band path's stick ends
     /// move outwards.
     pub(super) scale_motion: f32,
+    /// The thinning's `ε` when frame 2's boundaries are thinned
+    /// ([`crate::thin`]; 0 when not), part of [`Self::e2`].
+    pub(super) thin: f32,
 }
 
 impl<'c> Pair<'c> {
@@ -161,6 +164,7 @@ impl<'c> Pair<'c> {
                 [w, up * (1.0 + scale_comp), down * (1.0 - scale_comp)]
             },
             scale_motion: scale_comp,
+            thin: 0.0,
             geom,
         }
     }
@@ -189,7 +193,7 @@ impl<'c> Pair<'c> {
     }
 
     pub(super) fn e2(&self) -> f32 {
-        self.config.e2 + self.slack_e2
+        self.config.e2 + self.slack_e2 + self.thin
     }
 
     /// The grazing test's allowance for the polyline's error: `e₂ · 2/sin

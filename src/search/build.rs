@@ -28,6 +28,7 @@ impl<const N: usize> Index<N> {
         self.near.clear();
         self.near_overflow = false;
         Builder {
+            uneven: false,
             o: if orient < 0.0 { -1.0 } else { 1.0 },
             period,
             unkeyed,
@@ -52,6 +53,23 @@ impl<const N: usize> Index<N> {
     /// the minima before them left as they were.
     fn suffix_minima(
         &mut self,
+        (wide, uneven): (f32, bool),
+        tick: &mut Tick<'_>,
+        stop_once_loose: bool,
+    ) -> Option<bool> {
+        // (Two forms: the even one is the pass it was, without the
+        // widths' test, about 5 instructions a segment.)
+        if uneven {
+            self.suffix_minima_of::<true>(wide, tick, stop_once_loose)
+        } else {
+            self.suffix_minima_of::<false>(wide, tick, stop_once_loose)
+        }
+    }
+
+    /// [`Self::suffix_minima`], for an uneven polyline or not.
+    #[inline(always)]
+    fn suffix_minima_of<const UNEVEN: bool>(
+        &mut self,
         wide: f32,
         tick: &mut Tick<'_>,
         stop_once_loose: bool,
@@ -61,10 +79,19 @@ impl<const N: usize> Index<N> {
             return Some(false);
         };
         let (mut run, mut gap) = (f32::INFINITY, f32::NEG_INFINITY);
+        // (A thinned polyline's segments are uneven, [`Builder::uneven`]:
+        // a long chord is as wide in keys as the run it stands for, and
+        // only what its envelope adds to its own interval is a fold's.)
         let mut one = |g: &mut Seg| {
             run = fmin(run, g.lo);
             g.sm = run;
-            gap = fmax(gap, g.pm - run);
+            if UNEVEN {
+                let w = g.hi - g.lo;
+                let own = if w > 0.0 && w < f32::INFINITY { w } else { 0.0 };
+                gap = fmax(gap, (g.pm - run) - own);
+            } else {
+                gap = fmax(gap, g.pm - run);
+            }
             gap
         };
         match tick {
@@ -115,7 +142,13 @@ impl<const N: usize> Index<N> {
     /// rebuild the envelopes without them; `false` when `tick`'s clock
     /// stopped it (the index then unfit for queries).
     #[inline(never)]
-    fn rebuild(&mut self, orient: f32, wide: f32, tick: &mut Tick<'_>, defer: bool) -> bool {
+    fn rebuild(
+        &mut self,
+        orient: f32,
+        (wide, uneven): (f32, bool),
+        tick: &mut Tick<'_>,
+        defer: bool,
+    ) -> bool {
         let s = self.segments;
         let Some(seg) = self.seg.get_mut(..s) else {
             return true;
@@ -176,7 +209,7 @@ impl<const N: usize> Index<N> {
         }
         // The block tree for runs through the rebuilt envelopes, when they
         // are still loose (tight runs are short: no tree needed).
-        let Some(loose) = self.suffix_minima(wide, tick, false) else {
+        let Some(loose) = self.suffix_minima((wide, uneven), tick, false) else {
             return false;
         };
         self.loose = loose;
@@ -627,6 +660,8 @@ pub(crate) struct Builder<'a, const N: usize> {
     last: f32,
     run: f32,
     sum: f32,
+    /// The polyline was thinned ([`Self::uneven`]).
+    uneven: bool,
 }
 
 impl<const N: usize> Builder<'_, N> {
@@ -922,6 +957,18 @@ impl<const N: usize> Builder<'_, N> {
         self.finish_with(near, tick, false)
     }
 
+    /// Mark the polyline as thinned ([`crate::thin`]) when `on`: its
+    /// segments' lengths are then uneven (a chord stands for a run of the
+    /// detected ones), so a wide interval is not by itself a fold or an
+    /// outlier, and the index is loose only where an envelope reaches more
+    /// than [`WIDE`] average widths beyond the segment's own interval (a
+    /// run's length depends on that excess, not on the width). Only which
+    /// structure the queries walk changes, never what they find.
+    pub(crate) fn uneven(mut self, on: bool) -> Self {
+        self.uneven = on;
+        self
+    }
+
     /// [`Self::finish`] without a clock, a loose index's block tree left
     /// until a walk reads it ([`LazyBlocks`], [`Index::lean_lazy`]): for an
     /// index searched only by the lean wedge walks, which build it at their
@@ -957,6 +1004,7 @@ impl<const N: usize> Builder<'_, N> {
             sum,
             order,
             period,
+            uneven,
             ..
         } = self;
         let s = n.saturating_sub(1);
@@ -971,11 +1019,13 @@ impl<const N: usize> Builder<'_, N> {
         // this pass may stop once it knows, `answer`. Where an outlier at
         // the boundary's far end tells, the whole pass is saved: `demo_13`
         // 930.2 → 915.7 instructions a point.)
-        let Some(loose) = index.suffix_minima(wide, tick, true) else {
+        let Some(loose) = index.suffix_minima((wide, uneven), tick, true) else {
             return false;
         };
         index.loose = loose;
-        if (loose || odd || flip) && !index.rebuild(if flip { -o } else { o }, wide, tick, defer) {
+        if (loose || odd || flip)
+            && !index.rebuild(if flip { -o } else { o }, (wide, uneven), tick, defer)
+        {
             return false;
         }
         index.kmin = index.seg.first().map_or(f32::INFINITY, |g| g.sm);

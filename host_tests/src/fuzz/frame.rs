@@ -895,10 +895,18 @@ pub fn on_segment_distance(q: Pixel, (a, b): (Pixel, Pixel)) -> f64 {
 /// close to, the compensated frame-1 point and the FOE (`docs/METHOD.md`,
 /// "A match's pixel lies on the polyline"; the largest ratio seen in a minute of this pass was
 /// `8.3·10⁻⁷` before the segment's ends counted, about a twentieth of it).
+///
+/// `thin` is the thinning's `ε` when `s` came from `Processor::process`,
+/// which may thin frame 2's boundaries (`roadstereo::thin`; 0 otherwise):
+/// the match then lies on a chord of the boundary, whose vertices it
+/// skipped lie within `0.575 ε` of it, so the tolerance adds `ε` and takes
+/// the boundary's largest coordinate into `S` (the chord's ends are
+/// vertices of it).
 fn check_on_polyline<const N: usize, const B: usize>(
     s: &Structure<N, B>,
     kept: &Frame<N, B>,
     (frame, m): (&Frame<N, B>, &Motion),
+    thin: f64,
 ) {
     let g = roadstereo::PairGeometry::new(kept.camera(), frame.camera(), m);
     let foe = g
@@ -919,13 +927,20 @@ fn check_on_polyline<const N: usize, const B: usize>(
                 .max(f64::from(q.v.abs()))
                 .max(p1)
                 .max(foe);
+            let base = if thin > 0.0 {
+                poly.iter().fold(base, |s, p| {
+                    s.max(f64::from(p.u.abs())).max(f64::from(p.v.abs()))
+                })
+            } else {
+                base
+            };
             // The least ratio of distance to tolerance over the segments.
             let ratio = poly
                 .windows(2)
                 .map(|w| {
                     let ends = [w[0].u, w[0].v, w[1].u, w[1].v];
                     let scale = ends.iter().fold(base, |s, x| s.max(f64::from(x.abs())));
-                    on_segment_distance(q, (w[0], w[1])) / (scale / 65_536.0)
+                    on_segment_distance(q, (w[0], w[1])) / (scale / 65_536.0 + thin)
                 })
                 .fold(f64::INFINITY, f64::min);
             assert!(
@@ -1042,10 +1057,14 @@ fn matchers<const N: usize, const B: usize>(
     frame: &Frame<N, B>,
     m: &Motion,
     (config, counting): (&Config, bool),
+    thinned: bool,
 ) -> Box<Structure<N, B>> {
     let unlimited = config
         .with_work_budget(Config::MAX_WORK_PER_POINT)
         .expect("the largest budget is valid");
+    if thinned {
+        return thinned_matchers(kept, frame, m, (&unlimited, counting));
+    }
     let mut r = Box::new(Processor::<N, B>::new(unlimited));
     r.set_fold_counting(counting);
     assert!(matches!(r.process(kept, None), Ok(Step::First)));
@@ -1090,6 +1109,54 @@ fn matchers<const N: usize, const B: usize>(
         Some(kept),
         "process_against_kept replaced the kept frame"
     );
+    fast
+}
+
+/// [`matchers`] for `Processor::process`, which thins frame 2's
+/// boundaries (`roadstereo::thin`): the indexed and reference matchers,
+/// with the fold test and without, each on a processor that kept `kept`
+/// first, equal point for point; the indexed one with the fold test is
+/// returned.
+fn thinned_matchers<const N: usize, const B: usize>(
+    kept: &Frame<N, B>,
+    frame: &Frame<N, B>,
+    m: &Motion,
+    (unlimited, counting): (&Config, bool),
+) -> Box<Structure<N, B>> {
+    let run = |reference: bool, fold_test: bool| {
+        let mut r = Box::new(Processor::<N, B>::new(*unlimited));
+        r.set_fold_counting(counting);
+        assert!(matches!(r.process(kept, None), Ok(Step::First)));
+        let s = Box::new(
+            r.process_checked(frame, m, (reference, fold_test))
+                .expect("kept")
+                .clone(),
+        );
+        assert!(r.previous() == Some(frame), "the new frame was not kept");
+        s
+    };
+    let fast = run(false, true);
+    for fold_test in [true, false] {
+        let fast_here = if fold_test {
+            fast.clone()
+        } else {
+            run(false, false)
+        };
+        let slow = run(true, fold_test);
+        for (k, (x, y)) in fast_here
+            .boundaries()
+            .iter()
+            .zip(slow.boundaries())
+            .enumerate()
+        {
+            for (i, (p, q)) in x.points().iter().zip(y.points()).enumerate() {
+                assert!(
+                    p == q,
+                    "thinned matcher (fold test {fold_test}): boundary {k} point {i}: indexed {p:?}, reference {q:?} (largest budget)"
+                );
+            }
+        }
+    }
     fast
 }
 
@@ -1300,7 +1367,7 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
                 let motion = m.as_ref().and_then(|m| build_motion(m, &mut features));
                 let kept = a.previous().cloned().map(Box::new);
                 let reference = match (&kept, &motion) {
-                    (Some(k), Some(m)) => Some(matchers(k, &frame, m, (&config, counting))),
+                    (Some(k), Some(m)) => Some(matchers(k, &frame, m, (&config, counting), true)),
                     _ => None,
                 };
                 let got = match a.process(&frame, motion.as_ref()) {
@@ -1334,7 +1401,10 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
                         );
                         check_structure(&s, k, &config, &mut features);
                         if let Some(m) = &motion {
-                            check_on_polyline(&s, k, (&frame, m));
+                            // (The thinning's `ε`, `e₂/256`, where `process`
+                            // thins: `roadstereo::thin`.)
+                            let thin = f64::from(config.e2()) / 256.0;
+                            check_on_polyline(&s, k, (&frame, m), thin);
                         }
                         against_reference(&s, r, &config, &mut features);
                         let t = shadow.process(&frame, motion.as_ref());
@@ -1360,7 +1430,7 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
                 let kept = a.previous().cloned().map(Box::new);
                 let reference = kept
                     .as_ref()
-                    .map(|k| matchers(k, &frame, &motion, (&config, counting)));
+                    .map(|k| matchers(k, &frame, &motion, (&config, counting), false));
                 let got = a
                     .process_against_kept(&frame, &motion)
                     .map(|s| Box::new(s.clone()));
@@ -1375,7 +1445,7 @@ fn run_case<const N: usize, const B: usize>(case: &Case) -> Outcome {
                         points[0] += c[0];
                         points[1] += c[1];
                         check_structure(&s, k, &config, &mut features);
-                        check_on_polyline(&s, k, (&frame, &motion));
+                        check_on_polyline(&s, k, (&frame, &motion), 0.0);
                         against_reference(&s, r, &config, &mut features);
                         within_deadlines(
                             k,

@@ -33,8 +33,9 @@ use reference::{match_wedge_angular_reference, match_wedge_reference};
 /// Step 4 for every point of a boundary left by steps 1–2. (Out of line,
 /// with the loop inside: the frame's constants stay in registers.)
 /// With `counting` (the counting rule, [`super::Processor::set_fold_counting`];
-/// `checking` the tests' switch of the loops' forms) the points the rule
-/// gives back are searched afterwards ([`super::counted::counted_search`]).
+/// `checking` the tests' switch of the loops' forms; `thinned` whether
+/// `b2` was thinned, [`crate::thin`]) the points the rule gives back are
+/// searched afterwards ([`super::counted::counted_search`]).
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 pub(super) fn match_boundary<const N: usize, D: Deadline>(
@@ -45,7 +46,7 @@ pub(super) fn match_boundary<const N: usize, D: Deadline>(
     index: &mut Index<N>,
     (work, guard): (&mut Work, &mut Guard<'_, D>),
     matcher: Matcher,
-    (counting, checking): (bool, bool),
+    (counting, checking, thinned): (bool, bool, bool),
 ) {
     match_points(
         pair,
@@ -71,7 +72,7 @@ pub(super) fn match_boundary<const N: usize, D: Deadline>(
             (slots, b2),
             index,
             (work, guard),
-            (matcher, checking),
+            (matcher, checking, thinned),
         );
     }
 }

@@ -1,0 +1,344 @@
+//! Frame 2's boundary **thinned** before it is keyed and searched: the
+//! vertices that lie on the chord between their neighbours dropped.
+//!
+//! A row-scanning detector gives one point per image row, rounded to the
+//! pixel grid, so a straight stretch of a boundary comes out as a lattice
+//! staircase whose vertices lie *exactly* on a few long chords (one step
+//! of two columns in every row, say). Every such vertex makes a segment
+//! that steps 3 and 4 of [`crate::Processor::process`] key, index and
+//! clip although the chord alone carries the same polyline. The thinning
+//! replaces each run of vertices lying within `ε` of the chord between the
+//! run's ends by that chord, in one pass.
+//!
+//! # What the thinned polyline keeps
+//! The thinned polyline `Q` is a subsequence of the detected one `P` with
+//! the same two ends, and every vertex of `P` lies within `ε` of the
+//! segment of `Q` whose run holds it. So every segment of `P` (its two
+//! ends within `ε` of the same segment of `Q`) lies within `ε` of it: the
+//! `ε`-neighbourhood of a segment is convex. A true boundary within `e₂`
+//! of `P` (the error model, [`crate::depth`]) is therefore within `e₂ + ε`
+//! of `Q`, and every guarantee of the matching stage holds for `Q` with
+//! `e₂ + ε` in place of `e₂`: the processor searches `Q` with that error
+//! ([`crate::Processor::process`]), so a stick is about `ε / (r₁ + e₂)`
+//! wider than with `P` (`ε = e₂/256`: a few tenths of a per cent), and a
+//! match lies on `Q`, within `ε` of `P`. `Q` is again a boundary in the
+//! sense of [`crate::boundary`] (finite, inside the image, strictly
+//! monotone in `v`, at most `N` points).
+//!
+//! # The test, exactly
+//! Boundaries are strictly monotone in the row `v`, so a chord from the
+//! run's anchor `a` to a later vertex `j` is `u = u_a + s (v − v_a)` with
+//! the slope `s = Δu_j/Δv_j` (`Δ` from `a`, `Δv` counted along the
+//! boundary's direction, so positive and growing). Vertex `i` of the run
+//! lies within `e` of that chord *horizontally* at its own row when `|Δu_i
+//! − s Δv_i| ≤ e`, that is when `s` lies in `[(Δu_i − e)/Δv_i, (Δu_i +
+//! e)/Δv_i]`; as `0 < Δv_i < Δv_j` that chord point lies on the segment
+//! `a → j`, so the vertex is within `e` of the segment (the horizontal
+//! distance bounds the distance). The pass keeps the intersection
+//! `[lo, hi]` of those intervals over the run's vertices so far and takes
+//! the next vertex `j` into the run while its own slope lies in it; else
+//! the run ends at the vertex before `j`, which anchors the next run (its
+//! first segment, an original one, is taken without a test). One test a
+//! vertex, one more on each run's end: linear in the points.
+//!
+//! **Rounding.** In `f32`, each `Δ` is the exact difference rounded once
+//! (`1 + α`, `|α| ≤ u = 2⁻²⁴`), `1/Δv` once more, the slope and each end of
+//! an interval once or twice more. Carried through the test `s̃_j ≥ l̃_i`
+//! (multiplied by the exact `Δv_i > 0`), the exact deviation is at most
+//! `e (1 + 4.02 u) + 5.03 u |Δu_i| + 4.01 u |s_j Δv_i|`, and `|s_j Δv_i|
+//! = |Δu_j| Δv_i/Δv_j ≤ |Δu_j|`; the same for the upper end. A vertex joins
+//! a run only within `2¹⁸ e` columns of its anchor (`|Δu| ≤ 2¹⁸ e`,
+//! computed), so the deviation is at most `e (1 + 9.1 · 2⁻²⁴ · 2¹⁸ (1 +
+//! u)) + 4.1 u e < 1.15 e`. The pass tests with `e = ε/2`: every vertex of
+//! `P` lies within `0.575 ε` of `Q`'s segment. A tiny `Δv` (a `1/Δv` that
+//! overflows) makes the interval's end `±∞` where the exact one is huge,
+//! or `NaN` (`0 · ∞`), which fails every later test: the run ends there,
+//! never wrongly extended (an interval end is replaced by a `NaN` one, not
+//! kept, `!(x <= lo)`).
+//!
+//! # What it costs
+//! About 25–30 instructions a vertex on the emulated Cortex-M4F (one
+//! division, `VDIV`, a vertex, two where a run ends), against the keys,
+//! the index and the clips of step 4 it saves on every vertex dropped.
+//! Where little thins (a boundary curved or noisy at the pixel scale), it
+//! does not pay: after the first 64 vertices the pass gives up where it
+//! kept more than three in four, and the boundary is searched as given
+//! (its `e₂` still the widened one, which costs nothing but the few
+//! tenths of a per cent). The processor's index judges a thinned
+//! boundary's envelopes by what they add to each segment's own interval
+//! (`crate::search`'s `Builder::uneven`): a chord standing for a long run
+//! is as wide in keys as the run, and not a fold.
+//!
+//! # Where it runs
+//! Thinning needs the room for `Q`; [`crate::Processor::process`] (and
+//! [`crate::Processor::process_within`]) write it over the previous
+//! frame's boundary once step 1 has taken that boundary's points (the
+//! call makes the new frame the previous one at its end anyway). The calls
+//! against a kept frame (the fusion's) keep that frame and search frame
+//! 2's boundaries as given.
+
+use crate::camera::Pixel;
+use crate::search::{expired, Tick, CHUNK};
+
+/// How far (in units of the test's `e`) from the run's anchor, in
+/// columns, a vertex may lie to join the run: the bound on the rounding of
+/// the test (module docs, "Rounding").
+pub(crate) const REACH: f32 = 262_144.0;
+
+/// The thinning's `ε` for a frame-2 error `e₂`: `e₂/256` (module docs);
+/// the processor searches with `e₂ + ε`. 0 (no thinning) for `e₂ = 0`.
+pub(crate) fn epsilon(e2: f32) -> f32 {
+    e2 * (1.0 / 256.0)
+}
+
+/// Thin the boundary `src` with the tolerance `eps` ([`epsilon`]) into
+/// `out` (at least as long as `src`): the number of vertices written, a
+/// subsequence of `src` with its two ends, every vertex of `src` within
+/// `eps` of the segment between the two written vertices around it
+/// (module docs). `None` (nothing useful written) when `src` has fewer
+/// than three points, `eps` is not positive or `out` is too short, and
+/// when the first [`CHUNK`] vertices after the first two kept more than
+/// three in four (a boundary thinning does not pay for: module docs,
+/// "What it costs").
+///
+/// `src` must be strictly monotone in `v` ([`crate::boundary`]); on other
+/// input the result is still a subsequence with the same ends, without the
+/// bound.
+///
+/// Under a caller's deadline `tick` asks its clock before every
+/// [`CHUNK`] vertices after the first; `None` when it says the time is up
+/// (what was written then is a prefix of the thinned boundary).
+pub(crate) fn thin(
+    src: &[Pixel],
+    eps: f32,
+    out: &mut [Pixel],
+    tick: &mut Tick<'_>,
+) -> Option<usize> {
+    let e = eps * 0.5;
+    if src.len() < 3 || !(e > 0.0) || out.len() < src.len() {
+        return None;
+    }
+    let reach = e * REACH;
+    let (&first, rest) = src.split_first()?;
+    let (&second, rest) = rest.split_first()?;
+    // The test's `e` signed with the boundary's direction in `v` (strictly
+    // monotone): with `Δv` signed, `[(Δu − e_s)/Δv, (Δu + e_s)/Δv]` is the
+    // interval of the module docs either way (`Δv < 0` turns it round).
+    let es = if second.v > first.v { e } else { -e };
+    // A run's anchor and the slope interval its vertices allow.
+    let constraint = |a: Pixel, q: Pixel| {
+        let (du, r) = (q.u - a.u, 1.0 / (q.v - a.v));
+        ((du - es) * r, (du + es) * r)
+    };
+    let mut written = 0usize;
+    // (`out` holds at least as many vertices as `src`: every put lands.)
+    let put = |out: &mut [Pixel], written: &mut usize, p: Pixel| {
+        if let Some(slot) = out.get_mut(*written) {
+            *slot = p;
+            *written += 1;
+        }
+    };
+    put(out, &mut written, first);
+    let mut anchor = first;
+    let (mut lo, mut hi) = constraint(anchor, second);
+    let mut prev = second;
+    for (c, rest) in rest.chunks(CHUNK).enumerate() {
+        // After the first part: nothing more where it kept more than
+        // three vertices in four (a boundary thinning does not pay for),
+        // or where the caller's clock says the time is up.
+        if c == 1 && written * 4 > CHUNK * 3 {
+            return None;
+        }
+        if c > 0 && expired(tick) {
+            return None;
+        }
+        for &q in rest {
+            let (du, r) = (q.u - anchor.u, 1.0 / (q.v - anchor.v));
+            let s = du * r;
+            if s >= lo && s <= hi && du.abs() <= reach {
+                // `q` joins the run; its own interval narrows the run's
+                // (a `NaN` end is taken, and fails every later test).
+                let (l, h) = ((du - es) * r, (du + es) * r);
+                lo = if l <= lo { lo } else { l };
+                hi = if h >= hi { hi } else { h };
+            } else {
+                // The run ends at the vertex before `q`, which anchors the
+                // next one (its first segment taken as it is).
+                put(out, &mut written, prev);
+                anchor = prev;
+                (lo, hi) = constraint(anchor, q);
+            }
+            prev = q;
+        }
+    }
+    put(out, &mut written, prev);
+    Some(written)
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::test_rng::Rng;
+    use std::vec::Vec;
+
+    /// The distance from `p` to the segment `a → b`, in `f64`.
+    fn distance(p: Pixel, a: Pixel, b: Pixel) -> f64 {
+        let (px, py) = (f64::from(p.u), f64::from(p.v));
+        let (ax, ay) = (f64::from(a.u), f64::from(a.v));
+        let (bx, by) = (f64::from(b.u), f64::from(b.v));
+        let (dx, dy) = (bx - ax, by - ay);
+        let l2 = dx * dx + dy * dy;
+        let t = if l2 > 0.0 {
+            (((px - ax) * dx + (py - ay) * dy) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        ((px - ax - t * dx).powi(2) + (py - ay - t * dy).powi(2)).sqrt()
+    }
+
+    /// Checks the module's claims on one boundary: a subsequence with the
+    /// same ends, every dropped vertex within `bound` of its chord (in
+    /// `f64`). Returns the thinned length.
+    fn check(src: &[Pixel], eps: f32, bound: f64) -> usize {
+        let mut out = std::vec![Pixel::new(0.0, 0.0); src.len()];
+        let Some(m) = thin(src, eps, &mut out, &mut None) else {
+            // Given up after the first part: it kept more than 3 in 4.
+            assert!(src.len() > CHUNK + 2);
+            let mut first = std::vec![Pixel::new(0.0, 0.0); CHUNK + 2];
+            let kept = thin(&src[..CHUNK + 2], eps, &mut first, &mut None);
+            assert!(kept.is_some_and(|k| k * 4 > CHUNK * 3), "{kept:?}");
+            return src.len();
+        };
+        let q = &out[..m];
+        assert_eq!((q.first(), q.last()), (src.first(), src.last()));
+        // A subsequence: each kept vertex found in order.
+        let mut at = Vec::with_capacity(m);
+        let mut i = 0;
+        for v in q {
+            while src[i] != *v {
+                i += 1;
+            }
+            at.push(i);
+        }
+        for w in at.windows(2) {
+            for p in &src[w[0]..=w[1]] {
+                let d = distance(*p, src[w[0]], src[w[1]]);
+                assert!(d <= bound, "{d} > {bound} at {w:?}");
+            }
+        }
+        m
+    }
+
+    /// Lattice staircases (a detector's rounded straight edges), rounded
+    /// curves, noisy points and rows at any spacing, over cameras up to
+    /// 8 000 px: every dropped vertex within `0.575 ε` of its chord, and
+    /// straight staircases thinned.
+    #[test]
+    fn every_dropped_vertex_lies_on_its_chord() {
+        let mut g = Rng(7);
+        let mut dropped = 0usize;
+        let mut total = 0usize;
+        for case in 0..4000 {
+            let width = [512.0f32, 1024.0, 2048.0, 8000.0][case % 4];
+            let n = 3 + (g.next() * 300.0) as usize;
+            let (u0, v0) = (g.next() * width, g.next() * 100.0);
+            let slope = (g.next() - 0.5) * 8.0;
+            let curve = if case % 3 == 0 {
+                (g.next() - 0.5) * 0.02
+            } else {
+                0.0
+            };
+            let step = [1.0f32, 2.0, 0.37, 3.0][(case / 4) % 4];
+            let round = case % 5 != 0;
+            let noise = if case % 7 == 0 { 0.3 } else { 0.0 };
+            let mut src = Vec::with_capacity(n);
+            for k in 0..n {
+                let dv = k as f32 * step;
+                let mut u = u0 + slope * dv + curve * dv * dv + noise * (g.next() - 0.5);
+                if round {
+                    u = u.round();
+                }
+                src.push(Pixel::new(u, v0 + dv));
+            }
+            if case % 2 == 1 {
+                src.reverse();
+            }
+            let eps = [0.5f32 / 256.0, 0.002, 0.05, 1.0][(case / 16) % 4];
+            let m = check(&src, eps, 0.575 * f64::from(eps));
+            dropped += n - m;
+            total += n;
+        }
+        // Most of the staircases' vertices go.
+        assert!(dropped * 3 > total, "{dropped} of {total}");
+    }
+
+    /// A boundary whose first part thins by less than a quarter (noisy
+    /// points along a curve) is given up on after that part.
+    #[test]
+    fn a_boundary_that_does_not_thin_is_given_up() {
+        let mut g = Rng(11);
+        let src: Vec<Pixel> = (0..200)
+            .map(|k| {
+                let v = k as f32;
+                Pixel::new(100.0 + 0.002 * v * v + 0.3 * g.next(), 400.0 - v)
+            })
+            .collect();
+        let mut out = std::vec![Pixel::new(0.0, 0.0); src.len()];
+        assert_eq!(thin(&src, 0.002, &mut out, &mut None), None);
+        // Its first part alone (no second to give up before) is thinned.
+        let part = &src[..CHUNK + 2];
+        let m = check(part, 0.002, 0.575 * 0.002);
+        assert!(m * 4 > CHUNK * 3, "{m}");
+    }
+
+    /// Vertices built to sit at the test's edge: on a line, each moved
+    /// across it by `e` give or take a thousandth, alternately to either
+    /// side, far from the origin and with runs reaching the column limit:
+    /// still every dropped vertex within `0.575 ε` of its chord.
+    #[test]
+    fn vertices_at_the_tests_edge_stay_within_the_bound() {
+        let mut g = Rng(5);
+        for case in 0..2000 {
+            let eps = [0.002f32, 0.5 / 256.0, 0.03][case % 3];
+            let e = eps * 0.5;
+            let (u0, v0) = (g.next() * 7000.0 + 500.0, g.next() * 7000.0);
+            let slope = (g.next() - 0.5) * [0.5f32, 4.0, 1e3 * e][case % 3];
+            let step = [1.0f32, 0.25, 3.0, 1e-3][(case / 3) % 4];
+            let n = 3 + (g.next() * 200.0) as usize;
+            let src: Vec<Pixel> = (0..n)
+                .map(|k| {
+                    let dv = k as f32 * step;
+                    let side = if k % 2 == 0 { 1.0 } else { -1.0 };
+                    let off = side * e * (1.0 + (g.next() - 0.5) * 2e-3);
+                    Pixel::new(u0 + slope * dv + off, v0 + dv)
+                })
+                .collect();
+            check(&src, eps, 0.575 * f64::from(eps));
+        }
+    }
+
+    /// A straight staircase of two columns a row: every vertex but the
+    /// ends dropped; a row spacing of a hair (a `1/Δv` that overflows)
+    /// ends the run instead of taking a wrong one.
+    #[test]
+    fn straight_runs_go_and_hair_spacing_stops_them() {
+        let src: Vec<Pixel> = (0..100)
+            .map(|k| Pixel::new(10.0 + 2.0 * k as f32, 300.0 - k as f32))
+            .collect();
+        assert_eq!(check(&src, 0.002, 0.002), 2);
+        let tiny = [
+            Pixel::new(10.0, 5.0),
+            Pixel::new(12.0, 5.0 + 1e-38),
+            Pixel::new(14.0, 6.0),
+            Pixel::new(16.0, 7.0),
+            Pixel::new(100.0, 8.0),
+        ];
+        check(&tiny, 0.002, 0.002);
+        // Too short, or no tolerance: nothing done.
+        let mut out = [Pixel::new(0.0, 0.0); 5];
+        assert_eq!(thin(&tiny[..2], 0.002, &mut out, &mut None), None);
+        assert_eq!(thin(&tiny, 0.0, &mut out, &mut None), None);
+        assert_eq!(thin(&tiny, f32::NAN, &mut out, &mut None), None);
+    }
+}

@@ -425,6 +425,22 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         motion: &Motion,
         (reference, fold_test): (bool, bool),
     ) -> Result<&Structure<N, B>, ProcessError> {
+        self.test_reconstruct(frame, motion, (reference, fold_test, true))?;
+        self.previous.assign(frame);
+        Ok(&self.output)
+    }
+
+    /// The tests' reconstruction of `frame` against the previous frame:
+    /// the reference matcher when `reference`, step 2's fold test on only
+    /// with `fold_test`, frame 2's boundaries thinned with `thin` (over the
+    /// previous frame's, which the caller then replaces).
+    #[cfg(any(test, feature = "_reference"))]
+    fn test_reconstruct(
+        &mut self,
+        frame: &Frame<N, B>,
+        motion: &Motion,
+        (reference, fold_test, thin): (bool, bool, bool),
+    ) -> Result<(), ProcessError> {
         if !self.has_previous {
             return Err(ProcessError::NoKeptFrame);
         }
@@ -437,13 +453,12 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         self.reconstruct(
             frame,
             motion,
-            (matcher, true),
+            (matcher, thin),
             Rounding::NONE,
             &mut NoDeadline,
         );
         self.fold_test = true;
-        self.previous.assign(frame);
-        Ok(&self.output)
+        Ok(())
     }
 
     /// [`Processor::process_against_kept`] with step 2's fold test switched
@@ -465,23 +480,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
         motion: &Motion,
         reference: bool,
     ) -> Result<&Structure<N, B>, ProcessError> {
-        if !self.has_previous {
-            return Err(ProcessError::NoKeptFrame);
-        }
-        let matcher = if reference {
-            Matcher::Reference
-        } else {
-            Matcher::Indexed
-        };
-        self.fold_test = false;
-        self.reconstruct(
-            frame,
-            motion,
-            (matcher, false),
-            Rounding::NONE,
-            &mut NoDeadline,
-        );
-        self.fold_test = true;
+        self.test_reconstruct(frame, motion, (reference, false, false))?;
         Ok(&self.output)
     }
 

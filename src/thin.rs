@@ -50,14 +50,24 @@
 //! a run only within `2¹⁸ e` columns of its anchor (`|Δu| ≤ 2¹⁸ e`,
 //! computed), so the deviation is at most `e (1 + 9.1 · 2⁻²⁴ · 2¹⁸ (1 +
 //! u)) + 4.1 u e < 1.15 e`. The pass tests with `e = ε/2`: every vertex of
-//! `P` lies within `0.575 ε` of `Q`'s segment. A tiny `Δv` (a `1/Δv` that
-//! overflows) makes the interval's end `±∞` where the exact one is huge,
-//! or `NaN` (`0 · ∞`), which fails every later test: the run ends there,
-//! never wrongly extended (an interval end is replaced by a `NaN` one, not
+//! `P` lies within `0.575 ε` of `Q`'s segment. A vertex joins a run only
+//! with a finite slope (so a finite `1/Δv`): where a subnormal `Δv`
+//! overflows `1/Δv`, the run ends; a boundary whose rows are so far apart
+//! that `Δv` overflows is not thinned (the rows are monotone: one test of
+//! the whole boundary's span). (An adversarial review found the test passing `+∞ ≥ +∞`: a
+//! run's first vertex a subnormal row gap from its anchor and far to its
+//! side gave the interval `[+∞, +∞]`, and a later vertex as close in rows
+//! the slope `+∞`, dropping a vertex 499 px off its chord; through the
+//! processor a spike along row 0 went missing and a stick missed the
+//! truth, `host_tests/tests/thin.rs`.) The run's first vertex itself is
+//! taken without a test, and its interval is exact or wider: `[−∞, +∞]`
+//! only where it lies within `e` of its anchor at almost the same row,
+//! within `e` of any chord from the anchor; a `NaN` end (`0 · ∞`) fails
+//! every later test (an interval end is replaced by a `NaN` one, not
 //! kept, `!(x <= lo)`).
 //!
 //! # What it costs
-//! About 25–30 instructions a vertex on the emulated Cortex-M4F (one
+//! About 39 instructions a vertex on the emulated Cortex-M4F (one
 //! division, `VDIV`, a vertex, two where a run ends), against the keys,
 //! the index and the clips of step 4 it saves on every vertex dropped.
 //! Where little thins (a boundary curved or noisy at the pixel scale), it
@@ -121,6 +131,11 @@ pub(crate) fn thin(
     let reach = e * REACH;
     let (&first, rest) = src.split_first()?;
     let (&second, rest) = rest.split_first()?;
+    // The rows are monotone, so no `Δv` is larger than the whole
+    // boundary's: finite where that one is (a frame's always is).
+    if !(src.last()?.v - first.v).is_finite() {
+        return None;
+    }
     // The test's `e` signed with the boundary's direction in `v` (strictly
     // monotone): with `Δv` signed, `[(Δu − e_s)/Δv, (Δu + e_s)/Δv]` is the
     // interval of the module docs either way (`Δv < 0` turns it round).
@@ -155,7 +170,9 @@ pub(crate) fn thin(
         for &q in rest {
             let (du, r) = (q.u - anchor.u, 1.0 / (q.v - anchor.v));
             let s = du * r;
-            if s >= lo && s <= hi && du.abs() <= reach {
+            // (A finite slope: an overflowed `1/Δv` ends the run, module
+            // docs, "Rounding"; `Δv` itself is finite, below.)
+            if s >= lo && s <= hi && du.abs() <= reach && s.abs() < f32::INFINITY {
                 // `q` joins the run; its own interval narrows the run's
                 // (a `NaN` end is taken, and fails every later test).
                 let (l, h) = ((du - es) * r, (du + es) * r);
@@ -316,6 +333,43 @@ mod tests {
                 .collect();
             check(&src, eps, 0.575 * f64::from(eps));
         }
+    }
+
+    /// A review's finds: a run's first vertex a subnormal row gap from
+    /// its anchor and 500 px aside (its interval `[+∞, +∞]`), then a
+    /// vertex as close in rows (the slope `+∞`); the same decreasing; rows
+    /// so far apart that `Δv` overflows (`1/Δv = 0`, the interval `[0,
+    /// 0]`). No vertex is dropped farther than the bound from its chord.
+    #[test]
+    fn overflowed_row_gaps_end_the_run() {
+        let t = f32::from_bits;
+        let rising = [
+            Pixel::new(0.0, 0.0),
+            Pixel::new(500.0, t(1)),
+            Pixel::new(1.0, t(2)),
+        ];
+        assert_eq!(check(&rising, 0.39, 0.575 * 0.39), 3);
+        let falling = [
+            Pixel::new(0.0, 0.0),
+            Pixel::new(500.0, -t(1)),
+            Pixel::new(1.0, -t(2)),
+            Pixel::new(2.0, -1.0),
+        ];
+        check(&falling, 0.39, 0.575 * 0.39);
+        let falling_hair = [
+            Pixel::new(10.0, 2.0 * f32::MIN_POSITIVE),
+            Pixel::new(400.0, f32::MIN_POSITIVE),
+            Pixel::new(11.0, 0.0),
+            Pixel::new(12.0, -0.5),
+        ];
+        check(&falling_hair, 0.002, 0.575 * 0.002);
+        let huge = [
+            Pixel::new(0.0, -3.0e38),
+            Pixel::new(1000.0, 3.0e38),
+            Pixel::new(0.0, 3.4e38),
+        ];
+        let mut out = [Pixel::new(0.0, 0.0); 3];
+        assert_eq!(thin(&huge, 0.39, &mut out, &mut None), None);
     }
 
     /// A straight staircase of two columns a row: every vertex but the

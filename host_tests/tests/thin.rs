@@ -1,0 +1,54 @@
+//! Frame 2's boundaries thinned (`roadstereo::thin`) against the truth,
+//! on an input an adversarial review built to break it: a boundary whose
+//! rows at the image's top are subnormals apart, a spike along row 0.
+
+use roadstereo::{Camera, Config, Frame, Motion, Pixel, Processor, Status, Step};
+
+/// Moving forwards 0.5 (the FOE at the principal point), frame 1's point
+/// (260, 120) at depth 1 is seen in frame 2 at (200, 0), on the spike the
+/// frame-2 boundary makes along row 0 (the rows of its first three
+/// vertices a subnormal apart). `process` thins frame 2's boundary; the
+/// spike must survive it: the point is flagged, or `ok` with its stick
+/// holding depth 1 (a review found it `ok` at [1.197, 1.237] while the
+/// thinning's test took `+∞ ≥ +∞` and dropped the spike). The same for the
+/// kept-frame call, which does not thin.
+#[test]
+fn a_spike_at_subnormal_row_gaps_survives_the_thinning() {
+    let t = f32::from_bits;
+    let cam = Camera::new(500.0, 500.0, 320.0, 240.0, 640, 480).expect("camera");
+    let m = Motion::new([0.0, 0.0, 0.5], [0.0; 3]).expect("motion");
+    let p1 = [Pixel::new(260.0, 120.0), Pixel::new(262.0, 124.0)];
+    let p2 = [
+        Pixel::new(0.0, 0.0),
+        Pixel::new(400.0, t(1)),
+        Pixel::new(1.0, t(2)),
+        Pixel::new(600.0, 100.0),
+    ];
+    let mut f1 = Frame::<8, 1>::new(cam);
+    f1.push_boundary(&p1).expect("frame 1");
+    let mut f2 = Frame::<8, 1>::new(cam);
+    f2.push_boundary(&p2).expect("frame 2");
+    // The truth: (260, 120) at depth 1 is (−0.12, −0.24, 1); after moving
+    // 0.5 forwards it projects to (320 − 60/0.5, 240 − 120/0.5).
+    let truth = 1.0f32;
+    for kept in [false, true] {
+        let mut p = Box::new(Processor::<8, 1>::new(Config::DEFAULT));
+        assert!(matches!(p.process(&f1, None), Ok(Step::First)));
+        let s = if kept {
+            p.process_against_kept(&f2, &m).expect("kept").clone()
+        } else {
+            let Ok(Step::Structure(s)) = p.process(&f2, Some(&m)) else {
+                panic!("no structure");
+            };
+            s.clone()
+        };
+        let r = s.boundaries()[0].points()[0];
+        if r.status() == Status::Ok {
+            let i = r.interval().expect("a stick");
+            assert!(
+                i.z_near <= truth * 1.0001 && truth * 0.9999 <= i.z_far,
+                "kept {kept}: {r:?}"
+            );
+        }
+    }
+}

@@ -260,12 +260,14 @@ impl<const N: usize, const B: usize> Frame<N, B> {
 
     /// Boundary `k` overwritten with the boundary `src` thinned with the
     /// tolerance `eps` ([`crate::thin`]: a subsequence of `src`, so again
-    /// a boundary), and the thinned points; `None` (nothing changed) when
-    /// the frame has no boundary `k` or `src` is not thinned (too short,
-    /// `eps` not positive, more than `N` points).
-    /// Under a caller's deadline `tick` is asked between parts of the
-    /// pass; `None` when it says the time is up (boundary `k` then holds
-    /// what the pass wrote: the caller makes this frame another anyway).
+    /// a boundary), and the thinned points; `None` when the frame has no
+    /// boundary `k` (nothing changed) or `src` is not thinned
+    /// ([`crate::thin`]'s reasons: too short, `eps` not positive, a row
+    /// span that overflows, a first part that does not thin; more than `N`
+    /// points). Under a caller's deadline `tick` is asked between parts of
+    /// the pass; `None` when it says the time is up. After a `None` past
+    /// the pass's start, boundary `k` may hold a partial write: the caller
+    /// makes this frame another anyway.
     #[inline(never)]
     pub(crate) fn thin_into(
         &mut self,

@@ -958,7 +958,9 @@ fn frame2_keys<'a, const N: usize>(
     } else {
         b2.len().max(1)
     };
-    // (The clock was asked just before the first part.)
+    // (The clock was asked before the thinning's last part, or before
+    // this pass where nothing was thinned: at most a part of the thinning
+    // and one of the keys between two questions.)
     for (c, b2) in b2.chunks(part).enumerate() {
         if c > 0 && expired(tick) {
             return None;

@@ -84,8 +84,9 @@
 //! [`crate::Processor::process_within`]) write it over the previous
 //! frame's boundary once step 1 has taken that boundary's points (the
 //! call makes the new frame the previous one at its end anyway). The calls
-//! against a kept frame (the fusion's) keep that frame and search frame
-//! 2's boundaries as given.
+//! against a kept frame keep that frame and search frame 2's boundaries
+//! as given; so does every call of the fusion, even its last partner's,
+//! which replaces the key frame (a chance not taken yet).
 
 use crate::camera::Pixel;
 use crate::search::{expired, Tick, CHUNK};
@@ -106,7 +107,8 @@ pub(crate) fn epsilon(e2: f32) -> f32 {
 /// subsequence of `src` with its two ends, every vertex of `src` within
 /// `eps` of the segment between the two written vertices around it
 /// (module docs). `None` (nothing useful written) when `src` has fewer
-/// than three points, `eps` is not positive or `out` is too short, and
+/// than three points, `eps` is not positive, `out` is too short or the
+/// rows' span overflows (module docs, "Rounding"), and
 /// when the first [`CHUNK`] vertices after the first two kept more than
 /// three in four (a boundary thinning does not pay for: module docs,
 /// "What it costs").

@@ -142,11 +142,10 @@ pub(crate) fn thin(
     // monotone): with `Δv` signed, `[(Δu − e_s)/Δv, (Δu + e_s)/Δv]` is the
     // interval of the module docs either way (`Δv < 0` turns it round).
     let es = if second.v > first.v { e } else { -e };
-    // A run's anchor and the slope interval its vertices allow.
-    let constraint = |a: Pixel, q: Pixel| {
-        let (du, r) = (q.u - a.u, 1.0 / (q.v - a.v));
-        ((du - es) * r, (du + es) * r)
-    };
+    // The slope interval a vertex `Δu` columns from the run's anchor
+    // allows, `r = 1/Δv`; the interval of the run's first vertex.
+    let interval = |du: f32, r: f32| ((du - es) * r, (du + es) * r);
+    let constraint = |a: Pixel, q: Pixel| interval(q.u - a.u, 1.0 / (q.v - a.v));
     let mut written = 0usize;
     // (`out` holds at least as many vertices as `src`: every put lands.)
     let put = |out: &mut [Pixel], written: &mut usize, p: Pixel| {
@@ -173,11 +172,12 @@ pub(crate) fn thin(
             let (du, r) = (q.u - anchor.u, 1.0 / (q.v - anchor.v));
             let s = du * r;
             // (A finite slope: an overflowed `1/Δv` ends the run, module
-            // docs, "Rounding"; `Δv` itself is finite, below.)
+            // docs, "Rounding"; `Δv` itself is finite, the span's test
+            // above.)
             if s >= lo && s <= hi && du.abs() <= reach && s.abs() < f32::INFINITY {
                 // `q` joins the run; its own interval narrows the run's
                 // (a `NaN` end is taken, and fails every later test).
-                let (l, h) = ((du - es) * r, (du + es) * r);
+                let (l, h) = interval(du, r);
                 lo = if l <= lo { lo } else { l };
                 hi = if h >= hi { hi } else { h };
             } else {

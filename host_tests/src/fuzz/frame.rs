@@ -1071,14 +1071,7 @@ fn matchers<const N: usize, const B: usize>(
     let fast = Box::new(r.process_against_kept(frame, m).expect("kept").clone());
     let slow = Box::new(r.reference_against_kept(frame, m).expect("kept").clone());
     if !same(&fast, &slow) {
-        for (k, (x, y)) in fast.boundaries().iter().zip(slow.boundaries()).enumerate() {
-            for (i, (p, q)) in x.points().iter().zip(y.points()).enumerate() {
-                assert!(
-                    p == q,
-                    "matcher: boundary {k} point {i}: indexed {p:?}, reference {q:?} (largest budget)"
-                );
-            }
-        }
+        point_for_point(&fast, &slow, "matcher");
         panic!("matcher: the indexed and reference structures differ");
     }
     // The same with the fold test switched off, where every point on a
@@ -1091,19 +1084,7 @@ fn matchers<const N: usize, const B: usize>(
     let slow_all = r
         .without_fold_test_against_kept(frame, m, true)
         .expect("kept");
-    for (k, (x, y)) in fast_all
-        .boundaries()
-        .iter()
-        .zip(slow_all.boundaries())
-        .enumerate()
-    {
-        for (i, (p, q)) in x.points().iter().zip(y.points()).enumerate() {
-            assert!(
-                p == q,
-                "matcher without the fold test: boundary {k} point {i}: indexed {p:?}, reference {q:?} (largest budget)"
-            );
-        }
-    }
+    point_for_point(&fast_all, slow_all, "matcher without the fold test");
     assert_eq!(
         r.previous(),
         Some(kept),
@@ -1143,21 +1124,27 @@ fn thinned_matchers<const N: usize, const B: usize>(
             run(false, false)
         };
         let slow = run(true, fold_test);
-        for (k, (x, y)) in fast_here
-            .boundaries()
-            .iter()
-            .zip(slow.boundaries())
-            .enumerate()
-        {
-            for (i, (p, q)) in x.points().iter().zip(y.points()).enumerate() {
-                assert!(
-                    p == q,
-                    "thinned matcher (fold test {fold_test}): boundary {k} point {i}: indexed {p:?}, reference {q:?} (largest budget)"
-                );
-            }
-        }
+        let what = format!("thinned matcher (fold test {fold_test})");
+        point_for_point(&fast_here, &slow, &what);
     }
     fast
+}
+
+/// Every point of the indexed structure `fast` equal to the reference's
+/// `slow` (both with the largest budget); `what` names the matchers.
+fn point_for_point<const N: usize, const B: usize>(
+    fast: &Structure<N, B>,
+    slow: &Structure<N, B>,
+    what: &str,
+) {
+    for (k, (x, y)) in fast.boundaries().iter().zip(slow.boundaries()).enumerate() {
+        for (i, (p, q)) in x.points().iter().zip(y.points()).enumerate() {
+            assert!(
+                p == q,
+                "{what}: boundary {k} point {i}: indexed {p:?}, reference {q:?} (largest budget)"
+            );
+        }
+    }
 }
 
 /// A call that gave a structure (a reconstruction).

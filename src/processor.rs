@@ -17,8 +17,7 @@
 //!    pseudo-angle keys) is the polyline indexed and queried.
 //! 3. **Thin** the corresponding frame-2 polyline where the call may
 //!    (`crate::thin`: [`Processor::process`] and
-//!    [`Processor::process_within`] without a translation error, over the
-//!    previous frame's boundary,
+//!    [`Processor::process_within`], over the previous frame's boundary,
 //!    which step 1 has read; the pair's `e₂` then holds the thinning's
 //!    `ε = e₂/256`), and **index** it (`crate::search`).
 //! 4. **Match** every remaining point: its error band ([`crate::depth`]),
@@ -250,8 +249,7 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     /// [`Step::First`] returned; `motion` is then ignored. On error nothing
     /// changes. On success the new frame becomes the previous one.
     ///
-    /// Without a translation error (configured, or brought by a rotation
-    /// error), each boundary of `frame` is **thinned** before it is searched
+    /// Each boundary of `frame` is **thinned** before it is searched
     /// ([`crate::thin`]): the vertices within `ε = e₂/256` of the chord
     /// between their neighbours dropped (on a detector's rounded straight
     /// stretches, most of them), and the search's `e₂` widened by `ε`, so
@@ -543,12 +541,11 @@ impl<const N: usize, const B: usize> Processor<N, B> {
             motion,
             rounding,
         );
-        // Thinned without a translation error (forwards, the wedge path;
-        // backwards or sideways, the band path): with one (a rotation
-        // error turns the translation too) the band's searches measured
-        // dearer on the thinned polylines (docs/PERFORMANCE.md, "Frame 2's
-        // boundary thinned backwards too").
-        if thin && pair.translation <= 0.0 {
+        // Thinned on every path: the band's searches, backwards, sideways
+        // or under motion errors, take `e₂` from the pair as the wedge's do
+        // (docs/PERFORMANCE.md, "Frame 2's boundary thinned on every
+        // path").
+        if thin {
             pair.thin = crate::thin::epsilon(config.e2);
         }
         let pair = pair;

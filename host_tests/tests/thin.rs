@@ -1,7 +1,8 @@
 //! Frame 2's boundaries thinned (`roadstereo::thin`) against the truth,
 //! on an input an adversarial review built to break it: a boundary whose
 //! rows at the image's top are subnormals apart, a spike along row 0;
-//! moving forwards (the wedge path) and backwards (the band path).
+//! moving forwards (the wedge path), backwards (the band path), and
+//! forwards under a translation error (the band path).
 
 use roadstereo::{Camera, Config, Frame, Motion, Pixel, Processor, Status, Step};
 
@@ -32,6 +33,23 @@ fn a_spike_at_subnormal_row_gaps_survives_the_thinning_backwards() {
     );
 }
 
+/// [`a_spike_at_subnormal_row_gaps_survives_the_thinning`] with a
+/// translation error of 10⁻³ configured, which sends every point to the
+/// band path (thinned since the twenty-sixth session): the motion given is
+/// the true one, so the truth is the same.
+#[test]
+fn a_spike_at_subnormal_row_gaps_survives_the_thinning_under_a_translation_error() {
+    let config = Config::DEFAULT
+        .with_translation_error(1e-3)
+        .expect("config");
+    spike_survives_with(
+        config,
+        [0.0, 0.0, 0.5],
+        [Pixel::new(260.0, 120.0), Pixel::new(262.0, 124.0)],
+        1.0,
+    );
+}
+
 /// Frame 1's first point, at depth `truth`, is seen after the motion `t`
 /// at (200, 0), on the spike the frame-2 boundary makes along row 0 (the
 /// rows of its first three vertices a subnormal apart). `process` thins
@@ -41,6 +59,11 @@ fn a_spike_at_subnormal_row_gaps_survives_the_thinning_backwards() {
 /// +∞` and dropped the spike). The same for the kept-frame call, which
 /// does not thin.
 fn spike_survives(t: [f32; 3], p1: [Pixel; 2], truth: f32) {
+    spike_survives_with(Config::DEFAULT, t, p1, truth);
+}
+
+/// [`spike_survives`] with `config`.
+fn spike_survives_with(config: Config, t: [f32; 3], p1: [Pixel; 2], truth: f32) {
     let sub = f32::from_bits;
     let cam = Camera::new(500.0, 500.0, 320.0, 240.0, 640, 480).expect("camera");
     let m = Motion::new(t, [0.0; 3]).expect("motion");
@@ -55,7 +78,7 @@ fn spike_survives(t: [f32; 3], p1: [Pixel; 2], truth: f32) {
     let mut f2 = Frame::<8, 1>::new(cam);
     f2.push_boundary(&p2).expect("frame 2");
     for kept in [false, true] {
-        let mut p = Box::new(Processor::<8, 1>::new(Config::DEFAULT));
+        let mut p = Box::new(Processor::<8, 1>::new(config));
         assert!(matches!(p.process(&f1, None), Ok(Step::First)));
         let s = if kept {
             p.process_against_kept(&f2, &m).expect("kept").clone()

@@ -209,9 +209,9 @@ struct Filling {
 /// review's key frames of 90 points a boundary reached 98 in its harness,
 /// those of 16–32 points 126–177, `docs/FUSION.md`); `partners_2`,
 /// `default` with a key frame every 2 frames (its points enter the map
-/// every other step: the review's policies of one or two partners reached
-/// 75–113).
-const FILLING: [Filling; 10] = [
+/// every other step), and `partners_1`, every frame (every step retires;
+/// the review's policies of one or two partners reached 75–113).
+const FILLING: [Filling; 11] = [
     Filling::sideways("default", FusionConfig::DEFAULT, 0.0),
     Filling::sideways(
         "sight_check",
@@ -259,12 +259,24 @@ const FILLING: [Filling; 10] = [
         ..Filling::sideways("small_32", FusionConfig::DEFAULT, 0.0)
     },
     Filling::sideways("partners_2", PARTNERS_2, 0.0),
+    Filling::sideways("partners_1", PARTNERS_1, 0.0),
 ];
 
 /// [`FILLING`]'s `partners_2` policy: a key frame every 2 frames, the
 /// default otherwise.
 const PARTNERS_2: FusionConfig = match FusionConfig::new(2, 500) {
     Ok(c) => c,
+    Err(_) => FusionConfig::DEFAULT,
+};
+
+/// [`FILLING`]'s `partners_1` policy: a key frame every frame, its
+/// points into the map with one pair ([`FusionConfig::new`]: with one
+/// partner the map's minimum must be 1), the default otherwise.
+const PARTNERS_1: FusionConfig = match FusionConfig::new(1, 500) {
+    Ok(c) => match c.with_map_min_pairs(1) {
+        Ok(c) => c,
+        Err(_) => FusionConfig::DEFAULT,
+    },
     Err(_) => FusionConfig::DEFAULT,
 };
 

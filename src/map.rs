@@ -570,8 +570,9 @@ fn next_entry(
 /// `limit` ([`far_limit`]): a far end the codes cannot hold, or a decoded
 /// one whose distance bound (times the batch's ray bound) is past
 /// [`MAX_REACH`] ([`Retired::unbounded`]). The batch's extent takes the
-/// entries' `y` and codes in a pass of their own after them
-/// ([`RoadMap::enter`], [`Extent::take_y`], [`Extent::take_codes`]).
+/// entries' `y` range from the first and last of them and their codes in
+/// a pass of their own after them ([`RoadMap::enter`], [`Extent::take_y`],
+/// [`Extent::take_codes`]).
 #[inline(always)]
 fn entry_of(
     [x, y]: [f32; 2],
@@ -1345,7 +1346,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             break;
         }
         *at_out = at;
-        // The entries' extent, in a pass of their own: in the loops above
+        // The entries' extent, in a pass of their own: in the loop above
         // it cost the loop's registers, about 3 instructions an entry
         // more. (They are `start .. start + n`, in order.) Their `y` is
         // monotone along them: a boundary's rows are strictly monotone
@@ -1358,13 +1359,21 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         let ends = (ring.get(start % M), ring.get((start + n.max(1) - 1) % M));
         if let (true, Some(a), Some(b)) = (n > 0, ends.0, ends.1) {
             ext.take_y(a.y, b.y);
+            // (The tests check that this call's own range, from its first
+            // and last entry, holds every one of its entries' `y`, and so
+            // does the extent.)
+            #[cfg(test)]
+            for j in start..start + n {
+                if let Some(e) = ring.get(j % M) {
+                    let (lo, hi) = (fmin(a.y, b.y), fmax(a.y, b.y));
+                    assert!(lo <= e.y && e.y <= hi, "{lo} {hi} {}", e.y);
+                    assert!(ext.y.0 <= e.y && e.y <= ext.y.1, "{:?} {}", ext.y, e.y);
+                }
+            }
         }
         for j in start..start + n {
             if let Some(e) = ring.get(j % M) {
                 ext.take_codes(e);
-                // (The tests check the range holds every entry's `y`.)
-                #[cfg(test)]
-                assert!(ext.y.0 <= e.y && e.y <= ext.y.1, "{:?} {}", ext.y, e.y);
             }
         }
         *extent = ext;

@@ -1356,16 +1356,16 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         // twenty-seventh session `y` was too, about 11 instructions an
         // entry more.)
         let mut ext = *extent;
-        let ends = (ring.get(start % M), ring.get((start + n.max(1) - 1) % M));
-        if let (true, Some(a), Some(b)) = (n > 0, ends.0, ends.1) {
+        let last = (start + n).checked_sub(1).filter(|_| n > 0);
+        if let (Some(a), Some(b)) = (ring.get(start % M), last.and_then(|l| ring.get(l % M))) {
             ext.take_y(a.y, b.y);
             // (The tests check that this call's own range, from its first
             // and last entry, holds every one of its entries' `y`, and so
             // does the extent.)
             #[cfg(test)]
-            for j in start..start + n {
-                if let Some(e) = ring.get(j % M) {
-                    let (lo, hi) = (fmin(a.y, b.y), fmax(a.y, b.y));
+            {
+                let (lo, hi) = (fmin(a.y, b.y), fmax(a.y, b.y));
+                for e in (start..start + n).filter_map(|j| ring.get(j % M)) {
                     assert!(lo <= e.y && e.y <= hi, "{lo} {hi} {}", e.y);
                     assert!(ext.y.0 <= e.y && e.y <= ext.y.1, "{:?} {}", ext.y, e.y);
                 }

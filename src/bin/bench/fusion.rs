@@ -263,21 +263,23 @@ const FILLING: [Filling; 11] = [
 ];
 
 /// [`FILLING`]'s `partners_2` policy: a key frame every 2 frames, the
-/// default otherwise.
+/// default otherwise (a constant: an invalid one fails to compile).
 const PARTNERS_2: FusionConfig = match FusionConfig::new(2, 500) {
     Ok(c) => c,
-    Err(_) => FusionConfig::DEFAULT,
+    Err(_) => panic!("2 partners are a valid policy"),
 };
 
 /// [`FILLING`]'s `partners_1` policy: a key frame every frame, its
 /// points into the map with one pair ([`FusionConfig::new`]: with one
-/// partner the map's minimum must be 1), the default otherwise.
+/// partner the map's minimum must be 1), the default otherwise. (A
+/// constant: an invalid policy fails to compile, as
+/// [`FusionConfig::DEFAULT`] would.)
 const PARTNERS_1: FusionConfig = match FusionConfig::new(1, 500) {
     Ok(c) => match c.with_map_min_pairs(1) {
         Ok(c) => c,
-        Err(_) => FusionConfig::DEFAULT,
+        Err(_) => panic!("a map minimum of 1 pair is valid"),
     },
-    Err(_) => FusionConfig::DEFAULT,
+    Err(_) => panic!("1 partner is a valid policy"),
 };
 
 impl Filling {

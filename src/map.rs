@@ -1399,6 +1399,22 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         for e in ring.get(..n - head).unwrap_or(&[]) {
             ext.take_codes(e);
         }
+        // (The tests check that the codes of every entry of this call, by
+        // index modulo `M`, are within the extent's, and count the calls
+        // whose entries run past the ring's end.)
+        #[cfg(test)]
+        {
+            for e in (start..start + n).filter_map(|j| ring.get(j % M)) {
+                assert!(
+                    ext.codes.0 <= e.near && e.far <= ext.codes.1,
+                    "{:?} {e:?}",
+                    ext.codes
+                );
+            }
+            if head < n {
+                tests::WRAPPED.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
+            }
+        }
         *extent = ext;
         (n, unbounded)
     }
@@ -1439,6 +1455,11 @@ mod tests {
     use crate::test_rng::Rng;
 
     const M: usize = 64;
+
+    /// [`RoadMap::enter`]'s calls whose entries ran past the ring's end
+    /// (their codes taken over its two runs), in every test.
+    pub(super) static WRAPPED: core::sync::atomic::AtomicU32 =
+        core::sync::atomic::AtomicU32::new(0);
 
     /// A batch of random sticks (pixels anywhere in a wide camera's image
     /// and its margin, rays to about ±0.86, depths 0.01–1000 with near and
@@ -1535,7 +1556,10 @@ mod tests {
     /// straight road, rows pushed downwards and upwards (the far points,
     /// whose sticks one pair leaves unbounded, first or last), key frames
     /// of 6 to 200 points a boundary, one partner (every step retires, its
-    /// entries over two steps) or three.
+    /// entries over two steps) or three. The test build also checks each
+    /// call's entries' codes against the extent's, taken over the ring's
+    /// two runs, and the calls whose entries run past the ring's end are
+    /// counted: some must.
     #[test]
     fn entries_take_their_y_range_from_their_ends() {
         use crate::boundary::Frame;
@@ -1589,6 +1613,10 @@ mod tests {
             }
         }
         assert!(entered > 2_000, "{entered}");
+        // (Calls whose entries ran past the ring's end, the extent's codes
+        // taken over its two runs: counted by every test, so at least
+        // this one's.)
+        assert!(WRAPPED.load(core::sync::atomic::Ordering::Relaxed) > 0);
     }
 
     /// [`MapDrops`] wraps: a batch carried by a step forwards past its

@@ -1318,7 +1318,8 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         // `*at_out` on, as two iterators side by side; `*at_out` is left
         // after the last one looked at. (Until the twenty-eighth session an
         // index into both slices: its bounds checks and the registers they
-        // took measured about 4 instructions an entry more.)
+        // took measured about 3 instructions an entry more on the bench's
+        // `partners_1` drive.)
         let from = *at_out;
         let mut cells = key.cells(k).get(from..).unwrap_or(&[]).iter();
         let mut points = results.points().get(from..).unwrap_or(&[]).iter();
@@ -1337,7 +1338,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         // then, 96 with this loop. A bound lowered inside one loop had
         // measured 3 instructions an entry dearer on the bench's drives.)
         // (`pos`, the ring position of the next entry, `start + n`: the
-        // loop's registers hold one count, not two, about 3 instructions
+        // loop's registers hold one count, not two, about 4 instructions
         // an entry fewer since the twenty-eighth session.)
         let mut pos = start;
         'entries: loop {
@@ -1387,9 +1388,9 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
                 }
             }
         }
-        // (Over the ring's two runs, the slots after `start` up to the
+        // (Over the ring's two runs, the slots from `start % M` up to the
         // ring's end and those from its start, not by index modulo `M`:
-        // about 3 instructions an entry fewer since the twenty-eighth
+        // about 2 instructions an entry fewer since the twenty-eighth
         // session.)
         let first = start % M;
         let head = n.min(M - first);

@@ -339,6 +339,24 @@ impl Extent {
         self.codes = (self.codes.0.min(e.near), self.codes.1.max(e.far));
     }
 
+    /// Take the codes of the `n ≤ M` entries of `ring` from slot `start`
+    /// on (modulo `M`) in. Over the ring's two runs, the slots from `start % M` up to its
+    /// end and those from its start, not by index modulo `M`: about 2
+    /// instructions an entry fewer since the twenty-eighth session
+    /// (`tests::codes_over_the_rings_two_runs` holds it to the modulo
+    /// form).
+    #[inline(always)]
+    fn take_codes_of<const M: usize>(&mut self, ring: &[Entry; M], start: usize, n: usize) {
+        let first = start % M;
+        let head = n.min(M - first);
+        for e in ring.get(first..first + head).unwrap_or(&[]) {
+            self.take_codes(e);
+        }
+        for e in ring.get(..n - head).unwrap_or(&[]) {
+            self.take_codes(e);
+        }
+    }
+
     /// Take one entry in, whatever its order (the tests' batches).
     #[cfg(test)]
     fn take(&mut self, e: &Entry) {
@@ -547,8 +565,9 @@ fn far_limit(max_far: f32, scale: &DepthScale) -> u16 {
 
 /// [`RoadMap::enter`]'s next admitted point of a key-frame boundary
 /// (its `cells` and reconstruction `points`, as iterators side by side,
-/// both left after it): `Some` of its entry ([`entry_of`]; `None` inside:
-/// left out), or `None` when no admitted point is left.
+/// both left after it; a key frame has a cell for each of its points, so
+/// neither runs out first): `Some` of its entry ([`entry_of`]; `None`
+/// inside: left out), or `None` when no admitted point is left.
 #[inline(always)]
 fn next_entry<'a>(
     (cells, points): (
@@ -1290,7 +1309,8 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
     /// [`Self::retire`]'s entries on boundary `k`: the next `w` admitted
     /// points of the key frame from cell `*at` on (left after the last one
     /// looked at), no more than `look` looked at (entered or left out),
-    /// written into the ring after its used slots, their rays' forward
+    /// written into the ring after its used slots (`w ≤ M` and as many
+    /// slots free: [`Self::make_room`]; the test build checks `w ≤ M`), their rays' forward
     /// rates and their depths taken into `extent`. Returns how many
     /// entered, and how many were left out for a far end the codes cannot
     /// hold or past `limit` (a distance bound past [`MAX_REACH`],
@@ -1321,6 +1341,10 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         // took measured about 3 instructions an entry more on the bench's
         // `partners_1` drive.)
         let from = *at_out;
+        // (The callers' `w ≤ M`, and a cell for each point: the test build
+        // checks both.)
+        #[cfg(test)]
+        assert!(w <= M && key.cells(k).len() == results.points().len());
         let mut cells = key.cells(k).get(from..).unwrap_or(&[]).iter();
         let mut points = results.points().get(from..).unwrap_or(&[]).iter();
         let total = cells.len();
@@ -1329,7 +1353,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         // looked at, `n + unbounded`. (A review found the share passed by
         // as many points as were left out before the entries, when the
         // loop went on past them.) Between two points left out the bound
-        // is fixed, so the inner loop tests `n` alone; a point left out
+        // is fixed, so the inner loop tests `pos` alone; a point left out
         // lowers it. (Until the twenty-seventh session the loop after the
         // first point left out tested the three bounds at every entry,
         // about 4 instructions an entry dearer: on a drive whose far
@@ -1358,7 +1382,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
             }
             break;
         }
-        // (Neither overflows: `pos` only grew from `start`, the iterator
+        // (None of the three overflows: `pos` only grew from `start`, the iterator
         // only shrank from `total`, and `from` plus what it gave is at
         // most the boundary's length, or `from` itself past it.)
         let n = pos - start;
@@ -1373,6 +1397,8 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         // twenty-seventh session `y` was too, about 11 instructions an
         // entry more.)
         let mut ext = *extent;
+        #[cfg(test)]
+        let codes_before = ext.codes;
         let last = (start + n).checked_sub(1).filter(|_| n > 0);
         if let (Some(a), Some(b)) = (ring.get(start % M), last.and_then(|l| ring.get(l % M))) {
             ext.take_y(a.y, b.y);
@@ -1388,32 +1414,22 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
                 }
             }
         }
-        // (Over the ring's two runs, the slots from `start % M` up to the
-        // ring's end and those from its start, not by index modulo `M`:
-        // about 2 instructions an entry fewer since the twenty-eighth
-        // session.)
-        let first = start % M;
-        let head = n.min(M - first);
-        for e in ring.get(first..first + head).unwrap_or(&[]) {
-            ext.take_codes(e);
-        }
-        for e in ring.get(..n - head).unwrap_or(&[]) {
-            ext.take_codes(e);
-        }
-        // (The tests check that the codes of every entry of this call, by
-        // index modulo `M`, are within the extent's, and count the calls
-        // whose entries run past the ring's end.)
+        ext.take_codes_of(ring, start, n);
+        // (The tests check the codes taken against those of this call's
+        // entries by index modulo `M`, exactly, and count the calls whose
+        // entries run past the ring's end, in the test's own thread.)
         #[cfg(test)]
         {
+            let mut oracle = Extent {
+                codes: codes_before,
+                ..Extent::EMPTY
+            };
             for e in (start..start + n).filter_map(|j| ring.get(j % M)) {
-                assert!(
-                    ext.codes.0 <= e.near && e.far <= ext.codes.1,
-                    "{:?} {e:?}",
-                    ext.codes
-                );
+                oracle.take_codes(e);
             }
-            if head < n {
-                tests::WRAPPED.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
+            assert_eq!(ext.codes, oracle.codes);
+            if start % M + n > M {
+                tests::WRAPPED.with(|c| c.set(c.get() + 1));
             }
         }
         *extent = ext;
@@ -1457,10 +1473,59 @@ mod tests {
 
     const M: usize = 64;
 
-    /// [`RoadMap::enter`]'s calls whose entries ran past the ring's end
-    /// (their codes taken over its two runs), in every test.
-    pub(super) static WRAPPED: core::sync::atomic::AtomicU32 =
-        core::sync::atomic::AtomicU32::new(0);
+    std::thread_local! {
+        /// [`RoadMap::enter`]'s calls whose entries ran past the ring's
+        /// end (their codes taken over its two runs), in this thread: a
+        /// test's own (each test runs in a thread of its own).
+        pub(super) static WRAPPED: core::cell::Cell<u32> = const { core::cell::Cell::new(0) };
+    }
+
+    /// [`Extent::take_codes_of`] over the ring's two runs against the
+    /// codes of the same entries by index modulo `M`, exactly: rings of 1,
+    /// 2, 7 and 8 slots with random codes, every start from 0 to `2M` and
+    /// every count from 0 to `M`, from an empty extent and from one
+    /// holding codes already.
+    #[test]
+    fn codes_over_the_rings_two_runs() {
+        fn check<const R: usize>(g: &mut Rng) {
+            for _ in 0..64 {
+                let ring: [Entry; R] = core::array::from_fn(|_| {
+                    let near = (g.next() * 40_000.0) as u16;
+                    let far = near.saturating_add((g.next() * 20_000.0) as u16).max(1);
+                    Entry {
+                        x: 0.0,
+                        y: 0.0,
+                        near,
+                        far,
+                    }
+                });
+                for start in 0..=2 * R {
+                    for n in 0..=R {
+                        for before in [Extent::EMPTY.codes, (30_000, 10_000)] {
+                            let mut got = Extent {
+                                codes: before,
+                                ..Extent::EMPTY
+                            };
+                            got.take_codes_of(&ring, start, n);
+                            let mut want = Extent {
+                                codes: before,
+                                ..Extent::EMPTY
+                            };
+                            for j in start..start + n {
+                                want.take_codes(&ring[j % R]);
+                            }
+                            assert_eq!(got.codes, want.codes, "{start} {n}");
+                        }
+                    }
+                }
+            }
+        }
+        let mut g = Rng(0x2B_0C0D);
+        check::<1>(&mut g);
+        check::<2>(&mut g);
+        check::<7>(&mut g);
+        check::<8>(&mut g);
+    }
 
     /// A batch of random sticks (pixels anywhere in a wide camera's image
     /// and its margin, rays to about ±0.86, depths 0.01–1000 with near and
@@ -1557,10 +1622,10 @@ mod tests {
     /// straight road, rows pushed downwards and upwards (the far points,
     /// whose sticks one pair leaves unbounded, first or last), key frames
     /// of 6 to 200 points a boundary, one partner (every step retires, its
-    /// entries over two steps) or three. The test build also checks each
-    /// call's entries' codes against the extent's, taken over the ring's
-    /// two runs, and the calls whose entries run past the ring's end are
-    /// counted: some must.
+    /// entries over two steps) or three. The test build also checks the
+    /// codes each call takes, over the ring's two runs, against those of
+    /// its entries by index modulo `M`, exactly, and counts the calls
+    /// whose entries run past the ring's end: some of this test's must.
     #[test]
     fn entries_take_their_y_range_from_their_ends() {
         use crate::boundary::Frame;
@@ -1614,10 +1679,9 @@ mod tests {
             }
         }
         assert!(entered > 2_000, "{entered}");
-        // (Calls whose entries ran past the ring's end, the extent's codes
-        // taken over its two runs: counted by every test, so at least
-        // this one's.)
-        assert!(WRAPPED.load(core::sync::atomic::Ordering::Relaxed) > 0);
+        // (Calls of this test whose entries ran past the ring's end, the
+        // extent's codes taken over its two runs.)
+        assert!(WRAPPED.with(|c| c.get()) > 0);
     }
 
     /// [`MapDrops`] wraps: a batch carried by a step forwards past its

@@ -99,15 +99,17 @@ pub fn fusion_bench() -> bool {
 /// The frames of [`filling`]: the camera of the fusion examples (800 px,
 /// 512 × 480, level) at `x` across a straight road whose two edges lie on
 /// the ground 1.2 below it at `X = edges`, turned by `yaw` about its
-/// vertical axis, seen on `n` image rows evenly from 250 to 478 (up to
-/// 256 points a boundary, depths 4.3 to 80; a straight road along `Z`:
-/// the forward position does not change the image).
+/// vertical axis, seen on `n` image rows evenly from `v0` to `v1` (up to
+/// 256 points a boundary; from 250 to 478, depths 4.3 to 80; a straight
+/// road along `Z`: the forward position does not change the image),
+/// pushed from the far row on, or from the near one where `near_first`.
 fn filling_frame(
     frame: &mut Frame<256, 2>,
     (edges, n): ([f32; 2], u16),
     x: f32,
     yaw: f32,
     (offset, shifted): (f32, u16),
+    (v0, v1, near_first): (f32, f32, bool),
 ) {
     frame.clear();
     let cam = *frame.camera();
@@ -116,8 +118,9 @@ fn filling_frame(
     for edge in edges {
         let mut pts = [Pixel::new(0.0, 0.0); 256];
         let mut m = 0;
-        for i in 0..n {
-            let v = 250.0 + 228.0 * f32::from(i) / f32::from(n - 1);
+        for j in 0..n {
+            let i = if near_first { n - 1 - j } else { j };
+            let v = v0 + (v1 - v0) * f32::from(i) / f32::from(n - 1);
             let z = cam.fy() * 1.2 / (v - cam.cy());
             let edge = if i < shifted { edge + offset } else { edge };
             // (World `X − x = c x_c + s z`: the camera's `x_c` at depth `z`.)
@@ -169,8 +172,15 @@ struct Filling {
     shifted: u16,
     /// The first frame the road moves in (0: from the start).
     moves_from: u32,
-    /// Points a boundary (256 but for the small key frames' drives).
-    points: u16,
+    /// Points a boundary (256 but for the small key frames' drives), and
+    /// in the frames of every second 8 (`(i / 8) % 2 == 1`; 0: the same).
+    points: (u16, u16),
+    /// The rows' window and order ([`filling_frame`]); before frame
+    /// `split.1`, but in the frames `i % 8 == 7`, the window alternates
+    /// between rows 300 to `389 + split.0` (even frames) and `389 −
+    /// split.0` to 478 (odd ones), so consecutive frames share few rows.
+    rows: (f32, f32, bool),
+    split: (f32, u32),
 }
 
 /// The drives whose road map fills, each an adversarial review's (issue
@@ -214,7 +224,7 @@ struct Filling {
 /// miss; the other three meet the budget and are enforced (`partners_2`
 /// since the twenty-seventh session, `small_90` and `partners_1` since
 /// the twenty-eighth's cheaper entries).
-const FILLING: [Filling; 11] = [
+const FILLING: [Filling; 14] = [
     Filling::sideways("default", FusionConfig::DEFAULT, 0.0),
     Filling::sideways(
         "sight_check",
@@ -232,7 +242,9 @@ const FILLING: [Filling; 11] = [
         offsets: [0.0; 8],
         shifted: 0,
         moves_from: 0,
-        points: 256,
+        points: (256, 0),
+        rows: (250.0, 478.0, false),
+        split: (0.0, 0),
     },
     Filling {
         offsets: [-0.1, 0.1, -0.1, 0.1, -0.1, 0.1, -0.1, 0.1],
@@ -254,15 +266,29 @@ const FILLING: [Filling; 11] = [
         ..Filling::sideways("wobbling_forward", FusionConfig::DEFAULT, 0.0)
     },
     Filling {
-        points: 90,
+        points: (90, 0),
         ..Filling::sideways("small_90", FusionConfig::DEFAULT, 0.0)
     },
     Filling {
-        points: 32,
+        points: (32, 0),
         ..Filling::sideways("small_32", FusionConfig::DEFAULT, 0.0)
     },
     Filling::sideways("partners_2", PARTNERS_2, 0.0),
     Filling::sideways("partners_1", PARTNERS_1, 0.0),
+    Filling {
+        points: (256, 90),
+        rows: (300.0, 478.0, false),
+        ..Filling::sideways("shrinking", FusionConfig::DEFAULT, 0.0)
+    },
+    Filling {
+        rows: (300.0, 478.0, false),
+        ..Filling::sideways("partners_1_near", PARTNERS_1, 0.0)
+    },
+    Filling {
+        rows: (300.0, 478.0, true),
+        split: (5.0, 17),
+        ..Filling::sideways("partners_1_split", PARTNERS_1, 0.0)
+    },
 ];
 
 /// [`FILLING`]'s `partners_2` policy: a key frame every 2 frames, the
@@ -299,7 +325,9 @@ impl Filling {
             offsets: [0.0; 8],
             shifted: 0,
             moves_from: 0,
-            points: 256,
+            points: (256, 0),
+            rows: (250.0, 478.0, false),
+            split: (0.0, 0),
         }
     }
 }
@@ -339,12 +367,27 @@ fn filling(fusion: &mut Fusion<256, 2, 512>, drive: &Filling) -> bool {
         } else {
             drive.offsets.get(i as usize % 8).copied().unwrap_or(0.0)
         };
+        let per_boundary = match drive.points {
+            (_, other) if other > 0 && (i / 8) % 2 == 1 => other,
+            (n, _) => n,
+        };
+        let rows = match (drive.rows, drive.split) {
+            ((_, _, near_first), (d, until)) if i < until && i % 8 != 7 => {
+                if i % 2 == 0 {
+                    (300.0, 389.0 + d, near_first)
+                } else {
+                    (389.0 - d, 478.0, near_first)
+                }
+            }
+            (rows, _) => rows,
+        };
         filling_frame(
             &mut frame,
-            (drive.edges, drive.points),
+            (drive.edges, per_boundary),
             x,
             psi,
             (offset, drive.shifted),
+            rows,
         );
         let Some(Measured {
             step,

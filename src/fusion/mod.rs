@@ -87,7 +87,9 @@
 //! frame retires into a full map: `docs/FUSION.md`). Where the next key
 //! frame is much smaller, that step's work is the same, so its work a
 //! point of its own key frame is larger (a review's key frame of 4 points
-//! after one of 504: 34 670 instructions). (A share of the admitted points
+//! after one of 504: 34 670 instructions; the bench's `shrinking` drive,
+//! key frames of 256 and 90 points a boundary by turns, 145 instructions
+//! a key-frame point in the 90-point key frame's first step, issue 13). (A share of the admitted points
 //! split the demo drive's retirements too, and moved work into the step
 //! after one, the demo's dearest matching, past the deadline; a share of
 //! the capacity `B·N` left small key frames whole, a review's 90 points a

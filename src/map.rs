@@ -340,11 +340,12 @@ impl Extent {
     }
 
     /// Take the codes of the `n ≤ M` entries of `ring` from slot `start`
-    /// on (modulo `M`) in. Over the ring's two runs, the slots from `start % M` up to its
-    /// end and those from its start, not by index modulo `M`: about 2
-    /// instructions an entry fewer since the twenty-eighth session
-    /// (`tests::codes_over_the_rings_two_runs` holds it to the modulo
-    /// form).
+    /// on (modulo `M`, which is above 0: the map's is checked at compile
+    /// time) in. Over the ring's two runs, the slots from `start % M` up
+    /// to its end and those from its start, not by index modulo `M`:
+    /// about 2 instructions an entry fewer since the twenty-eighth
+    /// session (`tests::codes_over_the_rings_two_runs` holds it to the
+    /// modulo form).
     #[inline(always)]
     fn take_codes_of<const M: usize>(&mut self, ring: &[Entry; M], start: usize, n: usize) {
         let first = start % M;

@@ -8,7 +8,7 @@
 //!   then stayed `Consistent` with two exact pairs;
 //! * with `e₁ = 0` (valid) and exact motions, every map point's radius was
 //!   0 and the `f32` rounding of the poses put the true point up to
-//!   `1.8·10⁻⁶` off the stick (`src/map.rs`, "The radius").
+//!   `1.8·10⁻⁶` off the stick (`src/map/mod.rs`, "The radius").
 //!
 //! And by a second review: the pairs' sticks did not carry the rounding
 //! of the motion composed from the key frame, whose translation is off by

@@ -169,6 +169,17 @@ fn next_entry<'a>(
 /// entries' `y` range from the first and last of them and their codes in
 /// a pass of their own after them ([`RoadMap::enter`], [`Extent::take_y`],
 /// [`Extent::take_codes`]).
+///
+/// The near code is [`DepthScale::down_for_entry`]'s, which has no clamp
+/// at the top: the same entry as with [`DepthScale::down`]'s for every
+/// cell whose ends are in order, `z_near ≤ z_far`, as every admitted
+/// cell's are (a pair's stick, a range's validated interval, their
+/// intersections when not empty, a widened interval's `[H, max(far, U)]`
+/// with `H` the lowest near end: [`crate::fusion`]'s cells). Where the two
+/// codes differ, `z_near/s` is at or above `2 − 2⁻¹²`; then so is `z_far`,
+/// whose far code is at least `UNBOUNDED` (codes are monotone in depth),
+/// past every limit: no entry either way (`tests::entries_against_the_clamped_codes`).
+/// Out of order, either code gives an entry of no meaning.
 #[inline(always)]
 pub(super) fn entry_of(
     [x, y]: [f32; 2],
@@ -179,8 +190,8 @@ pub(super) fn entry_of(
     // (Below `2⁻¹⁵ s` a near end is code 0, depth 0, and a far end code 1,
     // about `2⁻¹⁵ s`: the decoded ends hold the fused ones whatever they
     // are.)
-    // (The ends are never NaN: a cell's, `DepthScale::down_no_nan`.)
-    let (near, far) = (scale.down_no_nan(z_near), scale.up_no_nan(z_far));
+    // (The ends are never NaN: a cell's, `DepthScale::down_for_entry`.)
+    let (near, far) = (scale.down_for_entry(z_near), scale.up_no_nan(z_far));
     // `|P_K|`'s bound on the true ray, the decoded far end times the
     // batch's ray bound: past `10³⁰` (a far ray of a wide-angle camera, or
     // such a scale) the map's `f32` arithmetic could overflow, so such a

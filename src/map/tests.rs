@@ -608,3 +608,53 @@ fn whole_batch_bound_at_its_edges_over_any_camera() {
     std::println!("ahead {n_ahead} behind {n_behind} bad_ahead {bad_ahead} bad_behind {bad_behind} worst {worst:e}");
     assert_eq!((bad_ahead, bad_behind), (0, 0));
 }
+
+/// [`entry_of`] against the entry the clamped codes give (the near end's
+/// [`DepthScale::down`], clamped at `UNBOUNDED − 1`, and the far end's
+/// unclamped code at least 1, then the limit's test: the form before the
+/// twenty-ninth session), exactly, for ends in order, `z_near ≤ z_far`,
+/// as an admitted cell's are: ends drawn around every scale's top codes
+/// (`z/s` from `2 − 2⁻¹⁰` to `2`, where the near code's clamp binds), at
+/// its bottom, at zero of either sign, across the range, and infinite
+/// far ends; limits 0, 1, random and `UNBOUNDED − 1`.
+#[test]
+fn entries_against_the_clamped_codes() {
+    use crate::fusion::code::UNBOUNDED;
+    let mut g = Rng(0xE7_C0DE);
+    let (mut made, mut top_near) = (0u32, 0u32);
+    for case in 0..200_000u32 {
+        let scale = DepthScale::for_max_depth(logu(&mut g, 1e-20, 1e20));
+        let s = scale.scale();
+        let end = |g: &mut Rng| match (g.next() * 8.0) as u32 {
+            0 => s * (2.0 - g.next() * (1.0 / 1024.0)),
+            1 => s * logu(g, 1e-6, 1e-4),
+            2 => [0.0, -0.0, s * 2.0, f32::MIN_POSITIVE][(g.next() * 4.0) as usize % 4],
+            3 => s * (1.0 + g.next()),
+            _ => s * logu(g, 1e-5, 4.0),
+        };
+        let (a, b) = (end(&mut g), end(&mut g));
+        let (z_near, mut z_far) = if a <= b { (a, b) } else { (b, a) };
+        if case % 97 == 0 {
+            z_far = f32::INFINITY;
+        }
+        let limit = match case % 5 {
+            0 => 0,
+            1 => 1,
+            2 => UNBOUNDED - 1,
+            _ => (g.next() * 65_535.0) as u16,
+        };
+        let far = scale.up_unclamped(z_far).max(1);
+        let want = (far <= i32::from(limit)).then(|| Entry {
+            x: 0.5,
+            y: -0.25,
+            near: scale.down(z_near),
+            far: far as u16,
+        });
+        let got = entry_of([0.5, -0.25], (z_near, z_far), limit, &scale);
+        assert_eq!(got, want, "{z_near:e} {z_far:e} {limit} {s:e}");
+        made += u32::from(got.is_some());
+        top_near += u32::from(scale.down(z_near) == UNBOUNDED - 1);
+    }
+    // (Both cases met often: entries made, and near ends at the top.)
+    assert!(made > 40_000 && top_near > 2_000, "{made} {top_near}");
+}

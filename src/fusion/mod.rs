@@ -64,7 +64,8 @@
 //! # The retirement over two steps
 //! A retiring key frame's admitted points are copied into the map (their
 //! rays, their coded ends, the batch's bounds): the costliest part of the
-//! fusion, about 100 instructions a point, and all of it in one frame. So
+//! fusion, about 100 instructions a point when this was written (about 65
+//! since the twenty-ninth session), and all of it in one frame. So
 //! the retiring step looks at no more of them than 35.5 % of the key
 //! frame's points, rounded up (entered, or left out as
 //! [`crate::map::Retired::unbounded`]; boundary by boundary, in order; the
@@ -88,8 +89,11 @@
 //! frame is much smaller, that step's work is the same, so its work a
 //! point of its own key frame is larger (a review's key frame of 4 points
 //! after one of 504: 34 670 instructions; the bench's `shrinking` drive,
-//! key frames of 256 and 90 points a boundary by turns, 145 instructions
-//! a key-frame point in the 90-point key frame's first step, issue 13). (A share of the admitted points
+//! key frames of 256 and 90 points a boundary by turns, 136 instructions
+//! a key-frame point in the 90-point key frame's first step, issue 13; a
+//! share from both key frames' sizes would move the entries into the
+//! retiring step, whose matching is the larger key frame's: the dearer
+//! frame for the deadline, `docs/FUSION.md`). (A share of the admitted points
 //! split the demo drive's retirements too, and moved work into the step
 //! after one, the demo's dearest matching, past the deadline; a share of
 //! the capacity `B·N` left small key frames whole, a review's 90 points a

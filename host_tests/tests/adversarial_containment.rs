@@ -349,3 +349,45 @@ fn the_focus_of_expansion_rounds_about_once_moving_backwards() {
     // the two-point boundary's ends.)
     assert_eq!(statuses.len(), 3);
 }
+
+/// A fourth finding (an adversarial review, twenty-ninth session): step 1
+/// accepted a point whose `q_z` is known to exactly half its value, `Δ/q_z
+/// = ½`, and the stick's widening `κ = 2Δ/q_z + 2.4·10⁻⁷` then passed 1.
+/// The near end is multiplied by `1 − κ`: at `κ ≥ 1` the near end of
+/// every stick is at most 0, the depth unbounded below (`Unbounded`), but
+/// where the unwidened near end lay behind the camera (`s_near < 0`) the
+/// product came out positive and the point `ok`, its near end (about
+/// `5·10⁻¹⁰` here) no bound at all. The set-up: pure translation, so
+/// `q_z = 1` at every pixel, and the rotation error chosen so that `Δ`
+/// is exactly ½ (`0x382c62ae`; three ulps lower, `Δ < ½`, gave every
+/// point `Unbounded` before the fix too).
+#[test]
+fn no_ok_stick_where_q_z_is_known_to_half_its_value() {
+    let cam = Camera::new(1.0, 1.0, 8191.5, 8191.5, 16384, 16384).unwrap();
+    let c = 8191.5f32;
+    let mut f1 = Frame::<64, 1>::new(cam);
+    let p1: Vec<Pixel> = (0..40)
+        .map(|i| Pixel::new(c + 30.0 + 0.001 * i as f32, c + 15.0 - 0.75 * i as f32))
+        .collect();
+    f1.push_boundary(&p1).unwrap();
+    let mut f2 = Frame::<64, 1>::new(cam);
+    let p2: Vec<Pixel> = (0..60)
+        .map(|i| Pixel::new(c + 0.1 + 0.0001 * i as f32, c + 500.0 - 16.5 * i as f32))
+        .collect();
+    f2.push_boundary(&p2).unwrap();
+    let motion = Motion::new([0.0, 0.0, -0.5], [0.0; 3]).unwrap();
+    for bits in [0x382c_62ae_u32, 0x382c_62ad, 0x382c_62ab] {
+        let config = Config::new(0.0, 0.0, 10.0, 1000.0)
+            .unwrap()
+            .with_rotation_error([f32::from_bits(bits), 0.0, 0.0])
+            .unwrap();
+        let mut p = Processor::<64, 1>::new(config);
+        p.process(&f1, None).unwrap();
+        let Step::Structure(s) = p.process(&f2, Some(&motion)).unwrap() else {
+            panic!("no structure");
+        };
+        for r in s.boundaries()[0].points() {
+            assert_ne!(r.status(), Status::Ok, "{bits:#x}: {r:?}");
+        }
+    }
+}

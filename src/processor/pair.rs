@@ -105,7 +105,21 @@ impl<'c> Pair<'c> {
         let composed = !in_config && (mt > 0.0 || mr > 0.0);
         let (foe_comp, scale_comp) = if composed {
             let (f, s) = geom.composition_error(mt, mr);
-            (f, s * 1.0001)
+            // (The stick's near ends are multiplied by `1 − s` (the wedge
+            // paths, `w_stick`) and by `1 − s − 2.4·10⁻⁷` (the band path),
+            // which must stay above 0, else a near end behind the camera
+            // turns positive; `composition_error`'s own test lets `s` reach
+            // about `1 + 2·10⁻⁵`. From `1 − 2⁻²⁰` on, infinite: every far
+            // end unbounded, no point `ok`.)
+            let s = s * 1.0001;
+            (
+                f,
+                if s < 1.0 - 1.0 / 1_048_576.0 {
+                    s
+                } else {
+                    f32::INFINITY
+                },
+            )
         } else {
             (0.0, 0.0)
         };

@@ -295,7 +295,8 @@ fn finish_point(
         r.status = Status::BeyondMaxDepth;
         return r;
     }
-    // κ = 2Δ/q_z (Δ/q_z ≤ 1/2 by step 1), plus the rounding of `iz`.
+    // κ = 2Δ/q_z (Δ/q_z ≤ ½ − 2⁻²⁰ by step 1, `HALF_KAPPA_MAX`), plus the
+    // rounding of `iz`: below 1, so `1 − κ` keeps the near end's sign.
     let kappa = 2.0 * pair.depth_scale_error * iz + 2.4e-7;
     let Some(stick) = interval(s_near, s_far, iz, kappa) else {
         return r;

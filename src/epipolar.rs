@@ -159,6 +159,11 @@ pub struct PairGeometry {
     qz_per_px: f32,
     /// The largest `|K₁⁻¹ p|` (ray length) over the frame-1 image.
     ray_max: f32,
+    /// `1/min(f_x, f_y)` of camera 1, rounded up: how much longer a ray
+    /// can get per pixel its point moves (the true pixel lies up to `e₁`
+    /// off the detected one, outside the image too:
+    /// [`Self::depth_scale_error`]).
+    ray_per_px: f32,
     /// `[Ā_x, Ā_y, Ā_z]`: each row of `H`, its sums made of positive terms
     /// (`|K₂| |Rᵀ| |K₁⁻¹|`), against the largest pixel coordinates; a
     /// row's computed value at any pixel is within `E_i = 10 · 2⁻²⁴ Ā_i` of the
@@ -258,6 +263,7 @@ impl PairGeometry {
             // (|h₂₀| + |h₂₁| of the exact H: one rounding each.)
             qz_per_px: (habs[2][0] + habs[2][1]) * (1.0 + 9.6e-7),
             ray_max: ray_max(cam1),
+            ray_per_px: fmax(ifx, ify) * (1.0 + 9.6e-7),
             foe_round: foe_rounding(tp, tp_abs, [fx2, fy2], [cx2, cy2]),
             rows,
             corner_u,
@@ -610,7 +616,15 @@ impl PairGeometry {
     /// `1.05 Σε |K₁⁻¹ p|` for the rotation (`q_z` is the third column of
     /// `R` against the ray; each elementary rotation's derivative has unit
     /// norm, 5 % for the second order, the sum of the angles being at most
-    /// 0.1 rad).
+    /// 0.1 rad), the ray's length taken at the **true** pixel, which lies
+    /// up to `e₁` off the detected one and so up to `e₁` outside the image:
+    /// `|K₁⁻¹ p_t| ≤ |K₁⁻¹ p| + e₁/min(f_x, f_y)` (the pixel step is `(δu/f_x,
+    /// δv/f_y, 0)` in the ray), rounded up. (Until the twenty-ninth session
+    /// the image's own largest ray: an adversarial review's 8 × 8 image at
+    /// `f = 10` with `e₁ = 100` px and a rotation error of 0.02 had a true
+    /// `q_z` of 0.792 against a computed 1 and `κ` 0.05, and an `ok` point's
+    /// truth 14.7 % past its far end; `host_tests/tests/adversarial_containment.rs`,
+    /// `the_rotation_errors_change_of_q_z_is_taken_at_the_true_pixel`.)
     ///
     /// Plus `8 E_z` for the rounding of the computed `q_z`
     /// itself (at most `E_z`, [`row_bounds`]), which also bounds that
@@ -619,7 +633,8 @@ impl PairGeometry {
     /// (module docs, "The error disc after compensation").
     pub(crate) fn depth_scale_error(&self, e1: f32, rotation_error: [f32; 3]) -> f32 {
         let [ex, ey, ez] = rotation_error;
-        e1 * self.qz_per_px + 1.05 * (ex + ey + ez) * self.ray_max + 4.77e-6 * self.rows[2]
+        let ray = (self.ray_max + e1 * self.ray_per_px) * (1.0 + 9.6e-7);
+        e1 * self.qz_per_px + 1.05 * (ex + ey + ez) * ray + 4.77e-6 * self.rows[2]
     }
 
     /// The radius of the compensated error disc (module docs, "The error

@@ -391,3 +391,77 @@ fn no_ok_stick_where_q_z_is_known_to_half_its_value() {
         }
     }
 }
+
+/// A fifth finding (a second adversarial review, twenty-ninth session):
+/// `Δ`, the bound on how far `q_z` moves, took the rotation error's part
+/// at the longest ray of the frame-1 image, but the true pixel lies up to
+/// `e₁` off the detected one, outside the image too, and its ray may be
+/// far longer. An 8 × 8 image at `f = 10` px with `e₁ = 100` px and a
+/// rotation error of 0.02 about `y`: the true pixel 99.9 px to the right
+/// of the detected one, the true rotation −0.0199 about `y`, so the true
+/// `q_z` is 0.792 where the library computes 1 with `κ` 0.05; the true
+/// point's frame-2 image lies on the polyline. The `ok` stick was
+/// `[0.290, 3.113]` against the true depth 3.570 (14.7 % past the far
+/// end). `Δ` now takes the ray at the true pixel, `|K₁⁻¹ p| + e₁/min(f_x,
+/// f_y)`. The truth is computed here in `f64`.
+#[test]
+fn the_rotation_errors_change_of_q_z_is_taken_at_the_true_pixel() {
+    let cam1 = Camera::new(10.0, 10.0, 3.5, 3.5, 8, 8).unwrap();
+    let cam2 = Camera::new(10.0, 10.0, 2047.5, 2047.5, 4096, 4096).unwrap();
+    let motion = Motion::new([-40.0, 0.0, 1.0], [0.0; 3]).unwrap();
+    let config = Config::new(100.0, 0.01, 1.0, 1.0e30)
+        .unwrap()
+        .with_rotation_error([0.0, 0.02, 0.0])
+        .unwrap();
+    let mut f1 = Frame::<64, 1>::new(cam1);
+    f1.push_boundary(&[Pixel::new(7.9, 3.5), Pixel::new(7.9, 3.75)])
+        .unwrap();
+    let u2 = 2796.0f32;
+    let b2: Vec<Pixel> = (0..=8)
+        .map(|j| Pixel::new(u2, (j as f32 * 511.875).min(4095.0)))
+        .collect();
+    let mut f2 = Frame::<64, 1>::new(cam2);
+    f2.push_boundary(&b2).unwrap();
+    let mut p = Processor::<64, 1>::new(config);
+    p.process(&f1, None).unwrap();
+    let Step::Structure(s) = p.process(&f2, Some(&motion)).unwrap() else {
+        panic!("no structure");
+    };
+    let r = s.boundaries()[0].points()[0];
+    // The truth: the frame-1 pixel (7.9 + 99.9, 3.5), within e₁ = 100 of
+    // the detected (7.9, 3.5); the rotation R_y(β), β = −0.0199, within
+    // the ±0.02 box about the given 0; the translation exact. A point `Z
+    // (x_t, 0, 1)` is `R_yᵀ (P − T)` in frame 2 (`roadstereo::motion`).
+    let xt = (7.9f64 + 99.9 - 3.5) / 10.0;
+    assert!(99.9 <= 100.0 && 0.0199 <= 0.02);
+    let (sb, cb) = (-0.0199f64).sin_cos();
+    let u_of = |z: f64| {
+        let d = [z * xt + 40.0, 0.0, z - 1.0];
+        let (x2, z2) = (cb * d[0] - sb * d[2], sb * d[0] + cb * d[2]);
+        assert!(z2 > 0.0, "in front of camera 2");
+        2047.5 + 10.0 * x2 / z2
+    };
+    // `u_of` falls with `z` on [2, 100]: bisection for the frame-2 image on
+    // the polyline (`u = 2796`, `v = c_y`, between its ends).
+    let (mut lo, mut hi) = (2.0f64, 100.0f64);
+    for _ in 0..200 {
+        let m = 0.5 * (lo + hi);
+        if u_of(m) > f64::from(u2) {
+            lo = m
+        } else {
+            hi = m
+        }
+    }
+    let zt = 0.5 * (lo + hi);
+    assert!((u_of(zt) - f64::from(u2)).abs() < 1e-6 && (zt - 3.5696).abs() < 1e-3);
+    if let Some(iv) = r.interval() {
+        assert!(
+            f64::from(iv.z_near) <= zt && zt <= f64::from(iv.z_far),
+            "{:?}: the truth {zt} outside [{}, {}]",
+            r.status(),
+            iv.z_near,
+            iv.z_far
+        );
+    }
+    assert_eq!(r.status(), Status::Ok, "{r:?}");
+}

@@ -134,6 +134,30 @@ use crate::camera::{Camera, Pixel};
 use crate::math::{dot3_accurate, fmax, fmin, mat3_transpose, mat3_vec, Mat3};
 use crate::motion::Motion;
 
+/// The largest `Δ/q_z` step 1 of the processor accepts (`Δ` the bound on
+/// `q_z`'s change, [`PairGeometry::depth_scale_error`]), and the
+/// certificate of a whole image asks of every pixel
+/// ([`PairGeometry::certifies_image`]): `½ − 2⁻²⁰`. The stick's ends are
+/// widened by `κ = 2Δ/q_z` plus the rounding of `1/q_z` (`2.4·10⁻⁷`), the
+/// near end times `1 − κ`, which must stay above 0: with `½` itself `κ`
+/// reached `1 + 2⁻²²`, and a stick whose near end lay behind the camera
+/// (`s_near < 0`, the depth unbounded below) came out `ok` with a
+/// positive near end (an adversarial review, twenty-ninth session;
+/// `host_tests/tests/adversarial_containment.rs`,
+/// `no_ok_stick_where_q_z_is_known_to_half_its_value`). Here `κ ≤
+/// 1 − 2⁻¹⁹ + 2.4·10⁻⁷ < 1 − 2⁻²¹` (doubling is exact, and so is `1 − κ`
+/// this near 1).
+pub(crate) const HALF_KAPPA_MAX: f32 = 0.5 - 1.0 / 1_048_576.0;
+
+/// A composed motion's largest scale error `s` a pair uses (the fusion's
+/// pairs; [`PairGeometry::composition_error`]): `1 − 2⁻²⁰`. The stick's
+/// near ends are multiplied by `1 − s` (the wedge paths) and `1 − s −
+/// 2.4·10⁻⁷` (the band path), which must stay above 0 for the same
+/// reason as `κ`'s ([`HALF_KAPPA_MAX`]): below this both are at least
+/// `2⁻²⁰ − 2.4·10⁻⁷ > 7·10⁻⁷`. From it on the pair takes `s` as infinite,
+/// every far end unbounded.
+pub(crate) const SCALE_ERROR_MAX: f32 = 1.0 - 1.0 / 1_048_576.0;
+
 /// The epipolar geometry of one frame pair, computed once per frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -528,8 +552,9 @@ impl PairGeometry {
 
     /// Whether every pixel of `cam`'s image with its margin passes the
     /// processor's step-1 checks (module `processor`): `q_z > 10⁻⁶`, the
-    /// compensated point [`Self::in_view`], and `dse / q_z ≤ 1/2` for the
-    /// bound `dse` on `q_z`'s change, each computed in `f32`.
+    /// compensated point [`Self::in_view`], and `dse / q_z ≤`
+    /// [`HALF_KAPPA_MAX`] for the bound `dse` on `q_z`'s change, each
+    /// computed in `f32`.
     ///
     /// On the image rectangle `q_z = h₂₀u + h₂₁v + h₂₂` is affine and, where
     /// it is positive, the compensated coordinates are linear-fractional,
@@ -558,7 +583,7 @@ impl PairGeometry {
         // The smallest q_z any pixel computes, over a relative 2⁻²⁰.
         let zlow = (zmin - 9.6e-7 * az) * (1.0 - 9.6e-7);
         // (A NaN fails.)
-        if !(zlow > 1.0e-6 && dse <= 0.5 * zlow * (1.0 - 9.6e-7)) {
+        if !(zlow > 1.0e-6 && dse <= HALF_KAPPA_MAX * zlow * (1.0 - 9.6e-7)) {
             return false;
         }
         let p = corners.map(|[u, v]| {

@@ -762,20 +762,6 @@ enum Matcher {
     Reference,
 }
 
-/// The largest `Δ/q_z` step 1 accepts (`Δ` the bound on `q_z`'s change,
-/// [`crate::epipolar::PairGeometry::depth_scale_error`]): `½ − 2⁻²⁰`. The
-/// stick's ends are widened by `κ = 2Δ/q_z` plus the rounding of `1/q_z`
-/// (`2.4·10⁻⁷`), the near end times `1 − κ`, which must stay above 0:
-/// with `½` itself `κ` reached `1 + 2⁻²²`, and a stick whose near end lay
-/// behind the camera (`s_near < 0`, the depth unbounded below) came out
-/// `ok` with a positive near end (an adversarial review, twenty-ninth
-/// session; `host_tests/tests/adversarial_containment.rs`,
-/// `no_ok_stick_where_q_z_is_known_to_half_its_value`). Here `κ ≤ 1 − 2⁻¹⁹
-/// + 2.4·10⁻⁷ < 1 − 2⁻²¹` (doubling is exact, and so is `1 − κ` this near
-/// 1). The frame-wide certificate already kept `κ` below 1
-/// ([`crate::epipolar::PairGeometry::certifies_image`]).
-const HALF_KAPPA_MAX: f32 = 0.5 - 1.0 / 1_048_576.0;
-
 /// Step 1 for one frame-1 point: compensate it and make its output slot
 /// hold it until step 4 overwrites it: `p₁'` in `pixel2`, `1/q_z` in `z`,
 /// `r₁` in `z_near`, the key of its epipolar line in `z_far`, and the
@@ -802,8 +788,8 @@ fn compensate_point(
             return Err(Status::OutOfView);
         }
         // q_z must be known to better than half its value (κ below, which
-        // must stay below 1: `HALF_KAPPA_MAX`). (A NaN fails.)
-        if !(pair.depth_scale_error * c.inv_depth_scale <= HALF_KAPPA_MAX) {
+        // must stay below 1: `epipolar::HALF_KAPPA_MAX`). (A NaN fails.)
+        if !(pair.depth_scale_error * c.inv_depth_scale <= crate::epipolar::HALF_KAPPA_MAX) {
             return Err(Status::BehindCamera);
         }
         let r1 = match pair.frame_r1 {
@@ -1362,25 +1348,30 @@ mod tests {
 
     /// A composed motion's scale error `s` (the fusion's pairs,
     /// `Pair::scale_motion`) near 1: the stick's near ends are multiplied
-    /// by `1 − s` (less a rounding), so from `s = 1` on nothing bounds a
-    /// depth from below and no point may be `Ok`. An adversarial review
-    /// (twenty-ninth session) found `composition_error`'s test letting
-    /// `s` reach about `1 + 2·10⁻⁵` (then `1.0001` times that); a near end
-    /// behind the camera (`s_near < 0`) then turned positive, as the same
-    /// review found for `κ` (`HALF_KAPPA_MAX`). Pure translation
-    /// backwards (`W' = 0.5`), so the composition's translation error `m_t`
-    /// sets `s = d_t/((W' − d_t)(1 − 10⁻⁵))(1 + 10⁻⁵)` with `d_t = m_t(1 +
-    /// 10⁻⁵)`: swept over `m_t` from 0.2499 to 0.25, `s` from about 0.9993
-    /// to past `W'/2`, where `composition_error` gives up. The frames are
+    /// by `1 − s` (the band path: `1 − s − 2.4·10⁻⁷`), so from there on
+    /// nothing bounds a depth from below and no point may be `Ok`. An
+    /// adversarial review (twenty-ninth session) found
+    /// `composition_error`'s test letting `s` reach about `1 + 2·10⁻⁵`
+    /// (then `1.0001` times that); a near end behind the camera (`s_near <
+    /// 0`) then turned positive, as the same review found for `κ`
+    /// (`epipolar::HALF_KAPPA_MAX`). Pure translation backwards (`W' =
+    /// −0.5`: the band path), so the composition's translation error `m_t`
+    /// sets `s = d_t/((|W'| − d_t)(1 − 10⁻⁵))(1 + 10⁻⁵)` with
+    /// `d_t = m_t(1 + 10⁻⁵)`: every `f32` `m_t` from 0.24996 to 0.25 (about 2 700), `s`
+    /// from about 0.9997 through the band path's last positive factor to
+    /// past `|W'|/2`, where `composition_error` gives up. The frames are
     /// those of the adversarial test (`host_tests/tests/
     /// adversarial_containment.rs`, `no_ok_stick_where_q_z_is_known_to_half_its_value`)
     /// ten times as far from the focus, whose 40 points' sticks reach
     /// behind the camera without a composition (every one `Unbounded`);
-    /// before the fix 18 of them came out `Ok` from `m_t = 0.24999` on.
+    /// before the fix 18 of them came out `Ok` from `m_t = 0.24999` on, and
+    /// with the threshold at `s < 1` at `m_t` just below 0.25 (a second
+    /// review: `s` from `1 − 2.4·10⁻⁷` to 1).
     #[test]
     fn no_ok_stick_where_the_composition_scale_reaches_one() {
         use crate::camera::{Camera, Pixel};
         use crate::deadline::NoDeadline;
+        use crate::epipolar::{PairGeometry, SCALE_ERROR_MAX};
         let cam = Camera::new(1.0, 1.0, 8191.5, 8191.5, 16384, 16384).expect("camera");
         let c = 8191.5f32;
         let mut f1 = Frame::<64, 1>::new(cam);
@@ -1395,9 +1386,15 @@ mod tests {
         f2.push_boundary(&p2).expect("frame 2");
         let motion = Motion::new([0.0, 0.0, -0.5], [0.0; 3]).expect("motion");
         let config = Config::new(0.0, 0.0, 10.0, 1000.0).expect("config");
-        let (mut bounded, mut matched) = (0u32, 0u32);
-        for k in 0..=100u32 {
-            let mt = 0.2499 + 1.0e-6 * k as f32;
+        let geom = PairGeometry::new(&cam, &cam, &motion);
+        // (Runs whose points reached the stick, and runs whose `s` lies in
+        // the band path's window `[1 − 2.4·10⁻⁷, 1)` or at or past 1.)
+        let (mut matched, mut window, mut past) = (0u32, 0u32, 0u32);
+        let mut mt = 0.249_96f32;
+        while mt <= 0.25 {
+            let s = geom.composition_error(mt, 0.0).1 * 1.0001;
+            window += u32::from((1.0 - 2.4e-7..1.0).contains(&s));
+            past += u32::from(s >= 1.0 && s.is_finite());
             let mut p = Processor::<64, 1>::new(config);
             p.process(&f1, None).expect("frame 1");
             let rounding = Rounding {
@@ -1405,16 +1402,27 @@ mod tests {
                 matrix: 0.0,
                 in_config: false,
             };
-            let s = p
+            let out = p
                 .process_composed_within(&f2, &motion, rounding, true, &mut NoDeadline)
                 .expect("pair");
-            for r in s.boundaries()[0].points() {
-                assert_ne!(r.status(), Status::Ok, "m_t {mt}: {r:?}");
-                matched += u32::from(r.status() == Status::Unbounded);
+            for r in out.boundaries()[0].points() {
+                assert_ne!(r.status(), Status::Ok, "m_t {mt:e} (s {s:e}): {r:?}");
             }
-            bounded += 1;
+            let unbounded = out.boundaries()[0].points().iter();
+            matched += u32::from(
+                unbounded
+                    .filter(|r| r.status() == Status::Unbounded)
+                    .count()
+                    > 0,
+            );
+            mt = f32::from_bits(mt.to_bits() + 1);
         }
-        // (The sweep ran, and the points reached the stick, unbounded.)
-        assert!(bounded == 101 && matched > 1000, "{bounded} {matched}");
+        // (The sweep met both: the points reached the stick, and `s`
+        // crossed the band path's window and 1, below `SCALE_ERROR_MAX`
+        // too.)
+        assert!(
+            matched > 1000 && window > 0 && past > 100 && SCALE_ERROR_MAX < 1.0 - 2.4e-7,
+            "{matched} {window} {past}"
+        );
     }
 }

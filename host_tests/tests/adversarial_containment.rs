@@ -359,8 +359,8 @@ fn the_focus_of_expansion_rounds_about_once_moving_backwards() {
 /// product came out positive and the point `ok`, its near end (about
 /// `5·10⁻¹⁰` here) no bound at all. The set-up: pure translation, so
 /// `q_z = 1` at every pixel, and the rotation error chosen so that `Δ`
-/// is exactly ½ (`0x382c62ae`; three ulps lower, `Δ < ½`, gave every
-/// point `Unbounded` before the fix too).
+/// is exactly ½ (18 of the 40 points `ok` there; a few ulps lower, `Δ <
+/// ½`, every point `Unbounded` before the fix too).
 #[test]
 fn no_ok_stick_where_q_z_is_known_to_half_its_value() {
     let cam = Camera::new(1.0, 1.0, 8191.5, 8191.5, 16384, 16384).unwrap();
@@ -376,7 +376,13 @@ fn no_ok_stick_where_q_z_is_known_to_half_its_value() {
         .collect();
     f2.push_boundary(&p2).unwrap();
     let motion = Motion::new([0.0, 0.0, -0.5], [0.0; 3]).unwrap();
-    for bits in [0x382c_62ae_u32, 0x382c_62ad, 0x382c_62ab] {
+    // Rotation errors a few dozen ulps either side of the one that puts
+    // `Δ/q_z` at ½ (`0x382c_62ae` before `Δ` took the true pixel's ray,
+    // `0x382c_62a1`–`a3` since): below the edge the points reach the stick
+    // and are `Unbounded`, at and past it step 1 flags them. (A sweep, so
+    // that the edge stays inside it when `Δ`'s rounding moves.)
+    let mut unbounded = 0;
+    for bits in 0x382c_6280_u32..=0x382c_62b0 {
         let config = Config::new(0.0, 0.0, 10.0, 1000.0)
             .unwrap()
             .with_rotation_error([f32::from_bits(bits), 0.0, 0.0])
@@ -388,8 +394,11 @@ fn no_ok_stick_where_q_z_is_known_to_half_its_value() {
         };
         for r in s.boundaries()[0].points() {
             assert_ne!(r.status(), Status::Ok, "{bits:#x}: {r:?}");
+            unbounded += usize::from(r.status() == Status::Unbounded);
         }
     }
+    // (The sweep reached the stick: the case the fix is for.)
+    assert!(unbounded > 100, "{unbounded}");
 }
 
 /// A fifth finding (a second adversarial review, twenty-ninth session):

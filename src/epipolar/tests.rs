@@ -5,11 +5,13 @@ use crate::test_rng::Rng;
 /// over the image with its margin, its edges and corners included);
 /// most ordinary geometries certify, and ones that put part of the
 /// image behind the camera, out of view or with `q_z` too uncertain
-/// do not.
+/// do not. Each geometry is checked at a random `dse` and, where it
+/// certifies at all, at the largest `dse` that certifies (bisected to
+/// the last bit), where `Δ/q_z ≤` [`HALF_KAPPA_MAX`] has the least room.
 #[test]
 fn certified_images_pass_every_check() {
     let mut rng = Rng(0xce27_1f1e);
-    let mut certified = 0;
+    let (mut certified, mut edges) = (0, 0);
     for case in 0..600 {
         let cam = Camera::new(
             300.0 + 900.0 * rng.next(),
@@ -26,26 +28,47 @@ fn certified_images_pass_every_check() {
         let a = [0.0; 3].map(|_: f32| (rng.next() - 0.5) * 2.0 * deg.to_radians());
         let m = Motion::new([0.1, 0.0, 1.0], a).expect("motion");
         let g = PairGeometry::new(&cam, &cam, &m);
-        let dse = rng.next() * rng.next();
-        if !g.certifies_image(&cam, dse) {
-            continue;
-        }
-        certified += 1;
-        for i in 0..=64 {
-            for j in 0..=64 {
-                let p = Pixel::new(
-                    -1.0 + 513.0 * i as f32 / 64.0,
-                    -1.0 + 481.0 * j as f32 / 64.0,
-                );
-                let c = g.compensate(p).expect("in front");
-                assert!(g.in_view(c.pixel), "case {case}: {p:?}");
-                assert!(dse * c.inv_depth_scale <= 0.5, "case {case}: {p:?}");
-                let f = g.compensate_certified(p, 1.0);
-                assert_eq!((f.pixel, f.inv_depth_scale), (c.pixel, c.inv_depth_scale));
+        let check = |dse: f32| {
+            for i in 0..=64 {
+                for j in 0..=64 {
+                    let p = Pixel::new(
+                        -1.0 + 513.0 * i as f32 / 64.0,
+                        -1.0 + 481.0 * j as f32 / 64.0,
+                    );
+                    let c = g.compensate(p).expect("in front");
+                    assert!(g.in_view(c.pixel), "case {case}: {p:?}");
+                    assert!(
+                        dse * c.inv_depth_scale <= HALF_KAPPA_MAX,
+                        "case {case}: {p:?} {dse:e}"
+                    );
+                    let f = g.compensate_certified(p, 1.0);
+                    assert_eq!((f.pixel, f.inv_depth_scale), (c.pixel, c.inv_depth_scale));
+                }
             }
+        };
+        let dse = rng.next() * rng.next();
+        if g.certifies_image(&cam, dse) {
+            certified += 1;
+            check(dse);
+        }
+        // The largest `dse` that certifies: its bits bisected (the
+        // certificate's test is monotone in `dse`).
+        if g.certifies_image(&cam, 0.0) {
+            let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
+            while hi - lo > 1 {
+                let mid = lo + (hi - lo) / 2;
+                if g.certifies_image(&cam, f32::from_bits(mid)) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            edges += 1;
+            check(f32::from_bits(lo));
         }
     }
     assert!((200..600).contains(&certified), "certified {certified}");
+    assert!(edges > 300, "edges {edges}");
 }
 
 /// The frame-wide stretch bound is never below a point's own stretch,
@@ -233,7 +256,7 @@ fn error_disc_holds_every_pixel_within_e1() {
             };
             let Some(c) = g.compensate(p) else { continue };
             let dse = g.depth_scale_error(e1, [0.0; 3]);
-            if !(g.in_view(c.pixel) && dse * c.inv_depth_scale <= 0.5) {
+            if !(g.in_view(c.pixel) && dse * c.inv_depth_scale <= HALF_KAPPA_MAX) {
                 continue;
             }
             let own = g.point_disc_radius(&c, e1);

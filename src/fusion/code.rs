@@ -156,7 +156,11 @@ impl DepthScale {
     /// `⌈b / 2¹¹⌉` for either sign: for every `z` but a NaN `b + 2¹¹ − 1`
     /// is below `0x7F80_0800`, no overflow (a NaN wraps, no panic). (Until
     /// the twenty-ninth session `⌊b / 2¹¹⌋` plus whether a cut bit was set:
-    /// about 2 instructions an entry more, `partners_1` 75.35 → 73.6.)
+    /// about 2 instructions an entry more, `partners_1` 75.35 → 73.6.) A
+    /// NaN is outside the contract either way: one with the sign bit set
+    /// got code 1 before and does now, and one whose bits are at least
+    /// `0x7FFF_F801` wraps to code 1 now where it got a code past every
+    /// limit before; the map's ends are never NaN (`down_for_entry`).
     #[inline(always)]
     pub(crate) fn up_no_nan(&self, z: f32) -> i32 {
         let b = (z * self.inv).to_bits() as i32;

@@ -109,17 +109,15 @@ impl<'c> Pair<'c> {
             // paths, `w_stick`) and by `1 − s − 2.4·10⁻⁷` (the band path),
             // which must stay above 0, else a near end behind the camera
             // turns positive; `composition_error`'s own test lets `s` reach
-            // about `1 + 2·10⁻⁵`. From `1 − 2⁻²⁰` on, infinite: every far
-            // end unbounded, no point `ok`.)
+            // about `1 + 2·10⁻⁵`. From `SCALE_ERROR_MAX` on, infinite:
+            // every far end unbounded, no point `ok`.)
             let s = s * 1.0001;
-            (
-                f,
-                if s < 1.0 - 1.0 / 1_048_576.0 {
-                    s
-                } else {
-                    f32::INFINITY
-                },
-            )
+            let s = if s < crate::epipolar::SCALE_ERROR_MAX {
+                s
+            } else {
+                f32::INFINITY
+            };
+            (f, s)
         } else {
             (0.0, 0.0)
         };

@@ -40,7 +40,8 @@
 //! Jacobian at the *detected* pixel. `|h₂·δ| ≤ e₁ |h₂|₁`, so with
 //! `x = e₁ |h₂|₁/Z ≤ ½` the displacement is at most `σ e₁/(1 − x) ≤
 //! σ e₁ (1 + 2x)` for any `σ ≥ ‖J‖₂` (the larger of `J`'s 1- and ∞-norms,
-//! [`Compensated::stretch`]). Step 1 flags a point with `Δ/q_z > ½`, and
+//! [`Compensated::stretch`]). Step 1 flags a point with `Δ/q_z` above
+//! [`HALF_KAPPA_MAX`] (`½ − 2⁻²⁰`, so every point above ½), and
 //! `Δ ≥ e₁ |h₂|₁` (`PairGeometry::depth_scale_error`), so `x ≤ ½` on
 //! every accepted point: the change of `q_z` across the disc costs at most
 //! a factor 2, and `1 + 2x` says how much (an earlier `r₁ = e₁ σ` at the
@@ -654,7 +655,8 @@ impl PairGeometry {
     /// Plus `8 E_z` for the rounding of the computed `q_z`
     /// itself (at most `E_z`, [`row_bounds`]), which also bounds that
     /// rounding relative to an accepted point's `q_z`: step 1 flags a point
-    /// whose `Δ/q_z` exceeds ½, so an accepted one has `E_z/q_z ≤ 1/16`
+    /// whose `Δ/q_z` exceeds [`HALF_KAPPA_MAX`], just under ½, so an
+    /// accepted one has `E_z/q_z ≤ 1/16`
     /// (module docs, "The error disc after compensation").
     pub(crate) fn depth_scale_error(&self, e1: f32, rotation_error: [f32; 3]) -> f32 {
         let [ex, ey, ez] = rotation_error;

@@ -41,7 +41,7 @@
 //! `x = e₁ |h₂|₁/Z ≤ ½` the displacement is at most `σ e₁/(1 − x) ≤
 //! σ e₁ (1 + 2x)` for any `σ ≥ ‖J‖₂` (the larger of `J`'s 1- and ∞-norms,
 //! [`Compensated::stretch`]). Step 1 flags a point with `Δ/q_z` above
-//! [`HALF_KAPPA_MAX`] (`½ − 2⁻²⁰`, so every point above ½), and
+//! `HALF_KAPPA_MAX` (`½ − 2⁻²⁰`, so every point above ½), and
 //! `Δ ≥ e₁ |h₂|₁` (`PairGeometry::depth_scale_error`), so `x ≤ ½` on
 //! every accepted point: the change of `q_z` across the disc costs at most
 //! a factor 2, and `1 + 2x` says how much (an earlier `r₁ = e₁ σ` at the

@@ -111,8 +111,10 @@
 //! and its offset `d` from `c₂` (`ε`, `PairGeometry::foe_rounding`).
 //! * Moving forwards, the geometry with the computed focus is the true one
 //!   with the frame-1 point moved by `(1 − 1/k) ε` (`k ≥ 1`), at most
-//!   `|ε| min(1, 4L/|e − c₂|)` (`PairGeometry::foe_shift`), which `r₁`
-//!   adds.
+//!   `|ε| min(1, 3L/(|e − c₂| + L))` (`PairGeometry::foe_shift`; `L`
+//!   the view's reach from `c₂`, and step 1 refuses a point whose `r₁ +
+//!   e₂` passes `L`, so that the true points lie within `2L` of `c₂`),
+//!   which `r₁` adds.
 //! * Moving backwards the correspondent, seen from the computed focus,
 //!   is moved in frame 2 by `(1 − k) ε` (`0 < k < 1`), `(1 − k) = d/|p₁'
 //!   − e|`: the same bound, which `e₂` adds.
@@ -329,14 +331,28 @@ impl PairGeometry {
     /// The shift that [`Self::foe_rounding`] stands for: moving forwards
     /// of the frame-1 point, `(1 − 1/k) |ε| = d |ε| / |p₂ − e|`; moving
     /// backwards of the correspondent in frame 2, `(1 − k) |ε| = d |ε| /
-    /// |p₁' − e|` (`d` the disparity; module docs). With `L` the largest
-    /// distance from the principal point of anything in view
-    /// ([`Self::in_view`]), `d ≤ 2L`; and for a true focus farther than
-    /// `2L` from the principal point both distances from it are at least
-    /// `|e − c₂| − L ≥ |e − c₂|/2`, so the shift is at most `|ε| min(1,
-    /// 4L/|e − c₂|)`, with `|e − c₂|` at least the computed focus's
-    /// distance less `|ε|`. (A far focus rounds by many pixels, but its
-    /// lines barely turn.)
+    /// |p₁' − e|` (`d` the disparity, `k` the ratio of the true points'
+    /// distances from the true focus `e`; module docs). Either factor is
+    /// below 1. With `L` the largest distance from the principal point
+    /// `c₂` of anything in view ([`Self::view_reach`]) and `D = |e − c₂|`:
+    /// the detected compensated point is in view ([`Self::in_view`]) and
+    /// the true one within `r₁` of it, so `|p₁' − c₂| ≤ L + r₁`; the true
+    /// correspondent lies within `e₂` of a polyline inside the image, so
+    /// `|p₂ − c₂| ≤ L + e₂`. Moving forwards `1 − 1/k = 1 − |p₁' −
+    /// e|/|p₂ − e| ≤ 1 − (D − L − r₁)/(D + L + e₂) = (2L + r₁ + e₂)/(D +
+    /// L + e₂)`, backwards `1 − k ≤ (2L + r₁ + e₂)/(D + L + r₁)`; both at
+    /// most `(2L + r₁ + e₂)/(D + L)`, which falls as `D` grows. Step 1
+    /// accepts only `r₁ + e₂ ≤ L` ([`Self::r1_cap`]), so the shift is at
+    /// most `|ε| min(1, 3L/(D + L))`, with `D` at least the computed
+    /// focus's distance less `|ε|`. (A far focus rounds by many pixels,
+    /// but its lines barely turn.)
+    ///
+    /// Until a review (thirtieth session) the factor was `4L/D` from `D >
+    /// 2L` on, from the disparity's bound `2L` for points in view: the
+    /// true points need not be, and on a 2 × 2 image (`L` ≈ 3.5 px) with
+    /// `e₂` = 100 px it fell short (0.014 against up to 0.19 at `D` = 1 000 px, `e₁` =
+    /// 100 px too).
+    /// `3L/(D + L)` is below `4L/D` everywhere, so no stick widens.
     pub(crate) fn foe_shift(&self) -> f32 {
         self.foe_shift_of(self.foe_rounding())
     }
@@ -346,25 +362,42 @@ impl PairGeometry {
         let Some(e) = self.focus_of_expansion() else {
             return 0.0;
         };
-        let [u0, u1, v0, v1] = self.view;
-        let (dx, dy) = (
-            fmax((u0 - self.c2[0]).abs(), (u1 - self.c2[0]).abs()),
-            fmax((v0 - self.c2[1]).abs(), (v1 - self.c2[1]).abs()),
-        );
-        // (Rounded up by a relative 10⁻⁵.)
-        let l = crate::math::sqrt(dx * dx + dy * dy) * (1.0 + 1.0e-5);
+        let l = self.view_reach();
         let (ex, ey) = (e.u - self.c2[0], e.v - self.c2[1]);
         // (The true focus is within `eps` of the computed one: at least
         // this far from the principal point. Until a review it was the
         // computed focus's distance, which a composed motion's focus
         // error, `composition_error`, can make far too large.)
         let de = crate::math::sqrt(ex * ex + ey * ey) * (1.0 - 1.0e-5) - eps;
-        // (A NaN keeps the whole rounding.)
+        // (A NaN keeps the whole rounding; from `D > 2L` on the factor is
+        // below 1.)
         if de > 2.0 * l {
-            eps * (4.0 * l / de) * (1.0 + 1.0e-5)
+            eps * (3.0 * l / (de + l)) * (1.0 + 1.0e-5)
         } else {
             eps
         }
+    }
+
+    /// `L`: the largest distance from the principal point `c₂` of anything
+    /// in view ([`Self::in_view`]), rounded up by a relative 10⁻⁵.
+    pub(crate) fn view_reach(&self) -> f32 {
+        let [u0, u1, v0, v1] = self.view;
+        let (dx, dy) = (
+            fmax((u0 - self.c2[0]).abs(), (u1 - self.c2[0]).abs()),
+            fmax((v0 - self.c2[1]).abs(), (v1 - self.c2[1]).abs()),
+        );
+        crate::math::sqrt(dx * dx + dy * dy) * (1.0 + 1.0e-5)
+    }
+
+    /// The largest `r₁` step 1 accepts for frame-2 errors `e2`: `L − e₂`
+    /// ([`Self::view_reach`]), rounded down, so that a true frame-1 point
+    /// and a true correspondent both lie within `2L` of `c₂`, as
+    /// [`Self::foe_shift`] needs. Negative (every point refused) when `e₂`
+    /// is past `L`: a 2 × 2 image with `e₂` above about 3.5 px. For the
+    /// paper's 512 × 480 camera `L` is about 1 050 px.
+    pub(crate) fn r1_cap(&self, e2: f32) -> f32 {
+        let l = self.view_reach();
+        (l - e2) - l * 1.0e-6
     }
 
     /// Where the motion given may be off the true one by its composition's

@@ -810,8 +810,11 @@ fn compensate_point(
                 // Far off the camera's axis the rotation error's shift has
                 // no bound (`rotation_shift_bound`): such a point is out of
                 // the view the stick can be certified in, and must not set
-                // the frame's largest error. (A NaN fails.)
-                if !(r1 < f32::INFINITY) {
+                // the frame's largest error. So is one whose error disc
+                // reaches past the view's reach with `e₂`
+                // (`PairGeometry::r1_cap`, for the focus's shift). (A NaN
+                // fails.)
+                if !(r1 <= pair.r1_cap) {
                     return Err(Status::OutOfView);
                 }
                 r1
@@ -1424,5 +1427,58 @@ mod tests {
             matched > 1000 && window > 0 && past > 100 && SCALE_ERROR_MAX < 1.0 - 2.4e-7,
             "{matched} {window} {past}"
         );
+    }
+
+    /// A point whose error disc, with `e₂`, reaches past the view's reach
+    /// `L` from the principal point (`PairGeometry::r1_cap`) is refused,
+    /// `OutOfView`: the focus's rounding is added as a shift bounded for
+    /// true points within `2L` of `c₂` (`PairGeometry::foe_shift`), and
+    /// the true points of such a disc need not be. A review (thirtieth
+    /// session) found that bound argued for points in view while the
+    /// true ones lie up to `r₁` and `e₂` beyond it. Frame 2 is a 16 × 16
+    /// image (`L` = 33.2 px), the focus far down the diagonal (`D` ≈
+    /// 1 400 px), frame 1's camera centred 23 px further out so that its
+    /// points compensate to near the view's corner. Below the cap (`e₂` =
+    /// 30 px) the points are searched (their band, wider than the image,
+    /// holds the boundary's ends: `BoundaryEnd`); past it (34 px) every
+    /// one is `OutOfView`, where before the cap they were searched too.
+    #[test]
+    fn points_whose_disc_with_e2_passes_the_views_reach_are_refused() {
+        use crate::camera::{Camera, Pixel};
+        let cam1 = Camera::new(16.0, 16.0, 30.5, 30.5, 64, 64).expect("camera 1");
+        let cam2 = Camera::new(16.0, 16.0, 7.5, 7.5, 16, 16).expect("camera 2");
+        let mut f1 = Frame::<16, 1>::new(cam1);
+        let p1: [Pixel; 5] = core::array::from_fn(|i| {
+            let t = i as f32 * 0.5 - 1.0;
+            Pixel::new(8.0 + t, 8.0 - t)
+        });
+        f1.push_boundary(&p1).expect("frame 1");
+        let mut f2 = Frame::<16, 1>::new(cam2);
+        let p2: [Pixel; 5] = core::array::from_fn(|i| {
+            let t = i as f32 * 0.5 - 1.0;
+            Pixel::new(14.0 + t, 14.0 - t)
+        });
+        f2.push_boundary(&p2).expect("frame 2");
+        // The focus `c₂ + 16 (U/W, V/W)` at about (−1 000, −1 000).
+        let motion = Motion::new([-0.063, -0.063, 0.001], [0.0; 3]).expect("motion");
+        let geom = crate::epipolar::PairGeometry::new(&cam1, &cam2, &motion);
+        let l = geom.view_reach();
+        assert!((33.0..33.5).contains(&l), "{l}");
+        let mut refused = [0usize; 2];
+        for (n, e2) in refused.iter_mut().zip([30.0f32, 34.0]) {
+            let config = Config::new(0.5, e2, 10.0, 1.0e6).expect("config");
+            let mut p = Processor::<16, 1>::new(config);
+            p.process(&f1, None).expect("frame 1");
+            let Ok(Step::Structure(out)) = p.process(&f2, Some(&motion)) else {
+                unreachable!("frame 2 makes a pair");
+            };
+            let points = out.boundaries()[0].points();
+            assert_eq!(points.len(), 5);
+            *n = points
+                .iter()
+                .filter(|r| r.status() == Status::OutOfView)
+                .count();
+        }
+        assert_eq!(refused, [0, 5]);
     }
 }

@@ -58,7 +58,11 @@ pub enum Status {
     /// correspondence (see [`crate::epipolar::PairGeometry`]); or, with a
     /// rotation error configured, so far off the camera's axis that the
     /// error's shift has no bound
-    /// ([`crate::motion_error::rotation_shift_bound`] infinite).
+    /// ([`crate::motion_error::rotation_shift_bound`] infinite); or its
+    /// error disc `r₁` with `e₂` reaches past the farthest point of that
+    /// view from the principal point (only on images not much larger than
+    /// the errors; the bound on the focus's rounding needs the true
+    /// points within it).
     OutOfView,
     /// The band reaches past an end of the frame-2 boundary (its first or
     /// last point lies in the band): the true crossing may lie beyond what

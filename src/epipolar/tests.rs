@@ -372,6 +372,82 @@ fn foe_rounding_holds() {
     assert!(ratio < 5.0, "{ratio}");
 }
 
+/// The focus's shift ([`PairGeometry::foe_shift_of`]) against `f64`,
+/// for true points anywhere step 1 lets them be: the compensated frame-1
+/// point within `L + r₁` of `c₂` and the correspondent within `L + e₂`,
+/// `r₁ + e₂ ≤ L` ([`PairGeometry::r1_cap`]), the true focus anywhere
+/// within `eps` of the computed one. The worst placement is on the line
+/// through the focus and `c₂`: moving forwards the frame-1 point
+/// `L + r₁` from `c₂` towards the focus and the correspondent `L + e₂`
+/// beyond, `1 − 1/k = 1 − (D − L − r₁)/(D + L + e₂)`; backwards the
+/// other way round, `1 − k = 1 − (D − L − e₂)/(D + L + r₁)`. Both are
+/// checked for every split of `L` between `r₁` and `e₂`, on images from
+/// 2 × 2 to 512 × 480 px, foci from the image to 10⁶ px away and `eps`
+/// from the focus's own rounding to 100 px. At `r₁ + e₂ = L` the bound
+/// is reached (within 10⁻⁴). Past the cap, at `r₁ + e₂ = 3L`, the factor
+/// before the review, `4L/D` from `D > 2L` on, falls short: why step 1
+/// refuses such points.
+#[test]
+fn foe_shift_holds_for_true_points_out_of_view() {
+    let mut rng = Rng(0xf0e_5a1f);
+    let (mut checked, mut tightest, mut old_short) = (0u32, f64::INFINITY, 0u32);
+    for case in 0..4_000 {
+        let (w, h) = [(2u16, 2u16), (4, 4), (16, 16), (64, 48), (512, 480)][case % 5];
+        let f = [1.0f32, 16.0, 800.0][case / 5 % 3];
+        let cam = Camera::new(
+            f,
+            fmax(1.0, f * (0.5 + rng.next())),
+            f32::from(w - 1) * rng.next(),
+            f32::from(h - 1) * rng.next(),
+            w,
+            h,
+        )
+        .expect("camera");
+        // Foci from near the image to 10⁶ px: `W` from 1 down to 10⁻⁶
+        // of `|T|`, either sign.
+        let wz = 10.0f32.powf(-6.0 * rng.next()) * if rng.next() < 0.5 { 1.0 } else { -1.0 };
+        let t = [rng.next() - 0.5, rng.next() - 0.5, wz];
+        let a = [0.0; 3].map(|_: f32| (rng.next() - 0.5) * 0.2);
+        let Ok(m) = Motion::new(t, a) else { continue };
+        let g = PairGeometry::new(&cam, &cam, &m);
+        let Some(e) = g.focus_of_expansion() else {
+            continue;
+        };
+        let l = f64::from(g.view_reach());
+        let (dx, dy) = (f64::from(e.u - g.c2[0]), f64::from(e.v - g.c2[1]));
+        for eps in [g.foe_rounding(), 0.01, 1.0, 100.0] {
+            let shift = f64::from(g.foe_shift_of(eps));
+            let eps = f64::from(eps);
+            let d = ((dx * dx + dy * dy).sqrt() - eps).max(0.0);
+            for s in [0.0, 0.25, 0.5, 0.75, 1.0] {
+                let (r1, e2) = (s * l, (1.0 - s) * l);
+                let ratio = |near: f64, far: f64| {
+                    let (a, b) = (d - l - near, d + l + far);
+                    if a > 0.0 {
+                        1.0 - a / b
+                    } else {
+                        1.0
+                    }
+                };
+                let worst = ratio(r1, e2).max(ratio(e2, r1)) * eps;
+                assert!(worst <= shift, "case {case} eps {eps}: {worst} > {shift}");
+                if worst > 0.0 {
+                    tightest = tightest.min(shift / worst);
+                }
+                checked += 1;
+            }
+            // Past the cap: the old factor.
+            if d > 4.0 * l {
+                let (a, b) = (d - 3.0 * l, d + 2.0 * l);
+                old_short += u32::from(1.0 - a / b > 4.0 * l / d);
+            }
+        }
+    }
+    assert!(checked > 50_000, "{checked}");
+    assert!(tightest < 1.0001, "{tightest}");
+    assert!(old_short > 100, "{old_short}");
+}
+
 /// The composition's bounds (`composition_error`, `composition_shift`
 /// and the rotation box that stands for the shift point by point,
 /// `processor::composition_box`) against `f64`: a motion whose matrix

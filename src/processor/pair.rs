@@ -20,8 +20,12 @@ pub(super) struct Pair<'c> {
     /// What `e₂` adds: the slack, and moving backwards the focus's
     /// rounding (as a frame-2 shift, [`PairGeometry::foe_shift`]).
     pub(super) slack_e2: f32,
+    /// The largest `r₁` step 1 accepts ([`PairGeometry::r1_cap`]: the
+    /// focus's shift, [`PairGeometry::foe_shift`], is bounded for true
+    /// points within `2L` of the principal point).
+    pub(super) r1_cap: f32,
     /// `r₁` for every point when the stretch bound is frame-wide and no
-    /// rotation error is configured.
+    /// rotation error is configured, and it is within `r1_cap`.
     pub(super) frame_r1: Option<f32>,
     /// `frame_r1` when, moreover, every pixel of the frame-1 image passes
     /// step 1's checks ([`PairGeometry::certifies_image`]).
@@ -140,6 +144,7 @@ impl<'c> Pair<'c> {
         } else {
             f32::INFINITY
         };
+        let r1_cap = geom.r1_cap(config.e2);
         let frame_r1 = match geom.frame_disc_radius(config.e1) {
             // The composition's error of the matrix shifts every
             // compensated point: at most its bound where the view,
@@ -151,6 +156,8 @@ impl<'c> Pair<'c> {
             Some(r) if !rotation => Some(r + slack_r1).filter(|r| r.is_finite()),
             _ => None,
         };
+        // (Past the cap each point is judged alone, step 1's own test.)
+        let frame_r1 = frame_r1.filter(|&r| r <= r1_cap);
         // (`q_z` moves by at most `mr |q|` with the matrix, as by a
         // rotation error of `mr` about one axis: the configured box, not
         // the one widened for the points' shift.)
@@ -162,6 +169,7 @@ impl<'c> Pair<'c> {
             scale,
             slack_r1,
             slack_e2,
+            r1_cap,
             frame_r1,
             certified_r1: frame_r1.filter(|_| geom.certifies_image(cam1, depth_scale_error)),
             depth_scale_error,

@@ -123,8 +123,9 @@
 //!
 //! The exact geometry is that of the motion's matrix
 //! ([`Motion::rotation_matrix`]); how closely that matrix follows the
-//! angles is `Motion::new`'s (entries within `1.7·10⁻⁷`, measured over
-//! random angles to 60°), a rotation
+//! angles is `Motion::new`'s (entries within `2·10⁻⁷` for angles to
+//! 60°, `motion::tests::the_matrix_is_within_2e_7_of_its_angles_rotation`;
+//! `1.7·10⁻⁷` here until a review found 1.91·10⁻⁷), a rotation
 //! error of that size that [`crate::Config::with_rotation_error`] covers
 //! where it matters (a long focal length: `f · 10⁻⁷` pixels).
 //!

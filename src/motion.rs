@@ -271,6 +271,14 @@ impl Motion {
     }
 
     /// Rotation matrix `R` (frame-2 axes as columns, in frame-1 coordinates).
+    ///
+    /// For a motion from [`Motion::new`] every entry is within `2·10⁻⁷` of
+    /// the exact rotation of the angles given (tested against `f64` to the
+    /// 60° limit). The sticks are guaranteed for this matrix as the motion
+    /// given: where the angles are the truth and `f · 2·10⁻⁷` pixels
+    /// matter (focal lengths of thousands of pixels), that difference is
+    /// part of the motion's error, for a configured rotation error
+    /// ([`crate::Config::with_rotation_error`]) to hold with margin.
     pub fn rotation_matrix(&self) -> [[f32; 3]; 3] {
         self.rotation
     }
@@ -326,6 +334,62 @@ mod tests {
         assert_eq!(fwd.then(&back), Err(MotionError::ZeroTranslation));
         let turn = Motion::new([0.0, 0.0, 0.4], [0.0, 0.6, 0.0]).unwrap();
         assert_eq!(turn.then(&turn), Err(MotionError::RotationTooLarge));
+    }
+
+    /// The matrix [`Motion::new`] builds is within `2·10⁻⁷` of the exact
+    /// rotation its angles name, entry by entry (`f64`, `R = R_y(β) R_x(α)
+    /// R_z(γ)`), for angles to the 60° limit: the figure the docs give
+    /// for a rotation error that covers it (`crate::epipolar`, "The exact
+    /// geometry"). An adversarial review (thirtieth session) measured 3.2
+    /// units in the last place, 1.91·10⁻⁷, at the angles checked first
+    /// here, where the docs said 1.7·10⁻⁷.
+    #[test]
+    fn the_matrix_is_within_2e_7_of_its_angles_rotation() {
+        extern crate std;
+        let exact = |a: [f32; 3]| -> [[f64; 3]; 3] {
+            let [al, be, ga] = a.map(f64::from);
+            let rx = [
+                [1.0, 0.0, 0.0],
+                [0.0, al.cos(), -al.sin()],
+                [0.0, al.sin(), al.cos()],
+            ];
+            let ry = [
+                [be.cos(), 0.0, be.sin()],
+                [0.0, 1.0, 0.0],
+                [-be.sin(), 0.0, be.cos()],
+            ];
+            let rz = [
+                [ga.cos(), -ga.sin(), 0.0],
+                [ga.sin(), ga.cos(), 0.0],
+                [0.0, 0.0, 1.0],
+            ];
+            let mul = |x: [[f64; 3]; 3], y: [[f64; 3]; 3]| {
+                [0, 1, 2].map(|i| [0, 1, 2].map(|j| (0..3).map(|k| x[i][k] * y[k][j]).sum::<f64>()))
+            };
+            mul(mul(ry, rx), rz)
+        };
+        let off = |a: [f32; 3]| {
+            let m = Motion::new([0.0, 0.0, 1.0], a)
+                .expect("motion")
+                .rotation_matrix();
+            let r = exact(a);
+            (0..9)
+                .map(|k| (f64::from(m[k / 3][k % 3]) - r[k / 3][k % 3]).abs())
+                .fold(0.0, f64::max)
+        };
+        let found = off([-1.033_229, -0.937_258_06, -0.691_887_8]);
+        assert!((1.8e-7..=2.0e-7).contains(&found), "{found:e}");
+        let mut g = crate::test_rng::Rng(0x0a11_5e7e);
+        let mut worst = 0.0f64;
+        for _ in 0..200_000 {
+            let a = [0.0; 3].map(|_: f32| (g.next() * 2.0 - 1.0) * MAX_ROTATION_RAD);
+            worst = worst.max(off(a));
+        }
+        assert!(worst <= 2.0e-7, "{worst:e}");
+        assert!(
+            worst > 1.2e-7,
+            "the sample reaches near the bound: {worst:e}"
+        );
     }
 
     #[test]

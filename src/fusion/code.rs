@@ -163,8 +163,17 @@ impl DepthScale {
     /// limit before; the map's ends are never NaN (`down_for_entry`).
     #[inline(always)]
     pub(crate) fn up_no_nan(&self, z: f32) -> i32 {
+        self.up_no_nan_unclamped(z).max(1)
+    }
+
+    /// [`Self::up_no_nan`] before its clamp to 1: 0 or negative for `z`
+    /// below the smallest far code's depth (`z ≤ 0` included). The map's
+    /// entries compare it with their limit first and clamp after
+    /// (`map::retire::entry_of`).
+    #[inline(always)]
+    pub(crate) fn up_no_nan_unclamped(&self, z: f32) -> i32 {
         let b = (z * self.inv).to_bits() as i32;
-        ((b.wrapping_add(0x7FF) >> 11) - CODE_BASE).max(1)
+        (b.wrapping_add(0x7FF) >> 11) - CODE_BASE
     }
 
     /// `2 s`: from here on a far end's code is [`UNBOUNDED`] (and a near

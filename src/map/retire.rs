@@ -150,7 +150,7 @@ fn next_entry<'a>(
         &mut core::slice::Iter<'a, PointResult>,
     ),
     min_pairs: u8,
-    (cam, limit, scale): (&Camera, u16, &DepthScale),
+    (cam, limit, scale): (&Camera, i32, &DepthScale),
 ) -> Option<Option<Entry>> {
     // (A tight scan: on most drives most points are not admitted.)
     loop {
@@ -158,6 +158,18 @@ fn next_entry<'a>(
         if c.admitted(min_pairs) {
             return Some(entry_of(cam.normalise(r.pixel1()), c.ends(), limit, scale));
         }
+    }
+}
+
+/// The map's far limit ([`far_limit`]) as [`entry_of`] compares it with
+/// a far code before the code's clamp to 1: the limit itself, or for 0
+/// (no entry at all) `i32::MIN`, below every code.
+#[inline(always)]
+pub(super) fn entry_limit(limit: u16) -> i32 {
+    if limit == 0 {
+        i32::MIN
+    } else {
+        i32::from(limit)
     }
 }
 
@@ -184,24 +196,27 @@ fn next_entry<'a>(
 pub(super) fn entry_of(
     [x, y]: [f32; 2],
     (z_near, z_far): (f32, f32),
-    limit: u16,
+    limit: i32,
     scale: &DepthScale,
 ) -> Option<Entry> {
     // (Below `2⁻¹⁵ s` a near end is code 0, depth 0, and a far end code 1,
     // about `2⁻¹⁵ s`: the decoded ends hold the fused ones whatever they
     // are.)
     // (The ends are never NaN: a cell's, `DepthScale::down_for_entry`.)
-    let (near, far) = (scale.down_for_entry(z_near), scale.up_no_nan(z_far));
+    let (near, far) = (scale.down_for_entry(z_near), scale.up_no_nan_unclamped(z_far));
     // `|P_K|`'s bound on the true ray, the decoded far end times the
     // batch's ray bound: past `10³⁰` (a far ray of a wide-angle camera, or
     // such a scale) the map's `f32` arithmetic could overflow, so such a
     // point is left out too, as is one whose far end the codes cannot hold
     // (`UNBOUNDED` is above every limit).
-    if far > i32::from(limit) {
+    // (The far code is `up_no_nan`'s, `far.max(1)`: with `limit` from
+    // [`entry_limit`], `far > limit` is `far.max(1) > ` the map's limit,
+    // the clamp's constant out of the comparison.)
+    if far > limit {
         return None;
     }
     // (At most `limit`, below `UNBOUNDED`: a `u16`.)
-    let far = far as u16;
+    let far = far.max(1) as u16;
     Some(Entry { x, y, near, far })
 }
 
@@ -570,6 +585,7 @@ impl<const B: usize, const M: usize> RoadMap<B, M> {
         let mut cells = key.cells(k).get(from..).unwrap_or(&[]).iter();
         let mut points = results.points().get(from..).unwrap_or(&[]).iter();
         let total = cells.len();
+        let limit = entry_limit(limit);
         let mut next = || next_entry((&mut cells, &mut points), min_pairs, (&cam, limit, &scale));
         // The points left out count against `look` too: at most `look`
         // looked at, `n + unbounded`. (A review found the share passed by

@@ -1,5 +1,5 @@
 extern crate std;
-use super::retire::{entry_of, far_limit, ray_bound, Extent};
+use super::retire::{entry_limit, entry_of, far_limit, ray_bound, Extent};
 use super::*;
 use crate::camera::Pixel;
 use crate::test_rng::Rng;
@@ -97,7 +97,7 @@ fn batch_at_the_edge(g: &mut Rng, case: usize) -> (RoadMap<1, M>, Batch<1>, usiz
         let z_near = 0.01 + 999.0 * g.next() * g.next() * g.next();
         let z_far = z_near * (1.0 + 3.0 * g.next() * g.next() * g.next());
         let limit = far_limit(MAX_REACH / bound, &scale);
-        if let Some(e) = entry_of(ray, (z_near, z_far), limit, &scale) {
+        if let Some(e) = entry_of(ray, (z_near, z_far), entry_limit(limit), &scale) {
             extent.take(&e);
             map.entries[0][m] = e;
             m += 1;
@@ -536,7 +536,7 @@ fn whole_batch_bound_at_its_edges_over_any_camera() {
             let zn = zc * logu(&mut g, 0.2, 1.0) * if g.next() < 0.1 { 0.0 } else { 1.0 };
             let top = 1.1 + g.next() * 4.0;
             let zf = fmax(zn, zc * logu(&mut g, 1.0, top));
-            if let Some(e) = entry_of(r, (zn, zf), limit, &scale) {
+            if let Some(e) = entry_of(r, (zn, zf), entry_limit(limit), &scale) {
                 extent.take(&e);
                 map.entries[0][m] = e;
                 m += 1;
@@ -650,7 +650,7 @@ fn entries_against_the_clamped_codes() {
             near: scale.down(z_near),
             far: far as u16,
         });
-        let got = entry_of([0.5, -0.25], (z_near, z_far), limit, &scale);
+        let got = entry_of([0.5, -0.25], (z_near, z_far), entry_limit(limit), &scale);
         assert_eq!(got, want, "{z_near:e} {z_far:e} {limit} {s:e}");
         made += u32::from(got.is_some());
         top_near += u32::from(scale.down(z_near) == UNBOUNDED - 1);

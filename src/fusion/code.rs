@@ -94,7 +94,7 @@ impl DepthScale {
 
     /// [`Self::up`] before its clamp to `UNBOUNDED` (from `2 s` on, and
     /// for a NaN, above it; 0 for `z ≤ 0`, at least 1 for `z > 0`). With
-    /// [`Self::up`], the reference the tests hold [`Self::up_no_nan`] to
+    /// [`Self::up`], the reference the tests hold `up_no_nan` to
     /// (the map's far ends; the fusion's cells keep exact depths since the
     /// twenty-fourth session, [`super::key`]).
     #[cfg(test)]
@@ -120,7 +120,7 @@ impl DepthScale {
     /// (`z/s` at or above `2 − 2⁻¹²`, where [`Self::down`] clamps), the
     /// unclamped code's low 16 bits, a code of no meaning. There a far end
     /// at or above `z` has a far code of at least `UNBOUNDED`
-    /// ([`Self::up_no_nan`]), past every entry's limit, so no entry is
+    /// (`up_no_nan`, the tests' form), past every entry's limit, so no entry is
     /// made (an admitted cell's ends are in order, `z_near ≤ z_far`, and
     /// the codes are monotone: [`crate::map`]'s `entry_of`).
     /// `codes_without_their_test_agree` checks both, for every exponent of
@@ -161,12 +161,15 @@ impl DepthScale {
     /// got code 1 before and does now, and one whose bits are at least
     /// `0x7FFF_F801` wraps to code 1 now where it got a code past every
     /// limit before; the map's ends are never NaN (`down_for_entry`).
-    #[inline(always)]
+    /// (The tests' form since the thirtieth session: the map's entries
+    /// take [`Self::up_no_nan_unclamped`] and clamp after their limit's
+    /// comparison.)
+    #[cfg(test)]
     pub(crate) fn up_no_nan(&self, z: f32) -> i32 {
         self.up_no_nan_unclamped(z).max(1)
     }
 
-    /// [`Self::up_no_nan`] before its clamp to 1: 0 or negative for `z`
+    /// `up_no_nan` (the tests') before its clamp to 1: 0 or negative for `z`
     /// below the smallest far code's depth (`z ≤ 0` included). The map's
     /// entries compare it with their limit first and clamp after
     /// (`map::retire::entry_of`).
@@ -335,7 +338,7 @@ mod tests {
         }
     }
 
-    /// [`DepthScale::down_for_entry`] and [`DepthScale::up_no_nan`]
+    /// [`DepthScale::down_for_entry`] and `DepthScale::up_no_nan`
     /// against [`DepthScale::down`] and [`DepthScale::up_unclamped`] (at
     /// least 1) for every exponent of either sign, mantissas at the cut's
     /// edges and 64 random ones an exponent, each as it is and times the

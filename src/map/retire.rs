@@ -203,7 +203,10 @@ pub(super) fn entry_of(
     // about `2⁻¹⁵ s`: the decoded ends hold the fused ones whatever they
     // are.)
     // (The ends are never NaN: a cell's, `DepthScale::down_for_entry`.)
-    let (near, far) = (scale.down_for_entry(z_near), scale.up_no_nan_unclamped(z_far));
+    let (near, far) = (
+        scale.down_for_entry(z_near),
+        scale.up_no_nan_unclamped(z_far),
+    );
     // `|P_K|`'s bound on the true ray, the decoded far end times the
     // batch's ray bound: past `10³⁰` (a far ray of a wide-angle camera, or
     // such a scale) the map's `f32` arithmetic could overflow, so such a

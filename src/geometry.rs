@@ -20,7 +20,8 @@
 //! cell and `g₊` at an end or, where `g′ = cos θ − y sin θ` changes sign in
 //! the cell, `√(1 + y²)`), each widened by the rounding of `g` (the sine
 //! and cosine within `3·10⁻⁷`, the sum within two units: `10⁻⁶ (|y| +
-//! 1)` taken) and of the products (`2⁻²²` relative). The heights covered by
+//! 1)` taken) and of the products (`2⁻²²` relative, and `4 · 2⁻¹⁴⁹`
+//! absolute for subnormal ones: sticks below `10⁻³⁸`). The heights covered by
 //! all but a few (`outliers`, wrong matches) of those intervals are found
 //! by a sweep over their ends. A `(θ, h)` that agrees with the sticks has
 //! `h` in every widened interval of `θ`'s cell and part, so the parts with
@@ -184,6 +185,9 @@ const SUB_CELLS: u16 = 16;
 const G_ROUNDING: f32 = 1.0e-6;
 /// The relative rounding allowance of a product `Z g` (module docs).
 const PRODUCT_ROUNDING: f32 = 2.384_185_8e-7;
+/// The absolute allowance for the same products where they are
+/// subnormal: `4 · 2⁻¹⁴⁹`, more than three roundings of half of `2⁻¹⁴⁹`.
+const SUBNORMAL_ROUNDING: f32 = f32::from_bits(4);
 
 /// The tilt cell `[θ_a, θ_b]` with the sines and cosines of its ends.
 #[derive(Clone, Copy)]
@@ -211,9 +215,17 @@ impl Cell {
             return None;
         }
         let g_lo = fmax(fmin(ga, gb) - tol, 0.0);
+        // (Relative allowances hold for normal products; a subnormal one
+        // rounds by up to half of `2⁻¹⁴⁹`, absolutely, each of two
+        // roundings and the allowance's own: `SUBNORMAL_ROUNDING` more.
+        // An adversarial review, thirtieth session, found sticks at
+        // `5 · 2⁻¹⁴⁹` whose consistent height lay outside the range.)
         Some((
-            p.z_near * g_lo * (1.0 - PRODUCT_ROUNDING),
-            p.z_far * g_hi * (1.0 + PRODUCT_ROUNDING),
+            fmax(
+                p.z_near * g_lo * (1.0 - PRODUCT_ROUNDING) - SUBNORMAL_ROUNDING,
+                0.0,
+            ),
+            p.z_far * g_hi * (1.0 + PRODUCT_ROUNDING) + SUBNORMAL_ROUNDING,
         ))
     }
 }

@@ -271,3 +271,86 @@ fn points_behind_and_heights_outside_the_model() {
     assert!(matches!(common_rows_motion(1.0, tilt, 800.0, 480.0, 0.0), Ok(Some(f)) if f > 0.99));
     assert!(ground_interval(1.0, tilt, 0.3).unwrap().is_some());
 }
+
+/// Eqs. 3.1 and 3.2 from finite inputs against `f64`, where the products
+/// `f h w` and `Z (Z − w)` overflow or underflow although the disparity
+/// need not. An adversarial review (thirtieth session) found `NaN` for
+/// `f = h = z = 10²⁰`, `w = 1` (the truth 1), 0 for `h = 10⁻³⁰`, `w =
+/// 10⁻²³`, `z = 2·10⁻²³` (the truth 5·10⁻⁸) and `+∞` from eq. 3.2 for a
+/// point 2·10⁻²³ ahead (the truth 5·10²²). Those three, then 200 000
+/// inputs with magnitudes from 10⁻³⁰ to 10³⁰ (the point in front of both
+/// cameras, `tilt` 0 for eq. 3.2, where it is eq. 3.1): wherever the
+/// truth is a normal `f32` the result is within 10⁻⁵ of it, and it is
+/// never `NaN`.
+#[test]
+fn disparities_from_extreme_finite_inputs() {
+    let truth = |f: f32, h: f32, w: f32, z: f32| {
+        let (f, h, w, z) = (f64::from(f), f64::from(h), f64::from(w), f64::from(z));
+        f * h * w / (z * (z - w))
+    };
+    let check = |f: f32, h: f32, w: f32, z: f32| -> bool {
+        let want = truth(f, h, w, z);
+        let flat = disparity_flat(f, h, w, z);
+        let tilted = disparity_tilted(f, h, w, z, 0.0).expect("tilt");
+        assert!(
+            !flat.is_nan() && !tilted.is_nan(),
+            "{f:e} {h:e} {w:e} {z:e}"
+        );
+        let normal =
+            want.abs() >= f64::from(f32::MIN_POSITIVE) && want.abs() <= f64::from(f32::MAX) * 0.999;
+        if normal {
+            for got in [flat, tilted] {
+                let rel = (f64::from(got) / want - 1.0).abs();
+                assert!(
+                    rel <= 1.0e-5,
+                    "{f:e} {h:e} {w:e} {z:e}: {got:e} against {want:e}"
+                );
+            }
+        }
+        normal
+    };
+    assert!(check(1.0e20, 1.0e20, 1.0, 1.0e20));
+    assert!(check(1.0, 1.0e-30, 1.0e-23, 2.0e-23));
+    assert!(check(1.0, 1.0, 1.0e-23, 2.0e-23));
+    let mut g = host_tests::synth::Rng(0xd15a_7e11);
+    let mut normal = 0;
+    for _ in 0..200_000 {
+        let mag = |g: &mut host_tests::synth::Rng| 10f64.powf(g.uniform(-30.0, 30.0)) as f32;
+        let (f, h, w) = (mag(&mut g), mag(&mut g), mag(&mut g));
+        let z = w + mag(&mut g);
+        if !(z.is_finite() && z > 0.0 && z - w > 0.0) {
+            continue;
+        }
+        normal += usize::from(check(f, h, w, z));
+    }
+    assert!(normal > 50_000, "{normal}");
+}
+
+/// `common_rows_motion` is a fraction, in `[0, 1]`, also where the
+/// horizon lies at the view's lower edge and `seen` is a sliver of a row
+/// (an adversarial review, thirtieth session: 26 at these values; the
+/// truth, `f64`, 0.99999999).
+#[test]
+fn common_rows_is_a_fraction_at_the_horizon() {
+    let got = common_rows_motion(
+        2.174_372,
+        -1.503_178_7,
+        492.561_95,
+        14_546.834,
+        0.000_254_892_66,
+    )
+    .expect("angles")
+    .expect("ground seen");
+    assert!((0.0..=1.0).contains(&got), "{got}");
+    let mut g = host_tests::synth::Rng(0xf4ac_7105);
+    for _ in 0..200_000 {
+        let h = g.uniform(0.1, 5.0) as f32;
+        let tilt = g.uniform(-1.6, 1.6) as f32;
+        let fy = g.uniform(100.0, 2000.0) as f32;
+        let rows = g.uniform(10.0, 20_000.0) as f32;
+        let w = 10f64.powf(g.uniform(-5.0, 1.0)) as f32;
+        if let Some(x) = common_rows_motion(h, tilt, fy, rows, w).expect("angles") {
+            assert!((0.0..=1.0).contains(&x), "{h} {tilt} {fy} {rows} {w}: {x}");
+        }
+    }
+}

@@ -609,3 +609,41 @@ fn a_wrong_match_above_the_horizon_anywhere_in_the_input() {
     }
     assert!(results.windows(2).all(|w| w[0] == w[1]), "{results:?}");
 }
+
+/// Sticks of subnormal depths: a consistent `(θ, h)` lies in the ranges.
+/// An adversarial review (thirtieth session): every sample at depth `5 ·
+/// 2⁻¹⁴⁹` with `y = 0`, so that `θ = 60°`, `h = Z sin 60° ≈ 4.33 · 2⁻¹⁴⁹`
+/// puts each exactly on its stick, and the height range was `[0, 4 ·
+/// 2⁻¹⁴⁹]`: the products' allowance was relative only. Then depths of 1
+/// to 64 units of `2⁻¹⁴⁹`, each at the tilts 0°, 30° and 60°.
+#[test]
+fn subnormal_sticks_keep_their_consistent_heights() {
+    for bits in [5u32, 1, 2, 3, 7, 16, 64] {
+        let z = f32::from_bits(bits);
+        let left: Vec<Sample> = (0..10)
+            .map(|i| Sample {
+                x: -0.5 + 0.01 * i as f32,
+                y: 0.0,
+                z_near: z,
+                z_far: z,
+            })
+            .collect();
+        let right: Vec<Sample> = left.iter().map(|s| Sample { x: -s.x, ..*s }).collect();
+        let g = road_geometry::<64>(&[(&left, &right)], 0).expect("consistent");
+        for deg in [0.0f64, 30.0, 60.0] {
+            let theta = deg.to_radians();
+            let h = f64::from(z) * theta.sin();
+            assert!(
+                f64::from(g.tilt.lo) <= theta && theta <= f64::from(g.tilt.hi),
+                "{bits}: {deg}° not in {:?}",
+                g.tilt
+            );
+            assert!(
+                f64::from(g.height.lo) <= h && h <= f64::from(g.height.hi),
+                "{bits}, {deg}°: h = {h:e} not in [{:e}, {:e}]",
+                g.height.lo,
+                g.height.hi
+            );
+        }
+    }
+}

@@ -74,8 +74,11 @@ pub fn disparity_flat(f: f32, h: f32, w: f32, z: f32) -> f32 {
 /// result itself overflows or underflows. 0 for a zero factor; a
 /// non-finite factor keeps the plain quotient.
 fn quotient([f, h, w]: [f32; 3], [a, b]: [f32; 2]) -> f32 {
-    let (num, den) = (f * h * w, a * b);
-    if num.is_normal() && den.is_normal() {
+    let fh = f * h;
+    let (num, den) = (fh * w, a * b);
+    // (Every partial product normal: `f h` too, which a reviewer found
+    // subnormal under a normal `f h w`, 1.45 % off.)
+    if fh.is_normal() && num.is_normal() && den.is_normal() {
         return num / den;
     }
     if f == 0.0 || h == 0.0 || w == 0.0 {

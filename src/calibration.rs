@@ -579,16 +579,18 @@ impl Intrinsics {
 /// roll of the model gives), or if the fit is ill-conditioned: the roll
 /// within about 2.9° of 45° + k·90° ([`MIN_STEPWISE_CONDITION`]), where
 /// the diagonal FOEs lie near the image axes and the perpendicularity
-/// test cannot tell the aspect ratio. Elsewhere an FOE error of `δ` px
-/// moves `r² = (f_x/f_y)²` by about `√2 δ (1/f_x + 1/f_y)/|cos 2γ|` of
-/// itself (`d_x`'s error relative to `f_x`, `d_y`'s to `f_y`; with square
-/// pixels `4 δ / (L |cos 2γ|)`, `L` the diagonal FOEs' distance from the
-/// straight one: at the limit, `δ = 0.5` and `L = 1 000`, 2 %); away from
-/// those rolls about `√2 δ (1/f_x + 1/f_y)`. Every sign pattern of errors
-/// of `δ` on the five FOEs stays within 1.002 times it for aspects from
-/// 1/10 to 10 (host test `stepwise_sensitivity_for_any_aspect`; the
-/// square-pixel form, quoted here until an adversarial review in the
-/// thirtieth session, fell 3.9 times short at `f = (100, 1 000)`).
+/// test cannot tell the aspect ratio. Elsewhere FOE errors of `δ` px
+/// along the diagonals move `r² = (f_x/f_y)²` by about `√2 δ (1/f_x +
+/// 1/f_y)/|cos 2γ|` of itself (`d_x`'s error relative to `f_x`, `d_y`'s
+/// to `f_y`; with square pixels `4 δ / (L |cos 2γ|)`, `L` the diagonal
+/// FOEs' distance from the straight one: at the limit, `δ = 0.5` and `L =
+/// 1 000`, 2 %), and errors of length `δ` in any direction by at most
+/// `√2` times that, `2 δ (1/f_x + 1/f_y)/|cos 2γ|`. Measured for aspects
+/// from 1/10 to 10 (host test `stepwise_sensitivity_for_any_aspect`):
+/// every sign pattern along the diagonals within 1.002 times the first
+/// form, errors in eight directions each within 0.92 times the second.
+/// (The square-pixel form, quoted here until an adversarial review in
+/// the thirtieth session, fell 3.9 times short at `f = (100, 1 000)`.)
 pub fn calibrate_stepwise(
     straight: Pixel,
     diagonal: [Pixel; 4],

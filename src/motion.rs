@@ -272,10 +272,12 @@ impl Motion {
 
     /// Rotation matrix `R` (frame-2 axes as columns, in frame-1 coordinates).
     ///
-    /// For a motion from [`Motion::new`] every entry is within `2·10⁻⁷` of
-    /// the exact rotation of the angles given (tested against `f64` to the
-    /// 60° limit). The sticks are guaranteed for this matrix as the motion
-    /// given: where the angles are the truth and `f · 2·10⁻⁷` pixels
+    /// For a motion from [`Motion::new`] every entry is within `3·10⁻⁷` of
+    /// the exact rotation of the angles given, as far as searched against
+    /// `f64` to the 60° limit (measured, not derived: the test
+    /// `the_matrix_is_within_3e_7_of_its_angles_rotation`). The sticks are
+    /// guaranteed for this matrix as the motion
+    /// given: where the angles are the truth and `f · 3·10⁻⁷` pixels
     /// matter (focal lengths of thousands of pixels), that difference is
     /// part of the motion's error, for a configured rotation error
     /// ([`crate::Config::with_rotation_error`]) to hold with margin.
@@ -336,15 +338,18 @@ mod tests {
         assert_eq!(turn.then(&turn), Err(MotionError::RotationTooLarge));
     }
 
-    /// The matrix [`Motion::new`] builds is within `2·10⁻⁷` of the exact
+    /// The matrix [`Motion::new`] builds is within `3·10⁻⁷` of the exact
     /// rotation its angles name, entry by entry (`f64`, `R = R_y(β) R_x(α)
-    /// R_z(γ)`), for angles to the 60° limit: the figure the docs give
-    /// for a rotation error that covers it (`crate::epipolar`, "The exact
-    /// geometry"). An adversarial review (thirtieth session) measured 3.2
-    /// units in the last place, 1.91·10⁻⁷, at the angles checked first
-    /// here, where the docs said 1.7·10⁻⁷.
+    /// R_z(γ)`), for angles to the 60° limit, as far as searched: 200 000
+    /// random triples, then a hill climb from the 64 worst of them,
+    /// nudging each angle by up to 2¹⁶ units in the last place. Measured,
+    /// not derived (the sines and cosines themselves are pinned within
+    /// `3·10⁻⁷` of `libm`'s at 2 001 points, `math`). The docs said
+    /// 1.7·10⁻⁷ until an adversarial review (thirtieth session) found
+    /// 1.91·10⁻⁷, then 2·10⁻⁷ until a reviewer's climb found 2.74·10⁻⁷ at
+    /// the angles checked first here.
     #[test]
-    fn the_matrix_is_within_2e_7_of_its_angles_rotation() {
+    fn the_matrix_is_within_3e_7_of_its_angles_rotation() {
         extern crate std;
         let exact = |a: [f32; 3]| -> [[f64; 3]; 3] {
             let [al, be, ga] = a.map(f64::from);
@@ -377,18 +382,39 @@ mod tests {
                 .map(|k| (f64::from(m[k / 3][k % 3]) - r[k / 3][k % 3]).abs())
                 .fold(0.0, f64::max)
         };
-        let found = off([-1.033_229, -0.937_258_06, -0.691_887_8]);
-        assert!((1.8e-7..=2.0e-7).contains(&found), "{found:e}");
+        let found = off([-0.921_213_4, -1.027_005_3, 0.859_918_5]);
+        assert!((2.7e-7..=3.0e-7).contains(&found), "{found:e}");
         let mut g = crate::test_rng::Rng(0x0a11_5e7e);
-        let mut worst = 0.0f64;
+        let mut starts = std::vec::Vec::new();
         for _ in 0..200_000 {
             let a = [0.0; 3].map(|_: f32| (g.next() * 2.0 - 1.0) * MAX_ROTATION_RAD);
-            worst = worst.max(off(a));
+            starts.push((off(a), a));
         }
-        assert!(worst <= 2.0e-7, "{worst:e}");
+        starts.sort_by(|x, y| y.0.total_cmp(&x.0));
+        let mut worst = starts.first().map_or(0.0, |s| s.0);
+        // A hill climb from the 64 worst: nudge one angle by ±2^j units
+        // in the last place (j up to 16), keep what is worse.
+        for &(mut best, mut a) in starts.iter().take(64) {
+            for _ in 0..600 {
+                let i = (g.next() * 3.0) as usize % 3;
+                let step = 1i32 << ((g.next() * 17.0) as i32).clamp(0, 16);
+                let step = if g.next() < 0.5 { step } else { -step };
+                let mut b = a;
+                b[i] = f32::from_bits(b[i].to_bits().wrapping_add_signed(step));
+                if !(b[i].abs() <= MAX_ROTATION_RAD) {
+                    continue;
+                }
+                let e = off(b);
+                if e > best {
+                    (best, a) = (e, b);
+                }
+            }
+            worst = worst.max(best);
+        }
+        assert!(worst <= 3.0e-7, "{worst:e}");
         assert!(
-            worst > 1.2e-7,
-            "the sample reaches near the bound: {worst:e}"
+            worst > 2.0e-7,
+            "the climb reaches near the bound: {worst:e}"
         );
     }
 

@@ -1439,9 +1439,11 @@ mod tests {
     /// image (`L` = 33.2 px), the focus far down the diagonal (`D` ≈
     /// 1 400 px), frame 1's camera centred 23 px further out so that its
     /// points compensate to near the view's corner. Below the cap (`e₂` =
-    /// 30 px) the points are searched (their band, wider than the image,
-    /// holds the boundary's ends: `BoundaryEnd`); past it (34 px) every
-    /// one is `OutOfView`, where before the cap they were searched too.
+    /// 30 px, and `L − 0.6` with `r₁` about 0.5) the points are searched
+    /// (their band, wider than the image, holds the boundary's ends:
+    /// `BoundaryEnd`); past it (`L − 0.45`, 34 px) every one is
+    /// `OutOfView`, where before the cap they were searched too. (A
+    /// reviewer asked for both sides of the cap: a cap 1 px off fails.)
     #[test]
     fn points_whose_disc_with_e2_passes_the_views_reach_are_refused() {
         use crate::camera::{Camera, Pixel};
@@ -1464,8 +1466,11 @@ mod tests {
         let geom = crate::epipolar::PairGeometry::new(&cam1, &cam2, &motion);
         let l = geom.view_reach();
         assert!((33.0..33.5).contains(&l), "{l}");
-        let mut refused = [0usize; 2];
-        for (n, e2) in refused.iter_mut().zip([30.0f32, 34.0]) {
+        // Either side of the cap itself: `r₁` is about `e₁` = 0.5 px here
+        // (a pure translation between two cameras of one focal length),
+        // so `e₂ = L − 0.6` leaves it under the cap and `L − 0.45` over.
+        let mut refused = [0usize; 4];
+        for (n, e2) in refused.iter_mut().zip([30.0f32, l - 0.6, l - 0.45, 34.0]) {
             let config = Config::new(0.5, e2, 10.0, 1.0e6).expect("config");
             let mut p = Processor::<16, 1>::new(config);
             p.process(&f1, None).expect("frame 1");
@@ -1479,6 +1484,6 @@ mod tests {
                 .filter(|r| r.status() == Status::OutOfView)
                 .count();
         }
-        assert_eq!(refused, [0, 5]);
+        assert_eq!(refused, [0, 0, 5, 5]);
     }
 }

@@ -382,38 +382,51 @@ fn foe_rounding_holds() {
 /// beyond, `1 − 1/k = 1 − (D − L − r₁)/(D + L + e₂)`; backwards the
 /// other way round, `1 − k = 1 − (D − L − e₂)/(D + L + r₁)`. Both are
 /// checked for every split of `L` between `r₁` and `e₂`, on images from
-/// 2 × 2 to 512 × 480 px, foci from the image to 10⁶ px away and `eps`
-/// from the focus's own rounding to 100 px. At `r₁ + e₂ = L` the bound
-/// is reached (within 10⁻⁴). Past the cap, at `r₁ + e₂ = 3L`, the factor
-/// before the review, `4L/D` from `D > 2L` on, falls short: why step 1
-/// refuses such points.
+/// 2 × 2 to 512 × 480 px, focal lengths from 1 to 10⁵ px, foci from the
+/// image to 10²³ px away (a reviewer found the shift 0 past 1.8·10¹⁹ px,
+/// where `ex² + ey²` overflowed; over 20 foci past that) and `eps` from the focus's own rounding
+/// to 100 px. At `r₁ + e₂ = L` the bound is reached (within 10⁻⁴). Then,
+/// without the argument's placement, random ones: a true focus within
+/// `eps` of the computed one, a frame-1 point anywhere within `L + r₁` of
+/// `c₂`, and the extreme `k` that keeps the correspondent `e + k (p₁' −
+/// e)` within `L + e₂` (a quadratic in `k`), forwards (`k ≥ 1`, the
+/// largest) and backwards (`k ≤ 1`, the smallest). Past the cap, at
+/// `r₁ + e₂ = 3L`, the factor before the review, `4L/D` from `D > 2L`
+/// on, falls short: why step 1 refuses such points.
 #[test]
 fn foe_shift_holds_for_true_points_out_of_view() {
     let mut rng = Rng(0xf0e_5a1f);
     let (mut checked, mut tightest, mut old_short) = (0u32, f64::INFINITY, 0u32);
+    let (mut placed, mut far) = (0u32, 0u32);
     for case in 0..4_000 {
         let (w, h) = [(2u16, 2u16), (4, 4), (16, 16), (64, 48), (512, 480)][case % 5];
-        let f = [1.0f32, 16.0, 800.0][case / 5 % 3];
-        let cam = Camera::new(
+        let f = [1.0f32, 16.0, 800.0, 1.0e5][case / 5 % 4];
+        // (A focal length the camera refuses for its size is skipped.)
+        let Ok(cam) = Camera::new(
             f,
             fmax(1.0, f * (0.5 + rng.next())),
             f32::from(w - 1) * rng.next(),
             f32::from(h - 1) * rng.next(),
             w,
             h,
-        )
-        .expect("camera");
-        // Foci from near the image to 10⁶ px: `W` from 1 down to 10⁻⁶
+        ) else {
+            continue;
+        };
+        // Foci from near the image to 10²³ px: `W` from 1 down to 10⁻¹⁸
         // of `|T|`, either sign.
-        let wz = 10.0f32.powf(-6.0 * rng.next()) * if rng.next() < 0.5 { 1.0 } else { -1.0 };
+        let wz = 10.0f32.powf(-18.0 * rng.next()) * if rng.next() < 0.5 { 1.0 } else { -1.0 };
         let t = [rng.next() - 0.5, rng.next() - 0.5, wz];
-        let a = [0.0; 3].map(|_: f32| (rng.next() - 0.5) * 0.2);
+        // (Half without a rotation: a turn mixes `U` into `W'` and keeps
+        // the focus near.)
+        let turn = if case % 2 == 0 { 0.2 } else { 0.0 };
+        let a = [0.0; 3].map(|_: f32| (rng.next() - 0.5) * turn);
         let Ok(m) = Motion::new(t, a) else { continue };
         let g = PairGeometry::new(&cam, &cam, &m);
         let Some(e) = g.focus_of_expansion() else {
             continue;
         };
         let l = f64::from(g.view_reach());
+        far += u32::from(f64::from(e.u - g.c2[0]).hypot(f64::from(e.v - g.c2[1])) > 2.0e19);
         let (dx, dy) = (f64::from(e.u - g.c2[0]), f64::from(e.v - g.c2[1]));
         for eps in [g.foe_rounding(), 0.01, 1.0, 100.0] {
             let shift = f64::from(g.foe_shift_of(eps));
@@ -421,10 +434,12 @@ fn foe_shift_holds_for_true_points_out_of_view() {
             let d = ((dx * dx + dy * dy).sqrt() - eps).max(0.0);
             for s in [0.0, 0.25, 0.5, 0.75, 1.0] {
                 let (r1, e2) = (s * l, (1.0 - s) * l);
+                // (`1 − a/b` as `(b − a)/b`: for a focus 10¹⁵ px away the
+                // difference cancels in `f64` too.)
                 let ratio = |near: f64, far: f64| {
                     let (a, b) = (d - l - near, d + l + far);
                     if a > 0.0 {
-                        1.0 - a / b
+                        (2.0 * l + near + far) / b
                     } else {
                         1.0
                     }
@@ -436,14 +451,56 @@ fn foe_shift_holds_for_true_points_out_of_view() {
                 }
                 checked += 1;
             }
+            // Random placements: the extreme `k` for a frame-1 point
+            // anywhere in its disc and a true focus anywhere within `eps`.
+            for _ in 0..4 {
+                let split = f64::from(rng.next());
+                let (r1, e2) = (split * l, (1.0 - split) * l);
+                let turn = |rng: &mut Rng| f64::from(rng.next()) * core::f64::consts::TAU;
+                let (t1, t2) = (turn(&mut rng), turn(&mut rng));
+                let ef = f64::from(rng.next()) * eps;
+                let et = [dx + ef * t1.cos(), dy + ef * t1.sin()];
+                let rp = (l + r1) * f64::from(rng.next()).sqrt();
+                let p = [rp * t2.cos(), rp * t2.sin()];
+                // `p₂ = p + s v`, `v` the unit vector from the focus
+                // through `p` (`k = 1 + s/|p − e|`): `|p + s v|² = (L +
+                // e₂)²`, a quadratic in `s` in pixels, well conditioned
+                // however far the focus (in `k` it cancels).
+                let u = [p[0] - et[0], p[1] - et[1]];
+                let nu = u[0].hypot(u[1]);
+                let v = [u[0] / nu, u[1] / nu];
+                let pv = p[0] * v[0] + p[1] * v[1];
+                let disc = pv * pv - (p[0] * p[0] + p[1] * p[1]) + (l + e2) * (l + e2);
+                if !(nu > 0.0 && disc >= 0.0) {
+                    continue;
+                }
+                let (s_lo, s_hi) = (-pv - disc.sqrt(), -pv + disc.sqrt());
+                let mut ratio = 0.0f64;
+                // Forwards, `k ≥ 1`: `1 − 1/k = s/(|p − e| + s)`, largest at `s_hi`.
+                if s_hi >= 0.0 {
+                    ratio = ratio.max(s_hi / (nu + s_hi));
+                }
+                // Backwards, `0 < k ≤ 1`: `1 − k = −s/|p − e|`, largest at `s_lo`.
+                if s_lo <= 0.0 && s_hi > -nu {
+                    ratio = ratio.max((-s_lo).min(nu) / nu);
+                }
+                let moved = ratio * eps;
+                assert!(
+                    moved <= shift * (1.0 + 1.0e-9),
+                    "case {case} eps {eps}: placed {moved} > {shift}"
+                );
+                placed += 1;
+            }
             // Past the cap: the old factor.
             if d > 4.0 * l {
-                let (a, b) = (d - 3.0 * l, d + 2.0 * l);
-                old_short += u32::from(1.0 - a / b > 4.0 * l / d);
+                old_short += u32::from(5.0 * l / (d + 2.0 * l) > 4.0 * l / d);
             }
         }
     }
-    assert!(checked > 50_000, "{checked}");
+    assert!(
+        checked > 50_000 && placed > 30_000 && far > 20,
+        "{checked} {placed} {far}"
+    );
     assert!(tightest < 1.0001, "{tightest}");
     assert!(old_short > 100, "{old_short}");
 }

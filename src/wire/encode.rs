@@ -229,6 +229,11 @@ impl<'a> FramePacket<'a> {
         // taken 10⁻⁵ larger, relative and absolute, for the square root and
         // the sum's rounding; `radius_to_raw` rounds up.)
         let mut moved = 0.0f32;
+        // Whether any point moved at all: below about 2⁻⁷⁵ px both squares
+        // underflow to 0, and such a point still moved (an adversarial
+        // review, thirtieth session: `u = 10⁻³⁰` sent as 0 with the radius
+        // 0); the absolute 10⁻⁵ covers it.
+        let mut any = false;
         // The row order the receiver checks (`Boundary`'s): rows strictly
         // monotone. Where the points as given keep it, the rounded rows
         // must too (rounding is monotone, but rows 1/32 px apart can round
@@ -253,10 +258,11 @@ impl<'a> FramePacket<'a> {
             last = Some((p.v, v));
             let (du, dv) = (raw_to_px(u) - p.u, raw_to_px(v) - p.v);
             moved = crate::math::fmax(moved, du * du + dv * dv);
+            any |= du != 0.0 || dv != 0.0;
             self.w.u16(u)?;
             self.w.u16(v)?;
         }
-        let shift = if moved > 0.0 {
+        let shift = if any {
             crate::math::sqrt(moved) * (1.0 + 1.0e-5) + 1.0e-5
         } else {
             0.0

@@ -737,6 +737,53 @@ fn run_fused_judges_the_motion_bounds_it_uses() {
     assert!(paired_absent >= 2, "{paired_absent}");
 }
 
+/// A point off the 1/16 px grid by less than about 2⁻⁷⁵ px moves when it
+/// is sent, though both squares of its move underflow to 0: the radius
+/// sent still covers it (an adversarial review, thirtieth session: `u =
+/// 10⁻³⁰`, radius 0, sent with radius 0), for offsets of either sign in
+/// either coordinate from the grid point (0, 0) and radii on the 1/256 px
+/// grid.
+#[test]
+fn the_radius_sent_covers_a_move_whose_square_underflows() {
+    for (du, dv) in [
+        (1.0e-30f32, 0.0f32),
+        (0.0, 1.0e-30),
+        (-1.0e-38, 0.0),
+        (f32::from_bits(1), 0.0),
+    ] {
+        for r in [0.0f32, 0.5, 1.0] {
+            // (Off the grid point (0, 0) by `(du, dv)`: near zero, where
+            // such offsets are not absorbed.)
+            let pts = [Pixel::new(du, dv), Pixel::new(5.0, 20.0)];
+            let mut raw = vec![0u8; frame_packet_max(64, 4)];
+            let head = FrameHead {
+                timestamp_us: 1,
+                frame_id: 1,
+                width: 512,
+                height: 480,
+            };
+            let bh = BoundaryHead {
+                quality: 0,
+                radius_px: r,
+            };
+            let n = encode::frame(&mut raw, IDS.frame, 0, &head, &[(bh, &pts)]).expect("encodes");
+            let mut d = Decoder::<64, 2>::new(IDS);
+            run(&mut d, &[vec![0u8], camera_packet(0)].concat(), 9);
+            let out = run(&mut d, &link(&raw[..n]), 9);
+            let [Out::Frame(f, info, 0)] = &out[..] else {
+                panic!("{out:?}")
+            };
+            let q = f.boundaries()[0].points()[0];
+            assert_eq!((q.u, q.v), (0.0, 0.0));
+            assert!(
+                info.radius_px[0] > r,
+                "{du:e} {dv:e}, radius {r}: sent {}",
+                info.radius_px[0]
+            );
+        }
+    }
+}
+
 /// The radius a frame packet carries bounds the true point's distance from
 /// the point as sent: the declared radius plus what the rounding to
 /// 1/16 px moved each point (exactly, in `f64`), for points anywhere on

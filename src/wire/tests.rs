@@ -737,6 +737,31 @@ fn run_fused_judges_the_motion_bounds_it_uses() {
     assert!(paired_absent >= 2, "{paired_absent}");
 }
 
+/// One boundary of `pts` with radius `r` encoded in a 512 × 480 frame
+/// packet and decoded after a camera packet: the boundary's points as
+/// sent and the radius the packet carries; the encoder's error, if any.
+fn sent_boundary(pts: &[Pixel], r: f32) -> Result<(Vec<Pixel>, f32), encode::EncodeError> {
+    let mut raw = vec![0u8; frame_packet_max(64, 4)];
+    let head = FrameHead {
+        timestamp_us: 1,
+        frame_id: 1,
+        width: 512,
+        height: 480,
+    };
+    let bh = BoundaryHead {
+        quality: 0,
+        radius_px: r,
+    };
+    let n = encode::frame(&mut raw, IDS.frame, 0, &head, &[(bh, pts)])?;
+    let mut d = Decoder::<64, 2>::new(IDS);
+    run(&mut d, &[vec![0u8], camera_packet(0)].concat(), 9);
+    let out = run(&mut d, &link(&raw[..n]), 9);
+    let [Out::Frame(f, info, 0)] = &out[..] else {
+        panic!("{out:?}")
+    };
+    Ok((f.boundaries()[0].points().to_vec(), info.radius_px[0]))
+}
+
 /// A point off the 1/16 px grid by less than about 2⁻⁷⁵ px moves when it
 /// is sent, though both squares of its move underflow to 0: the radius
 /// sent still covers it (an adversarial review, thirtieth session: `u =
@@ -755,31 +780,9 @@ fn the_radius_sent_covers_a_move_whose_square_underflows() {
             // (Off the grid point (0, 0) by `(du, dv)`: near zero, where
             // such offsets are not absorbed.)
             let pts = [Pixel::new(du, dv), Pixel::new(5.0, 20.0)];
-            let mut raw = vec![0u8; frame_packet_max(64, 4)];
-            let head = FrameHead {
-                timestamp_us: 1,
-                frame_id: 1,
-                width: 512,
-                height: 480,
-            };
-            let bh = BoundaryHead {
-                quality: 0,
-                radius_px: r,
-            };
-            let n = encode::frame(&mut raw, IDS.frame, 0, &head, &[(bh, &pts)]).expect("encodes");
-            let mut d = Decoder::<64, 2>::new(IDS);
-            run(&mut d, &[vec![0u8], camera_packet(0)].concat(), 9);
-            let out = run(&mut d, &link(&raw[..n]), 9);
-            let [Out::Frame(f, info, 0)] = &out[..] else {
-                panic!("{out:?}")
-            };
-            let q = f.boundaries()[0].points()[0];
-            assert_eq!((q.u, q.v), (0.0, 0.0));
-            assert!(
-                info.radius_px[0] > r,
-                "{du:e} {dv:e}, radius {r}: sent {}",
-                info.radius_px[0]
-            );
+            let (q, sent) = sent_boundary(&pts, r).expect("encodes");
+            assert_eq!((q[0].u, q[0].v), (0.0, 0.0));
+            assert!(sent > r, "{du:e} {dv:e}, radius {r}: sent {sent}");
         }
     }
 }
@@ -810,31 +813,14 @@ fn the_radius_sent_covers_the_rounding_of_the_points() {
                 )
             })
             .collect();
-        let mut raw = vec![0u8; frame_packet_max(64, 4)];
-        let head = FrameHead {
-            timestamp_us: 1,
-            frame_id: 1,
-            width: 512,
-            height: 480,
-        };
-        let bh = BoundaryHead {
-            quality: 0,
-            radius_px: r,
-        };
-        let n = match encode::frame(&mut raw, IDS.frame, 0, &head, &[(bh, &pts)]) {
-            Ok(n) => n,
+        let (points, radius) = match sent_boundary(&pts, r) {
+            Ok(sent) => sent,
             // (99.9 px plus the rounding can pass the 100 px limit.)
             Err(encode::EncodeError::Radius) if r > 99.0 => continue,
             Err(e) => panic!("{e:?}"),
         };
-        let mut d = Decoder::<64, 2>::new(IDS);
-        run(&mut d, &[vec![0u8], camera_packet(0)].concat(), 9);
-        let out = run(&mut d, &link(&raw[..n]), 9);
-        let [Out::Frame(f, info, 0)] = &out[..] else {
-            panic!("{out:?}")
-        };
-        let sent = f64::from(info.radius_px[0]);
-        for (p, q) in pts.iter().zip(f.boundaries()[0].points()) {
+        let sent = f64::from(radius);
+        for (p, q) in pts.iter().zip(&points) {
             let moved = (f64::from(q.u) - f64::from(p.u)).hypot(f64::from(q.v) - f64::from(p.v));
             assert!(
                 moved + f64::from(r) <= sent,
@@ -842,7 +828,7 @@ fn the_radius_sent_covers_the_rounding_of_the_points() {
             );
         }
         if on_grid {
-            assert_eq!(info.radius_px[0], raw_to_radius(radius_to_raw(r).unwrap()));
+            assert_eq!(radius, raw_to_radius(radius_to_raw(r).unwrap()));
         } else {
             widened += usize::from(sent > f64::from(r) + 1.0 / 256.0);
         }

@@ -63,7 +63,7 @@
 //! `w = 8` some random scenarios lose most of their points. Pairs across
 //! several frames walk longer: on the fusion's random drives 24 of 304
 //! have a pair where the cap changes points, 59 of them `over_budget`, 3
-//! of those `ok` without the cap (`host_tests/tests/fusion.rs`,
+//! of those `ok` without the cap (`host_tests/tests/fusion/`,
 //! `the_deadline_cap_on_the_drives`). A firmware
 //! that needs `process`'s results whenever its clock does not fire should
 //! give a larger `w`, or a clock whose [`Deadline::carry`] is larger.

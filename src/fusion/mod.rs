@@ -112,7 +112,7 @@
 //! then `⌈k/2⌉ ≥ share`, so `k ≥ share`).
 //! (The bench's jumping road, 455 conflicts in a retiring step: 88.7
 //! instructions a key-frame point without the cut, 74.9 with it;
-//! `host_tests/tests/fusion.rs`,
+//! `host_tests/tests/fusion/`,
 //! `a_retiring_step_whose_pass_conflicts_enters_less_and_the_rest_next`.)
 //!
 //! Between the two steps the map holds the points entered so far (each
@@ -131,7 +131,7 @@
 //! twenty-second session it retired whole, a review's 108 instructions a
 //! key-frame point). A share of 1000 ‰ retires every key frame whole.
 //! The map after the next step is the one a whole retirement leaves (the
-//! same points, bounds and counts: `host_tests/tests/fusion.rs`,
+//! same points, bounds and counts: `host_tests/tests/fusion/`,
 //! `a_retirement_over_two_steps_leaves_the_whole_ones_map` and
 //! `a_retirement_at_a_motion_limit_over_two_steps_leaves_the_whole_ones_map`).
 //!

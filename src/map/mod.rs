@@ -37,7 +37,7 @@
 //! sum, `Z_far λ + ρ + φ |P_K|`, as its `radius`: the true point is within
 //! `radius` of the stick. (The radius left out `Z_far λ` until an
 //! adversarial review found it: about `0.49 Z/800` missing with the
-//! key-frame pixels 0.49 px off, `host_tests/tests/fusion.rs`.)
+//! key-frame pixels 0.49 px off, `host_tests/tests/fusion/`.)
 //!
 //! The `f32` arithmetic is bounded the same way, as a motion error that
 //! is always there, configured bounds or not (a second review found map

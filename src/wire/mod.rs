@@ -83,6 +83,12 @@ pub(crate) const RESULT_POINT_MAX: usize = 21;
 pub const MAX_RADIUS_PX: f32 = 100.0;
 
 /// Largest frame payload for `B` boundaries of up to `N` points.
+///
+/// The header's length field is 16 bits: a frame whose payload would pass
+/// 65 535 bytes cannot be sent ([`encode::EncodeError::TooLarge`]). A
+/// capacity whose full frame passes it (`18 + B·(6 + 4 N) > 65 535`, e.g.
+/// `N = 16 383, B = 1` or `N = 1 024, B = 16`) can be declared, but only
+/// frames that leave enough of it unused go over the link.
 pub const fn frame_payload_max(n: usize, b: usize) -> usize {
     FRAME_HEAD_LEN + b * (BOUNDARY_HEAD_LEN + POINT_LEN * n)
 }

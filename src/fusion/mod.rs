@@ -538,6 +538,11 @@ pub struct Fusion<const N: usize, const B: usize, const M: usize> {
     /// The key frame's motion to the last accepted frame.
     chain: Chain,
     last: Option<u32>,
+    /// Where the last accepted frame came from a link job
+    /// ([`crate::wire::FrameJob::run_fused`]), the job's serial: a later
+    /// job chains onto it only if its kept frame is that one (frame ids
+    /// need not be unique). `None` after a step by the caller.
+    pub(crate) link_serial: Option<u32>,
     /// The next frame is the key frame's last partner.
     due: bool,
     /// A key frame the processor keeps whose fusion has not started yet:
@@ -597,6 +602,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
             shows_retired: false,
             chain: Chain::IDENTITY,
             last: None,
+            link_serial: None,
             due: false,
             pending: None,
             map: RoadMap::new(config.tilt_sc, scale),
@@ -616,6 +622,7 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         self.shows_retired = false;
         self.chain = Chain::IDENTITY;
         self.last = None;
+        self.link_serial = None;
         self.due = false;
         self.pending = None;
         self.finished = None;
@@ -737,11 +744,13 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
         // 1. Validate (nothing changes on an error).
         let Some(last) = self.last else {
             self.last = Some(id);
+            self.link_serial = None;
             out.new_key = self.start_key(id, frame, KeyReason::First, false);
             return Ok(out);
         };
         let m = chained_from(last, id, motion)?;
         self.last = Some(id);
+        self.link_serial = None;
         let bounds = StepBounds::of(&self.base);
         self.settle();
         out.finished = self.finished.take();

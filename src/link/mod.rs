@@ -19,9 +19,19 @@ use core::fmt;
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
 pub enum Error<E, P = core::convert::Infallible> {
-    /// The bus (SPI or UART) failed; the packet in progress is ended (the
-    /// receiver reports it truncated) and the next one decodes as usual.
+    /// The bus (SPI or UART) failed. Reading, the packet in progress ends
+    /// where it stands, as at a delimiter: a cut packet is refused
+    /// (`truncated`, or `bad_crc` where the cut falls at the end of one of
+    /// its COBS runs), one that lacked only its delimiter is taken, and
+    /// the bytes after the error start a new packet (the rest of a cut one
+    /// refused in turn). Writing, what was written of the packet stays
+    /// written.
     Bus(E),
+    /// Writing, the bus accepted no byte of a non-empty buffer (`Ok(0)`,
+    /// which embedded-io's `Write::write` contract rules out: a driver
+    /// that breaks it gets this error, where `write_all` would panic); what
+    /// was written of the packet stays written.
+    WriteZero,
     /// The data-ready pin could not be read.
     Pin(P),
     /// The SPI length header is not valid (its check bytes disagree, or
@@ -46,6 +56,7 @@ impl<E: fmt::Debug, P: fmt::Debug> fmt::Display for Error<E, P> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::Bus(e) => write!(f, "bus error: {e:?}"),
+            Self::WriteZero => f.write_str("the bus accepted no byte of a write"),
             Self::Pin(e) => write!(f, "data-ready pin error: {e:?}"),
             Self::BadHeader { raw } => write!(f, "bad SPI length header {raw:02x?}"),
             Self::TooLarge { len, max } => {
@@ -61,12 +72,14 @@ impl<E: fmt::Debug, P: fmt::Debug> core::error::Error for Error<E, P> {}
 use crate::wire::Receiver;
 
 /// End the packet in progress (after a bus error): the receiver sees a
-/// delimiter, reports the cut packet and starts afresh.
+/// delimiter, reports the cut packet and starts afresh. The delimiter is
+/// not a byte the bus delivered: [`crate::wire::Counters::bytes`] does not
+/// count it (an adversary found every bus error counted a byte).
 fn cut<const N: usize, const B: usize>(
     rx: &mut Receiver<N, B>,
     on: &mut impl FnMut(crate::wire::Event<'_, N, B>),
 ) {
-    rx.feed(&[0], on);
+    rx.feed_uncounted(&[0], on);
 }
 
 #[cfg(test)]

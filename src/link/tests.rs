@@ -218,6 +218,9 @@ fn spi_bus_error_mid_frame_ends_the_packet_and_the_next_decodes() {
     );
     assert_eq!(link.poll(&mut rx, record(&mut log)), Ok(true));
     assert_eq!(log, ["camera", "error truncated", "frame 2"]);
+    // The bytes the bus delivered: the cut's delimiter is not one of them.
+    let delivered = cam_b.len() + SPI_CHUNK.min(f1.len()) + f2.len();
+    assert_eq!(rx.counters().bytes as usize, delivered);
     let (mut spi, mut pin) = link.release();
     spi.inner.done();
     pin.done();
@@ -300,6 +303,9 @@ fn spi_data_ready_stuck_high_gives_bad_headers_and_returns() {
 struct Uart {
     reads: Vec<Result<Vec<u8>, ()>>,
     written: Vec<u8>,
+    /// How many bytes each write takes, in turn (`None`: all it is given;
+    /// after the script, all).
+    writes: Vec<Option<usize>>,
 }
 #[derive(Debug, PartialEq)]
 struct UartError;
@@ -339,8 +345,15 @@ impl embedded_io::Read for Uart {
 }
 impl embedded_io::Write for Uart {
     fn write(&mut self, buf: &[u8]) -> Result<usize, UartError> {
-        self.written.extend_from_slice(buf);
-        Ok(buf.len())
+        let n = match self.writes.first().copied() {
+            Some(n) => {
+                let _ = self.writes.remove(0);
+                n.unwrap_or(buf.len()).min(buf.len())
+            }
+            None => buf.len(),
+        };
+        self.written.extend_from_slice(&buf[..n]);
+        Ok(n)
     }
     fn flush(&mut self) -> Result<(), UartError> {
         Ok(())
@@ -360,15 +373,20 @@ fn uart_chunks_read_error_and_write() {
         Err(()),
         Ok(f3.clone()),
     ];
+    let delivered = s.len() + 50 + f3.len();
     let mut link = UartLink::new(Uart {
         reads,
         written: Vec::new(),
+        writes: Vec::new(),
     });
     let mut rx = Receiver::<32, 2>::new(IDS, Config::DEFAULT);
     let mut log = Vec::new();
     for _ in 0..12 {
         let _ = link.poll(&mut rx, record(&mut log));
     }
+    // The delimiter the read error put in is not a byte the UART gave (an
+    // adversary found each bus error counted one).
+    assert_eq!(rx.counters().bytes as usize, delivered);
     assert_eq!(
         log,
         [
@@ -389,4 +407,34 @@ fn uart_chunks_read_error_and_write() {
     let mut dec = w.clone();
     let m = cobs::decode_in_place(&mut dec[..w.len() - 1]).unwrap();
     assert_eq!(&dec[..m], &raw[..n]);
+}
+
+/// `write_packet` on a UART that takes a byte a write writes the packet
+/// whole; one whose `write` takes nothing of a non-empty buffer (which
+/// embedded-io's contract rules out) gets `WriteZero`, not a panic (an
+/// adversary's find: `write_all` panics there), with what was taken
+/// before it kept.
+#[test]
+fn uart_write_packet_one_byte_at_a_time_and_a_write_of_nothing() {
+    let mut raw = [0u8; 64];
+    let n = encode::report(&mut raw, IDS.report, 3, &WireError::BadCrc).unwrap();
+    let framed = framed(&raw[..n]);
+    let mut scratch = [0u8; 80];
+    let mut one = Uart {
+        reads: Vec::new(),
+        written: Vec::new(),
+        writes: vec![Some(1); 200],
+    };
+    super::write_packet(&mut one, &raw[..n], &mut scratch).unwrap();
+    assert_eq!(one.written, framed);
+    let mut zero = Uart {
+        reads: Vec::new(),
+        written: Vec::new(),
+        writes: vec![Some(5), Some(0)],
+    };
+    assert_eq!(
+        super::write_packet(&mut zero, &raw[..n], &mut scratch),
+        Err(Error::WriteZero)
+    );
+    assert_eq!(zero.written, framed[..5]);
 }

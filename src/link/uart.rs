@@ -38,7 +38,8 @@ impl<IO: Read + Write> UartLink<IO> {
 
     /// One read (blocking until at least one byte came, as
     /// [`Read::read`] does) fed to `rx`; the bytes read. A read error ends
-    /// the packet in progress (the receiver reports it truncated).
+    /// the packet in progress where it stands ([`Error::Bus`] says what
+    /// the receiver makes of it).
     pub fn poll<const N: usize, const B: usize>(
         &mut self,
         rx: &mut Receiver<N, B>,
@@ -57,16 +58,28 @@ impl<IO: Read + Write> UartLink<IO> {
     }
 }
 
-/// COBS-frame the packet `raw` into `scratch` and write it all to `w`.
+/// COBS-frame the packet `raw` into `scratch` and write it all to `w`,
+/// then flush. At most one `write` a byte: each must take at least one
+/// ([`Error::WriteZero`] if one takes none; embedded-io's `write_all`
+/// panics there).
 pub fn write_packet<W: Write>(
     w: &mut W,
     raw: &[u8],
     scratch: &mut [u8],
 ) -> Result<(), Error<W::Error>> {
     let n = cobs_frame(raw, scratch).map_err(Error::Encode)?;
-    let bytes = scratch
+    let mut rest = scratch
         .get(..n)
         .ok_or(Error::Encode(EncodeError::BufferTooSmall))?;
-    w.write_all(bytes).map_err(Error::Bus)?;
+    for _ in 0..n {
+        if rest.is_empty() {
+            break;
+        }
+        match w.write(rest).map_err(Error::Bus)? {
+            0 => return Err(Error::WriteZero),
+            // (A writer that claims more than it was given has taken it all.)
+            k => rest = rest.get(k..).unwrap_or(&[]),
+        }
+    }
     w.flush().map_err(Error::Bus)
 }

@@ -84,6 +84,11 @@ pub struct FrameJob<'a, const N: usize, const B: usize> {
     pub kept_id: u32,
     /// The kept frame's boundary qualities (what the result reports).
     pub kept_quality: [u8; B],
+    /// This frame's place among the frames the receiver handed out (1 for
+    /// the first; wrapping), and the kept frame's: what
+    /// [`Self::run_fused`] chains by, as frame ids need not be unique.
+    serial: u32,
+    kept_serial: u32,
 }
 
 impl<const N: usize, const B: usize> FrameJob<'_, N, B> {
@@ -127,11 +132,19 @@ impl<const N: usize, const B: usize> FrameJob<'_, N, B> {
     /// [`FusionError::ErrorsAboveConfig`] and nothing changes: the sticks
     /// would not be guaranteed. Make the fusion with the largest errors the
     /// front end and the odometry declare. A frame whose motion does not
-    /// start from the fusion's last frame ([`Fusion::last_frame`]: the
-    /// motion packet was lost, [`Self::motion`] `None`, or the frame before
-    /// was refused or not run) resets the fusion first ([`Fusion::reset`])
-    /// and starts it anew: the chain of motions is broken and the map
-    /// cannot be carried to this frame.
+    /// start from the frame the fusion took last, the previous job's of
+    /// this receiver (the motion packet was lost, [`Self::motion`] `None`;
+    /// the frame before was refused or not run into this fusion, also when
+    /// it had the same frame id as the fusion's last frame; or the fusion's
+    /// last step was the caller's own [`Fusion::step`]), resets the fusion
+    /// first ([`Fusion::reset`]) and starts it anew: the chain of motions
+    /// is broken and the map cannot be carried to this frame. (Until the
+    /// thirty-first session the frame ids alone decided: a refused frame
+    /// with the fusion's last id let the next motion chain onto the older
+    /// frame.) The other refusal is the fusion's own
+    /// [`FusionError::RepeatedFrame`], a frame with the same id as the one
+    /// its motion starts from (the receiver pairs a motion packet from
+    /// `k` to `k`); nothing changes, and the next job starts anew.
     pub fn run_fused<const M: usize>(
         &self,
         fusion: &mut Fusion<N, B, M>,
@@ -152,7 +165,9 @@ impl<const N: usize, const B: usize> FrameJob<'_, N, B> {
                 from: self.kept_id,
                 motion,
             })
-            .filter(|c| fusion.last_frame() == Some(c.from));
+            .filter(|c| {
+                fusion.last_frame() == Some(c.from) && fusion.link_serial == Some(self.kept_serial)
+            });
         let base = fusion.base_config();
         let radius = self.info.max_radius(self.frame.boundaries().len());
         let mut within = radius <= fmin(base.e1(), base.e2());
@@ -168,7 +183,10 @@ impl<const N: usize, const B: usize> FrameJob<'_, N, B> {
         if chained.is_none() {
             fusion.reset();
         }
-        fusion.step_within(self.info.frame_id, self.frame, chained.as_ref(), deadline)
+        let step =
+            fusion.step_within(self.info.frame_id, self.frame, chained.as_ref(), deadline)?;
+        fusion.link_serial = Some(self.serial);
+        Ok(step)
     }
 
     /// The result packet's head for this job.
@@ -204,6 +222,8 @@ pub enum Event<'a, const N: usize, const B: usize> {
 #[derive(Debug, Clone, Copy)]
 struct Kept<const B: usize> {
     id: u32,
+    /// Its place among the frames handed out ([`FrameJob::serial`]).
+    serial: u32,
     radius: f32,
     quality: [u8; B],
 }
@@ -215,6 +235,8 @@ pub struct Receiver<const N: usize, const B: usize> {
     base: Config,
     motion: Option<MotionPacket>,
     kept: Option<Kept<B>>,
+    /// The last frame job's serial ([`FrameJob::serial`]).
+    serial: u32,
     counters: Counters,
 }
 
@@ -241,6 +263,7 @@ impl<const N: usize, const B: usize> Receiver<N, B> {
             base,
             motion: None,
             kept: None,
+            serial: 0,
             counters: Counters {
                 bytes: 0,
                 frames: 0,
@@ -259,17 +282,26 @@ impl<const N: usize, const B: usize> Receiver<N, B> {
     /// Feed the next bytes from the link; `on` is called for every event,
     /// in order (a frame job's borrow ends with the call). At most
     /// `input.len()` decoder steps.
-    pub fn feed(&mut self, input: &[u8], mut on: impl FnMut(Event<'_, N, B>)) {
+    pub fn feed(&mut self, input: &[u8], on: impl FnMut(Event<'_, N, B>)) {
+        self.counters.bytes = self
+            .counters
+            .bytes
+            .saturating_add(u32::try_from(input.len()).unwrap_or(u32::MAX));
+        self.feed_uncounted(input, on);
+    }
+
+    /// [`Self::feed`] without counting the bytes ([`Counters::bytes`]): a
+    /// delimiter the link drivers make up after a bus error
+    /// (`crate::link`).
+    pub(crate) fn feed_uncounted(&mut self, input: &[u8], mut on: impl FnMut(Event<'_, N, B>)) {
         let Self {
             decoder,
             base,
             motion,
             kept,
+            serial,
             counters,
         } = self;
-        counters.bytes = counters
-            .bytes
-            .saturating_add(u32::try_from(input.len()).unwrap_or(u32::MAX));
         let mut rest = input;
         for _ in 0..input.len() {
             if rest.is_empty() {
@@ -300,6 +332,10 @@ impl<const N: usize, const B: usize> Receiver<N, B> {
                 Ok(Packet::Frame(frame, info)) => {
                     let count = frame.boundaries().len();
                     let radius = info.max_radius(count);
+                    // (Wrapping: 2³² frames apart, two jobs' serials
+                    // agree; a fusion fed by this receiver would need that
+                    // many frames not run into it between two it ran.)
+                    *serial = serial.wrapping_add(1);
                     let mut job = FrameJob {
                         frame,
                         info,
@@ -307,9 +343,18 @@ impl<const N: usize, const B: usize> Receiver<N, B> {
                         config: *base,
                         kept_id: info.frame_id,
                         kept_quality: info.quality,
+                        serial: *serial,
+                        kept_serial: *serial,
                     };
+                    // The motion packet since the kept frame, if any: one
+                    // that came before it (before the first frame, or
+                    // before a frame that started the pairing anew) is
+                    // dropped here too. (An adversary's find: a motion
+                    // packet sent before the first frame paired the
+                    // second.)
+                    let since = motion.take();
                     if let Some(k) = *kept {
-                        match motion.take() {
+                        match since {
                             Some(m) if m.from == k.id && m.to == info.frame_id => {
                                 match pair_config(base, k.radius, radius, &m) {
                                     Ok(c) => {
@@ -317,6 +362,7 @@ impl<const N: usize, const B: usize> Receiver<N, B> {
                                         job.config = c;
                                         job.kept_id = k.id;
                                         job.kept_quality = k.quality;
+                                        job.kept_serial = k.serial;
                                     }
                                     Err(e) => report(counters, e, &mut on),
                                 }
@@ -343,6 +389,7 @@ impl<const N: usize, const B: usize> Receiver<N, B> {
                     }
                     *kept = Some(Kept {
                         id: info.frame_id,
+                        serial: *serial,
                         radius,
                         quality: info.quality,
                     });

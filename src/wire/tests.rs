@@ -737,6 +737,150 @@ fn run_fused_judges_the_motion_bounds_it_uses() {
     assert!(paired_absent >= 2, "{paired_absent}");
 }
 
+/// The motion packet of [`drive_step`] from frame `from` to `to`.
+fn motion_packet_between(counter: u16, from: u32, to: u32) -> Vec<u8> {
+    let step = drive_step();
+    let mut raw = [0u8; 80];
+    let m = MotionFields {
+        from,
+        to,
+        translation: step.translation(),
+        rotation: step.angles(),
+        translation_error: None,
+        rotation_error: None,
+    };
+    let n = encode::motion(&mut raw, IDS.motion, counter, &m).unwrap();
+    link(&raw[..n])
+}
+
+/// The chain `run_fused` goes on is the previous job's frame, not a frame
+/// id: a frame refused with the fusion's last id (an adversary's find:
+/// frame 9 of a drive sent as id 4, after frame 4, with a radius above
+/// the fusion's), then a motion from "4" and frame 5: the fusion starts
+/// anew, where it paired frame 5 with frame 4 under frame 9's motion
+/// before (14 of 16 intervals in conflict). The same after the fusion's
+/// own refusal of a frame with its kept frame's id (a motion packet from
+/// 3 to 3, `RepeatedFrame`).
+#[test]
+fn run_fused_chains_onto_the_previous_jobs_frame_not_its_id() {
+    use crate::fusion::{Fusion, FusionConfig, FusionError, KeyReason};
+    use crate::Config;
+    let mut f = Fusion::<64, 2, 128>::new(Config::DEFAULT, FusionConfig::new(8, 500).unwrap());
+    let mut rx = super::Receiver::<64, 2>::new(IDS, Config::DEFAULT);
+    rx.feed(&[0], |_| {});
+    rx.feed(&camera_packet(0), |_| {});
+    let mut counter = 1u16;
+    let mut send = |rx: &mut super::Receiver<64, 2>,
+                    f: &mut Fusion<64, 2, 128>,
+                    motion: Option<(u32, u32)>,
+                    id: u32,
+                    at: f32,
+                    r: f32| {
+        if let Some((from, to)) = motion {
+            rx.feed(&motion_packet_between(counter, from, to), |_| {});
+            counter += 1;
+        }
+        let pts = drive_edge(at, -1.0);
+        let packet = frame_packet(counter, id, &[(r, pts.clone()), (r, pts)]);
+        counter += 1;
+        let mut got = None;
+        rx.feed(&packet, |e| {
+            if let super::Event::Frame(job) = e {
+                got = Some(job.run_fused(f));
+            }
+        });
+        got.expect("a frame job")
+    };
+    for id in 0..5u32 {
+        let m = (id > 0).then(|| (id - 1, id));
+        let s = send(&mut rx, &mut f, m, id, id as f32, 0.5).unwrap();
+        assert_eq!(s.new_key.is_some(), id == 0, "frame {id}");
+    }
+    // Drive frame 9 as id 4, no motion, 0.75 px: refused, nothing changes.
+    let before = (f.digest(), f.last_frame(), f.key_id());
+    let got = send(&mut rx, &mut f, None, 4, 9.0, 0.75);
+    assert_eq!(got, Err(FusionError::ErrorsAboveConfig));
+    assert_eq!((f.digest(), f.last_frame(), f.key_id()), before);
+    // Its motion to frame 10, sent as id 5: anew.
+    let s = send(&mut rx, &mut f, Some((4, 5)), 5, 10.0, 0.5).unwrap();
+    assert_eq!((s.paired, s.new_key), (None, Some(KeyReason::First)));
+    assert_eq!((f.key_id(), f.last_frame()), (Some(5), Some(5)));
+    // Frames 6 and 7 pair on.
+    for id in 6..8u32 {
+        let s = send(
+            &mut rx,
+            &mut f,
+            Some((id - 1, id)),
+            id,
+            id as f32 + 5.0,
+            0.5,
+        )
+        .unwrap();
+        assert!(s.paired.is_some() && s.new_key.is_none(), "frame {id}");
+    }
+    // A motion from 7 to 7 and a frame 7: the receiver pairs them, the
+    // fusion refuses the repeated id, nothing changes.
+    let before = (f.digest(), f.last_frame(), f.key_id());
+    let got = send(&mut rx, &mut f, Some((7, 7)), 7, 13.0, 0.5);
+    assert_eq!(got, Err(FusionError::RepeatedFrame(7)));
+    assert_eq!((f.digest(), f.last_frame(), f.key_id()), before);
+    // The next motion starts from the refused frame 7: anew.
+    let s = send(&mut rx, &mut f, Some((7, 8)), 8, 14.0, 0.5).unwrap();
+    assert_eq!((s.paired, s.new_key), (None, Some(KeyReason::First)));
+    // And the caller's own steps between two jobs: a reset and a frame
+    // stepped as id 9, the receiver's kept frame's id (a different frame,
+    // drive frame 16); the next job's motion from 9 chains onto the
+    // receiver's frame 9, not the fusion's: anew.
+    let s = send(&mut rx, &mut f, Some((8, 9)), 9, 15.0, 0.5).unwrap();
+    assert!(s.paired.is_some());
+    let mut frame = Frame::<64, 2>::new(cam());
+    let pts = drive_edge(16.0, -1.0);
+    frame.push_boundary(&pts).unwrap();
+    frame.push_boundary(&pts).unwrap();
+    f.reset();
+    let direct = f.step(9, &frame, None).unwrap();
+    assert_eq!(direct.new_key, Some(KeyReason::First));
+    let s = send(&mut rx, &mut f, Some((9, 10)), 10, 17.0, 0.5).unwrap();
+    assert_eq!((s.paired, s.new_key), (None, Some(KeyReason::First)));
+    assert_eq!((f.key_id(), f.last_frame()), (Some(10), Some(10)));
+}
+
+/// A motion packet that came before the kept frame is not used to pair
+/// the next one (an adversary's find: one sent before the first frame
+/// paired the second): the second frame is `missing_motion` and starts
+/// the pairing anew.
+#[test]
+fn a_motion_before_the_kept_frame_pairs_nothing() {
+    use crate::Config;
+    let mut rx = super::Receiver::<64, 2>::new(IDS, Config::DEFAULT);
+    rx.feed(&[0], |_| {});
+    rx.feed(&camera_packet(0), |_| {});
+    rx.feed(&motion_packet_between(1, 0, 1), |_| {});
+    let pts = |n: f32| drive_edge(n, -1.0);
+    let mut log = Vec::new();
+    for (c, id) in [(2u16, 0u32), (3, 1)] {
+        let packet = frame_packet(c, id, &[(0.5, pts(id as f32)), (0.5, pts(id as f32))]);
+        rx.feed(&packet, |e| match e {
+            super::Event::Frame(job) => log.push(std::format!(
+                "frame {} kept {} paired {}",
+                job.info.frame_id,
+                job.kept_id,
+                job.motion.is_some()
+            )),
+            super::Event::Error(e) => log.push(std::format!("error {}", e.kind().name())),
+            _ => {}
+        });
+    }
+    assert_eq!(
+        log,
+        [
+            "frame 0 kept 0 paired false",
+            "error missing_motion",
+            "frame 1 kept 1 paired false"
+        ]
+    );
+}
+
 /// One boundary of `pts` with radius `r` encoded in a 512 × 480 frame
 /// packet and decoded after a camera packet: the boundary's points as
 /// sent and the radius the packet carries; the encoder's error, if any.

@@ -167,7 +167,7 @@
 //! # Memory and work
 //! Beside the processor, `Fusion<N, B, M>` holds a [`KeyFrame`] (`20·B·N`
 //! bytes), a [`RoadMap`] (`12·B·M` bytes and [`crate::map::MAP_BATCHES`]
-//! batches) and a few words: 23 632 bytes for `N = 256`, `B = 2`,
+//! batches) and a few words: 23 640 bytes for `N = 256`, `B = 2`,
 //! `M = 512` on the Cortex-M4F, asserted at compile time there (at most
 //! 24 KiB). Per frame the fusion costs one pass over the key frame's points
 //! (`O(1)` each: an intersection, or the consistency check), `O(MAP_BATCHES)`

@@ -95,6 +95,16 @@ impl<const N: usize, const B: usize> FrameJob<'_, N, B> {
     /// Run the per-frame call on `processor`: set the pair's configuration,
     /// reset first when the pairing starts anew, then
     /// [`Processor::process`].
+    ///
+    /// Run every job the receiver hands out, in order, on one processor:
+    /// the processor pairs the frame with the frame it kept, which is the
+    /// job's kept frame only if the previous job ran on it. A job skipped
+    /// (or run on another processor) makes the next one pair across the
+    /// gap, under a motion that is not theirs, and its sticks are not
+    /// guaranteed; after skipping one, [`Processor::reset`] first. (The
+    /// processor keeps no frame ids to check it by; [`Self::run_fused`]
+    /// checks it.) `run` never refuses a frame: with a motion the
+    /// processor has a frame to pair with, without one it was reset.
     pub fn run<'p>(
         &self,
         processor: &'p mut Processor<N, B>,

@@ -690,7 +690,16 @@ impl<const N: usize, const B: usize> fmt::Debug for KeyFrame<N, B> {
 }
 
 impl<const N: usize, const B: usize> KeyFrame<N, B> {
+    /// A key frame's lengths and counts are `u16`: `N` at most 65 535. (An
+    /// adversary's find: with `N` past it, the points past 65 534 were
+    /// never fused, uncounted, and [`super::Fusion::constrain`] on one
+    /// passed its check, entered a pending retirement's rest, then
+    /// refused it.)
+    const CHECK: () = assert!(N <= u16::MAX as usize, "N <= 65535");
+
     pub(crate) const fn new(scale: DepthScale, min_pairs: u8) -> Self {
+        #[allow(clippy::let_unit_value)]
+        let () = Self::CHECK;
         Self {
             cells: [[Cell::EMPTY; N]; B],
             lens: [0; B],

@@ -522,8 +522,20 @@ pub struct FusionStep {
 }
 
 /// The key-frame fusion and its road map, around the per-frame processor
-/// (module docs). `N`, `B` as for [`Processor`]; `M` points per boundary in
-/// the map, `0 < M < 65535` (checked at compile time: [`RoadMap`]).
+/// (module docs). `N`, `B` as for [`Processor`], and `N ≤ 65 535` (a key
+/// frame's counts are 16-bit; checked at compile time); `M` points per
+/// boundary in the map, `0 < M < 65535` (checked at compile time:
+/// [`RoadMap`]).
+///
+/// ```no_run
+/// # use roadstereo::{fusion::{Fusion, FusionConfig}, Config};
+/// let f = Box::new(Fusion::<65_535, 1, 4>::new(Config::DEFAULT, FusionConfig::DEFAULT));
+/// ```
+///
+/// ```compile_fail
+/// # use roadstereo::{fusion::{Fusion, FusionConfig}, Config};
+/// let f = Box::new(Fusion::<65_536, 1, 4>::new(Config::DEFAULT, FusionConfig::DEFAULT));
+/// ```
 #[derive(Debug, Clone)]
 pub struct Fusion<const N: usize, const B: usize, const M: usize> {
     processor: Processor<N, B>,

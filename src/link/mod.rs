@@ -13,19 +13,21 @@ pub use uart::{write_packet, UartLink, UART_CHUNK};
 
 use core::fmt;
 
-/// A driver's error: the bus's or pin's own error, or what the link's
-/// framing found before any byte reached the decoder.
+/// A driver's error: the bus's or pin's own error, what the link's
+/// framing found before any byte reached the decoder, or, writing, a bus
+/// that takes nothing ([`Error::WriteZero`]) or a buffer too small.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
 pub enum Error<E, P = core::convert::Infallible> {
     /// The bus (SPI or UART) failed. Reading, the packet in progress ends
     /// where it stands, as at a delimiter: a cut packet is refused
-    /// (`truncated`, or `bad_crc` where the cut falls at the end of one of
-    /// its COBS runs), one that lacked only its delimiter is taken, and
-    /// the bytes after the error start a new packet (the rest of a cut one
-    /// refused in turn). Writing, what was written of the packet stays
-    /// written.
+    /// (`truncated`, or `bad_crc` where the bytes before the cut end one
+    /// of its COBS runs and decode to 14 bytes or more), one that lacked
+    /// only its delimiter is taken, a cut before any of its bytes reports
+    /// nothing, and the bytes after the error start a new packet (the rest
+    /// of a cut one refused in turn). Writing, what was written of the
+    /// packet stays written.
     Bus(E),
     /// Writing, the bus accepted no byte of a non-empty buffer (`Ok(0)`,
     /// which embedded-io's `Write::write` contract rules out: a driver

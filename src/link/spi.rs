@@ -14,8 +14,9 @@
 //!
 //! Each chunk goes to the [`Receiver`] as it arrives, so no packet buffer
 //! is needed and a short read or a corrupt byte is the decoder's typed
-//! error. A bus error ends the packet in progress (the receiver reports it
-//! truncated) and the next packet decodes as usual.
+//! error. A bus error ends the packet in progress where it stands and the
+//! next packet decodes as usual ([`Error::Bus`] says what the receiver
+//! makes of the cut one).
 
 use embedded_hal::digital::InputPin;
 use embedded_hal::spi::{Operation, SpiDevice};

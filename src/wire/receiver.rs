@@ -84,8 +84,8 @@ pub struct FrameJob<'a, const N: usize, const B: usize> {
     pub kept_id: u32,
     /// The kept frame's boundary qualities (what the result reports).
     pub kept_quality: [u8; B],
-    /// This frame's place among the frames the receiver handed out (1 for
-    /// the first; wrapping), and the kept frame's: what
+    /// This frame job's serial, unique among the jobs every receiver of
+    /// the program handed out (`next_serial`), and the kept frame's: what
     /// [`Self::run_fused`] chains by, as frame ids need not be unique.
     serial: u32,
     kept_serial: u32,
@@ -145,16 +145,22 @@ impl<const N: usize, const B: usize> FrameJob<'_, N, B> {
     /// start from the frame the fusion took last, the previous job's of
     /// this receiver (the motion packet was lost, [`Self::motion`] `None`;
     /// the frame before was refused or not run into this fusion, also when
-    /// it had the same frame id as the fusion's last frame; or the fusion's
-    /// last step was the caller's own [`Fusion::step`]), resets the fusion
-    /// first ([`Fusion::reset`]) and starts it anew: the chain of motions
-    /// is broken and the map cannot be carried to this frame. (Until the
+    /// it had the same frame id as the fusion's last frame; the fusion's
+    /// last frame came from another receiver; or the fusion's last step
+    /// was the caller's own [`Fusion::step`]), resets the fusion first
+    /// ([`Fusion::reset`]) and starts it anew: the chain of motions is
+    /// broken and the map cannot be carried to this frame. (Until the
     /// thirty-first session the frame ids alone decided: a refused frame
     /// with the fusion's last id let the next motion chain onto the older
-    /// frame.) The other refusal is the fusion's own
+    /// frame.) Jobs are told apart by a serial unique over every receiver
+    /// of the program where the target has 32-bit atomics (`thumbv7em`
+    /// has); on a target without them, within one receiver only: reset
+    /// the fusion before feeding it from a new receiver. Where the chain
+    /// holds, the other refusal is the fusion's own
     /// [`FusionError::RepeatedFrame`], a frame with the same id as the one
-    /// its motion starts from (the receiver pairs a motion packet from
-    /// `k` to `k`); nothing changes, and the next job starts anew.
+    /// its motion starts from (the receiver pairs a motion packet from `k`
+    /// to `k`); nothing changes, and the next job starts anew. (Where the
+    /// chain is broken, such a frame starts the fusion anew as any other.)
     pub fn run_fused<const M: usize>(
         &self,
         fusion: &mut Fusion<N, B, M>,
@@ -342,10 +348,7 @@ impl<const N: usize, const B: usize> Receiver<N, B> {
                 Ok(Packet::Frame(frame, info)) => {
                     let count = frame.boundaries().len();
                     let radius = info.max_radius(count);
-                    // (Wrapping: 2³² frames apart, two jobs' serials
-                    // agree; a fusion fed by this receiver would need that
-                    // many frames not run into it between two it ran.)
-                    *serial = serial.wrapping_add(1);
+                    *serial = next_serial(*serial);
                     let mut job = FrameJob {
                         frame,
                         info,
@@ -408,6 +411,33 @@ impl<const N: usize, const B: usize> Receiver<N, B> {
                 }
             }
         }
+    }
+}
+
+/// The frame jobs handed out by every receiver of the program, where the
+/// target has 32-bit atomics: a job's serial is unique among them, so a
+/// fusion fed by two receivers, or by a new one after a link restart,
+/// chains no job onto another receiver's frame (a review's find, when
+/// each receiver counted from 1). (Wrapping: two jobs 2³² apart share a
+/// serial; chaining also needs their frame ids to match.)
+#[cfg(target_has_atomic = "32")]
+static JOB_SERIALS: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
+
+/// The next frame job's serial ([`FrameJob::serial`]) after `last`, this
+/// receiver's last: from [`JOB_SERIALS`] where the target has 32-bit
+/// atomics, else `last + 1` (then unique within one receiver only: a
+/// fusion fed by a new receiver must be reset first, [`FrameJob::run_fused`]).
+fn next_serial(last: u32) -> u32 {
+    #[cfg(target_has_atomic = "32")]
+    {
+        let _ = last;
+        JOB_SERIALS
+            .fetch_add(1, core::sync::atomic::Ordering::Relaxed)
+            .wrapping_add(1)
+    }
+    #[cfg(not(target_has_atomic = "32"))]
+    {
+        last.wrapping_add(1)
     }
 }
 

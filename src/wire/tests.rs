@@ -845,6 +845,116 @@ fn run_fused_chains_onto_the_previous_jobs_frame_not_its_id() {
     assert_eq!((f.key_id(), f.last_frame()), (Some(10), Some(10)));
 }
 
+/// A frame job sent through `rx`: its motion packet (from, to) if any,
+/// then frame `id` showing the drive at `at` with radius `r`, each job
+/// handed to `on`.
+fn send_job(
+    rx: &mut super::Receiver<64, 2>,
+    counter: &mut u16,
+    (motion, id, at, r): (Option<(u32, u32)>, u32, f32, f32),
+    mut on: impl FnMut(&super::FrameJob<'_, 64, 2>),
+) {
+    if let Some((from, to)) = motion {
+        rx.feed(&motion_packet_between(*counter, from, to), |_| {});
+        *counter += 1;
+    }
+    let pts = drive_edge(at, -1.0);
+    let packet = frame_packet(*counter, id, &[(r, pts.clone()), (r, pts)]);
+    *counter += 1;
+    rx.feed(&packet, |e| {
+        if let super::Event::Frame(job) = e {
+            on(&job);
+        }
+    });
+}
+
+/// `run_fused` chains no job onto a frame another receiver put into the
+/// fusion, nor onto the caller's own steps, whatever the ids (a review's
+/// finds: each receiver counted its jobs from 1, so a new receiver after
+/// a link restart, its first frame refused, chained its second onto the
+/// old receiver's frame of the same id, the key point of true depth 14
+/// given `[1.20, 1.68]`; and no test caught the caller's own steps
+/// without a reset).
+#[test]
+fn run_fused_chains_onto_no_other_receivers_frame_nor_the_callers() {
+    use crate::fusion::{ChainedMotion, Fusion, FusionConfig, FusionError, KeyReason};
+    use crate::Config;
+    let fusion = || Fusion::<64, 2, 128>::new(Config::DEFAULT, FusionConfig::new(8, 500).unwrap());
+    let receiver = || {
+        let mut rx = super::Receiver::<64, 2>::new(IDS, Config::DEFAULT);
+        rx.feed(&[0], |_| {});
+        rx.feed(&camera_packet(0), |_| {});
+        rx
+    };
+    let anew = |got: Option<Result<crate::fusion::FusionStep, FusionError>>| {
+        let s = got.expect("a job").expect("taken");
+        assert_eq!((s.paired, s.new_key), (None, Some(KeyReason::First)));
+    };
+    // A new receiver after a restart (the sender's ids restarted too).
+    let mut f = fusion();
+    let (mut rx1, mut c1) = (receiver(), 1u16);
+    send_job(&mut rx1, &mut c1, (None, 0, 0.0, 0.5), |j| {
+        j.run_fused(&mut f).unwrap();
+    });
+    let (mut rx2, mut c2) = (receiver(), 1u16);
+    send_job(&mut rx2, &mut c2, (None, 0, 9.0, 0.75), |j| {
+        assert_eq!(j.run_fused(&mut f), Err(FusionError::ErrorsAboveConfig));
+    });
+    let mut got = None;
+    send_job(&mut rx2, &mut c2, (Some((0, 1)), 1, 10.0, 0.5), |j| {
+        got = Some(j.run_fused(&mut f));
+    });
+    anew(got);
+    // Two receivers into one fusion: b's second frame does not chain onto
+    // a's first, which has its first's id.
+    let mut f = fusion();
+    let (mut a, mut ca, mut b, mut cb) = (receiver(), 1u16, receiver(), 1u16);
+    send_job(&mut a, &mut ca, (None, 0, 0.0, 0.5), |j| {
+        j.run_fused(&mut f).unwrap();
+    });
+    send_job(&mut b, &mut cb, (None, 0, 20.0, 0.5), |_| {});
+    let mut got = None;
+    send_job(&mut b, &mut cb, (Some((0, 1)), 1, 21.0, 0.5), |j| {
+        got = Some(j.run_fused(&mut f));
+    });
+    anew(got);
+    // The caller's own steps, no reset, back to the id of the receiver's
+    // kept frame: the next job starts anew.
+    let mut f = fusion();
+    let (mut rx, mut c) = (receiver(), 1u16);
+    send_job(&mut rx, &mut c, (None, 0, 0.0, 0.5), |j| {
+        j.run_fused(&mut f).unwrap();
+    });
+    let frame = |n: f32| {
+        let mut fr = Frame::<64, 2>::new(cam());
+        let pts = drive_edge(n, -1.0);
+        fr.push_boundary(&pts).unwrap();
+        fr.push_boundary(&pts).unwrap();
+        fr
+    };
+    let m = drive_step();
+    f.step(
+        100,
+        &frame(1.0),
+        Some(&ChainedMotion { from: 0, motion: m }),
+    )
+    .unwrap();
+    f.step(
+        0,
+        &frame(2.0),
+        Some(&ChainedMotion {
+            from: 100,
+            motion: m,
+        }),
+    )
+    .unwrap();
+    let mut got = None;
+    send_job(&mut rx, &mut c, (Some((0, 1)), 1, 1.0, 0.5), |j| {
+        got = Some(j.run_fused(&mut f));
+    });
+    anew(got);
+}
+
 /// A motion packet that came before the kept frame is not used to pair
 /// the next one (an adversary's find: one sent before the first frame
 /// paired the second): the second frame is `missing_motion` and starts

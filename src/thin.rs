@@ -50,7 +50,16 @@
 //! a run only within `2¹⁸ e` columns of its anchor (`|Δu| ≤ 2¹⁸ e`,
 //! computed), so the deviation is at most `e (1 + 9.1 · 2⁻²⁴ · 2¹⁸ (1 +
 //! u)) + 4.1 u e < 1.15 e`. The pass tests with `e = ε/2`: every vertex of
-//! `P` lies within `0.575 ε` of `Q`'s segment. A vertex joins a run only
+//! `P` lies within `0.575 ε` of `Q`'s segment. The factors `1 + α` hold
+//! for results in `f32`'s normal range; a subnormal result (an interval
+//! end or slope of a tiny `e` over a long `Δv`) is rounded by up to
+//! `2⁻¹⁵⁰` absolutely instead, which times `Δv < 2¹⁵` (images at most
+//! [`crate::camera::MAX_IMAGE_SIDE`] rows and their margin) and a few
+//! roundings stays below `2⁻¹³²` columns, under the bound's slack of
+//! `0.0078 e` for every `ε ≥ 2⁻⁹⁹` px (`MIN_EPS`); below it, `e₂` under
+//! `2⁻⁹¹` px, the boundary is not thinned (`epsilon` is 0). (An
+//! adversary's find: at `e₂ = 10⁻⁴⁰` a vertex `36 ε` off its chord was
+//! dropped, `3 333 ε` at `10⁻⁴²`; by at most about `10⁻⁴¹` px.) A vertex joins a run only
 //! with a finite slope (so a finite `1/Δv`): where a subnormal `Δv`
 //! overflows `1/Δv`, the run ends; a boundary whose rows are so far apart
 //! that `Δv` overflows is not thinned (the rows are monotone: one test of
@@ -110,10 +119,20 @@ pub(crate) const fn gives_up(kept: usize) -> bool {
     kept * 8 > CHUNK * 7
 }
 
+/// The smallest `ε` the pass thins with, `2⁻⁹⁹` px (module docs,
+/// "Rounding": below it a subnormal interval end rounds absolutely).
+pub(crate) const MIN_EPS: f32 = f32::from_bits(28 << 23);
+
 /// The thinning's `ε` for a frame-2 error `e₂`: `e₂/256` (module docs);
-/// the processor searches with `e₂ + ε`. 0 (no thinning) for `e₂ = 0`.
+/// the processor searches with `e₂ + ε`. 0 (no thinning) for `e₂` below
+/// `256 · MIN_EPS` (`2⁻⁹¹` px), `e₂ = 0` included.
 pub(crate) fn epsilon(e2: f32) -> f32 {
-    e2 * (1.0 / 256.0)
+    let eps = e2 * (1.0 / 256.0);
+    if eps >= MIN_EPS {
+        eps
+    } else {
+        0.0
+    }
 }
 
 /// Thin the boundary `src` with the tolerance `eps` ([`epsilon`]) into
@@ -264,6 +283,51 @@ mod tests {
             }
         }
         m
+    }
+
+    /// Where `ε` is tiny the interval ends are subnormal and round
+    /// absolutely: below [`MIN_EPS`] nothing is thinned (an adversary's
+    /// case, `e₂ = 10⁻⁴⁰`: a vertex `36 ε` off its chord was dropped), and
+    /// from it on every dropped vertex still lies within `0.575 ε` of its
+    /// chord, the middle vertex placed from 0 to `2.9 ε` off its chord,
+    /// rows up to 16 000 apart. (With `ε` a thousand million times smaller,
+    /// subnormal, the same vertices fail the bound.)
+    #[test]
+    fn tiny_errors_thin_within_the_bound_or_not_at_all() {
+        let case = [
+            Pixel::new(0.0, 0.0),
+            Pixel::new(f32::from_bits(0x1388), 10_000.0),
+            Pixel::new(f32::from_bits(0x5dbf), 16_000.0),
+        ];
+        let mut out = [Pixel::new(0.0, 0.0); 3];
+        assert_eq!(epsilon(1e-40), 0.0);
+        assert_eq!(thin(&case, epsilon(1e-40), &mut out, &mut None), None);
+        assert_eq!(epsilon(0.0), 0.0);
+        assert_eq!(epsilon(256.0 * MIN_EPS), MIN_EPS);
+        assert!(epsilon(f32::NAN) == 0.0);
+        let mut dropped = 0;
+        for k in 0..40 {
+            let eps = MIN_EPS * [1.0f32, 1.5, 7.0, 1e3, 1e9][k % 5];
+            for (rows, dev) in [16_000.0f32, 9_000.0, 3.0]
+                .into_iter()
+                .flat_map(|r| (0..30).map(move |j| (r, f64::from(j) * 0.1)))
+            {
+                // The middle vertex `dev · ε` to the side of the chord from
+                // (u0, 0) to (u0 + du, rows), at a third of its rows.
+                let u0 = f64::from(eps) * [0.0, 3.0, 1e3][k % 3];
+                let du = f64::from(eps) * [0.0, 50.0, -7.0, 2e4][k % 4];
+                let v1 = f64::from(rows) / 3.0;
+                let mid = u0 + du / 3.0 + dev * f64::from(eps);
+                let src = [
+                    Pixel::new(u0 as f32, 0.0),
+                    Pixel::new(mid as f32, v1 as f32),
+                    Pixel::new((u0 + du) as f32, rows),
+                ];
+                let m = check(&src, eps, 0.575 * f64::from(eps));
+                dropped += 3 - m;
+            }
+        }
+        assert!(dropped > 100, "{dropped}");
     }
 
     /// Lattice staircases (a detector's rounded straight edges), rounded

@@ -57,7 +57,7 @@
 //! [`crate::camera::MAX_IMAGE_SIDE`] rows and their margin) and a few
 //! roundings stays below `2⁻¹³²` columns, under the bound's slack of
 //! `0.0078 e` for every `ε ≥ 2⁻⁹⁹` px (`MIN_EPS`); below it, `e₂` under
-//! `2⁻⁹¹` px, the boundary is not thinned (`epsilon` is 0). (An
+//! `2⁻⁹¹` px, the boundary is not thinned (`thin` refuses such an `ε`). (An
 //! adversary's find: at `e₂ = 10⁻⁴⁰` a vertex `36 ε` off its chord was
 //! dropped, `3 333 ε` at `10⁻⁴²`; by at most about `10⁻⁴¹` px.) A vertex joins a run only
 //! with a finite slope (so a finite `1/Δv`): where a subnormal `Δv`
@@ -124,15 +124,11 @@ pub(crate) const fn gives_up(kept: usize) -> bool {
 pub(crate) const MIN_EPS: f32 = f32::from_bits(28 << 23);
 
 /// The thinning's `ε` for a frame-2 error `e₂`: `e₂/256` (module docs);
-/// the processor searches with `e₂ + ε`. 0 (no thinning) for `e₂` below
-/// `256 · MIN_EPS` (`2⁻⁹¹` px), `e₂ = 0` included.
+/// the processor searches with `e₂ + ε`. [`thin`] leaves a boundary as it
+/// is for `ε` below [`MIN_EPS`] (`e₂` below `2⁻⁹¹` px, `e₂ = 0`
+/// included), where the widening by `ε` is then only a margin.
 pub(crate) fn epsilon(e2: f32) -> f32 {
-    let eps = e2 * (1.0 / 256.0);
-    if eps >= MIN_EPS {
-        eps
-    } else {
-        0.0
-    }
+    e2 * (1.0 / 256.0)
 }
 
 /// Thin the boundary `src` with the tolerance `eps` ([`epsilon`]) into
@@ -140,7 +136,7 @@ pub(crate) fn epsilon(e2: f32) -> f32 {
 /// subsequence of `src` with its two ends, every vertex of `src` within
 /// `eps` of the segment between the two written vertices around it
 /// (module docs). `None` (nothing useful written) when `src` has fewer
-/// than three points, `eps` is not positive, `out` is too short or the
+/// than three points, `eps` is below [`MIN_EPS`] (or NaN), `out` is too short or the
 /// rows' span overflows (module docs, "Rounding"), and
 /// when the first [`CHUNK`] vertices after the first two kept more than
 /// seven in eight ([`gives_up`]: a boundary thinning does not pay for,
@@ -160,7 +156,8 @@ pub(crate) fn thin(
     tick: &mut Tick<'_>,
 ) -> Option<usize> {
     let e = eps * 0.5;
-    if src.len() < 3 || !(e > 0.0) || out.len() < src.len() {
+    // (`ε` below `MIN_EPS`, or NaN: not thinned, module docs, "Rounding".)
+    if src.len() < 3 || !(eps >= MIN_EPS) || out.len() < src.len() {
         return None;
     }
     let reach = e * REACH;
@@ -300,11 +297,10 @@ mod tests {
             Pixel::new(f32::from_bits(0x5dbf), 16_000.0),
         ];
         let mut out = [Pixel::new(0.0, 0.0); 3];
-        assert_eq!(epsilon(1e-40), 0.0);
         assert_eq!(thin(&case, epsilon(1e-40), &mut out, &mut None), None);
-        assert_eq!(epsilon(0.0), 0.0);
+        assert_eq!(thin(&case, f32::NAN, &mut out, &mut None), None);
+        assert_eq!(thin(&case, MIN_EPS * 0.99, &mut out, &mut None), None);
         assert_eq!(epsilon(256.0 * MIN_EPS), MIN_EPS);
-        assert!(epsilon(f32::NAN) == 0.0);
         let mut dropped = 0;
         for k in 0..40 {
             let eps = MIN_EPS * [1.0f32, 1.5, 7.0, 1e3, 1e9][k % 5];

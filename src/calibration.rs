@@ -46,7 +46,7 @@ use core::fmt;
 
 use crate::camera::{Camera, CameraError, Pixel};
 use crate::math::{
-    cross, dot, fmax, reduce_angle, sin_cos_reduced, sqrt, sub, AngleError, MAX_TRANSLATION,
+    cross, dot, fmax, fmin, reduce_angle, sin_cos_reduced, sqrt, sub, AngleError, MAX_TRANSLATION,
 };
 use crate::motion::{Motion, MotionError};
 
@@ -83,7 +83,7 @@ pub enum CalibrationError {
     BadTranslation,
     /// The FOEs are inconsistent with the model (e.g. `r² ≤ 0`), or the
     /// joint fit's equations are singular or too close to it (fewer than
-    /// three motions, translations on one line, [`MIN_JOINT_SPREAD`],
+    /// three motions, translations on one line: [`MIN_JOINT_SPREAD`],
     /// [`MIN_JOINT_CONDITION`]) or its iterations diverged.
     Degenerate,
     /// A result would not be finite in `f32` (finite but extreme inputs).
@@ -721,28 +721,37 @@ pub struct JointFit {
 pub const MIN_STEPWISE_CONDITION: f32 = 0.05;
 
 /// The least spread of the motions' translations [`calibrate_jointly`]
-/// accepts: the smallest pivot of the moment matrix of their points
-/// `(t_x, t_y)/t_z` scaled to a unit diagonal (0 where they lie on one
-/// line, 1 where they are uncorrelated, as the paper's five motions are).
-/// The model's FOE `(c_x + f_x x', c_y + f_y y')`, `(x', y')` the point
-/// turned by the roll, is affine in the point, so points on one line
-/// determine four of the five parameters at most, and fewer than three
-/// motions likewise (an adversary's find: two motions, or five on a line,
-/// gave `Ok` results up to 109 px off). Measured: at most 3.3·10⁻⁷ on
-/// such sets, at least 0.55 over 2 730 random cameras with motions in
-/// four directions; `10⁻⁴` between.
+/// accepts: `4 det C / (tr C)²` of the covariance `C` of their points
+/// `(t_x, t_y)/t_z`, 0 where they lie on one line (or are fewer than
+/// three), 1 where they spread alike in every direction (the paper's five
+/// motions); unchanged by turning, shifting or scaling the points. The
+/// model's FOE `(c_x + f_x x', c_y + f_y y')`, `(x', y')` the point turned
+/// by the roll, is affine in the point, so points on one line determine
+/// four of the five parameters at most, and fewer than three motions
+/// likewise (an adversary's find: two motions, or five on a line, gave
+/// `Ok` results up to 109 px off). Measured: at most 2.3·10⁻⁹ on such
+/// sets, at least 0.55 over 2 730 random cameras with motions in four
+/// directions; `10⁻⁴` refuses too points that all lie within about half
+/// a per cent of their extent from one line (three points whose triangle
+/// is that flat, `q ≈ 5.3 (h/L)²`), where the fit is poorly determined
+/// anyway.
 pub const MIN_JOINT_SPREAD: f32 = 1.0e-4;
 
 /// The least conditioning of the joint fit's normal equations
 /// [`calibrate_jointly`] accepts: their matrix's smallest Cholesky pivot
-/// scaled to a unit diagonal (a lower bound on the reciprocal of its
-/// condition number). Below it the flows leave a combination of the
-/// parameters undetermined and the `f32` sums cannot tell it from
-/// singular: measured at most 2.8·10⁻⁶ where the fit is singular (50
-/// flows a motion), at least 2.3·10⁻³ on the paper's set-up with 10 %
-/// wrong matches and 6.6·10⁻⁵ over 2 730 random cameras (images up to
-/// 16 384 px, focal lengths to 10⁵ px, aspect ratios 0.1–10). A fit
-/// refused here is [`CalibrationError::Degenerate`].
+/// scaled to a unit diagonal, which is at least the matrix's smallest
+/// eigenvalue: below it the flows leave a combination of the parameters
+/// undetermined (a motion whose flows all lie on one line through its
+/// FOE fixes that FOE in one direction only, which the translations'
+/// spread cannot see) and the `f32` sums cannot tell it from singular.
+/// (A pivot above it does not bound the condition number.) The sums are
+/// compensated (Kahan), so their rounding does not grow with the flows:
+/// measured at most 7.1·10⁻⁷ where the fit is singular with 50 flows a
+/// motion and 0 with 12 000 (a review's case; 1.0·10⁻⁵ before the
+/// compensation), at least 2.3·10⁻³ on the paper's set-up with 10 % wrong
+/// matches and 6.6·10⁻⁵ over 2 730 random cameras (images up to 16 384
+/// px, focal lengths to 10⁵ px, aspect ratios 0.1–10). A fit refused here
+/// is [`CalibrationError::Degenerate`].
 pub const MIN_JOINT_CONDITION: f32 = 1.0e-5;
 
 /// Gauss–Newton iterations of [`calibrate_jointly`] at most.
@@ -765,9 +774,11 @@ pub const JOINT_ITERATIONS: usize = 10;
 /// ([`CalibrationError::Overflow`] otherwise). A fit the motions cannot
 /// determine is [`CalibrationError::Degenerate`] whatever its residuals:
 /// fewer than three motions with two usable flows, their translations'
-/// points `(t_x, t_y)/t_z` (near) one line ([`MIN_JOINT_SPREAD`]), or
-/// normal equations too close to singular for `f32` to tell
-/// ([`MIN_JOINT_CONDITION`]). The standard deviations are the linearised
+/// points `(t_x, t_y)/t_z` on one line or within about half a per cent
+/// of their extent from it
+/// ([`MIN_JOINT_SPREAD`]), or normal equations too close to singular for
+/// `f32` to tell ([`MIN_JOINT_CONDITION`]; e.g. motions whose flows each
+/// lie on one line through their FOE). The standard deviations are the linearised
 /// ones at the result: with wrong matches among the flows they can
 /// understate the error (module docs). Work: at most `JOINT_ITERATIONS + 1` passes over the flows,
 /// each `O(n²)` per motion of `n ≤ N` flows (the median of the masks).
@@ -857,10 +868,18 @@ struct Normal {
     jtr: [f32; 5],
     ss: f32,
     n: usize,
-    /// `Σ (1, x, y)ᵀ (1, x, y)` over the motions used, `(x, y)` each one's
-    /// translation `(t_x, t_y)/t_z` (turned by the roll): singular where
-    /// they lie on one line ([`translations_conditioning`]).
-    moments: [[f32; 5]; 5],
+    /// The running compensations of `jtj` and `jtr` (Kahan's summation:
+    /// without them the sums' rounding grows with the flows, and with
+    /// twelve thousand flows a motion a singular fit's scaled pivot
+    /// reached [`MIN_JOINT_CONDITION`], a review's find).
+    jtj_c: [[f32; 5]; 5],
+    jtr_c: [f32; 5],
+    /// Over the motions used, with `(x, y)` each one's translation
+    /// `(t_x, t_y)/t_z` (turned by the roll) less the first one's: their
+    /// count and `Σx, Σy, Σx², Σxy, Σy²` ([`translations_spread`]).
+    spread: (usize, [f32; 5]),
+    /// The first used motion's point, the origin of `spread`.
+    origin: Option<(f32, f32)>,
 }
 
 impl Normal {
@@ -879,7 +898,10 @@ impl Normal {
             jtr: [0.0f32; 5],
             ss: 0.0,
             n: 0,
-            moments: [[0.0f32; 5]; 5],
+            jtj_c: [[0.0f32; 5]; 5],
+            jtr_c: [0.0f32; 5],
+            spread: (0, [0.0f32; 5]),
+            origin: None,
         };
         for m in motions {
             let mut keep = [false; N];
@@ -888,11 +910,15 @@ impl Normal {
             }
             let t = m.translation;
             let (x, y) = ((c * t[0] + s * t[1]) / t[2], (-s * t[0] + c * t[1]) / t[2]);
-            let h = [1.0, x, y];
-            for (row, &ha) in eq.moments.iter_mut().zip(h.iter()) {
-                for (cell, &hb) in row.iter_mut().zip(h.iter()) {
-                    *cell += ha * hb;
-                }
+            let (x0, y0) = *eq.origin.get_or_insert((x, y));
+            let (dx0, dy0) = (x - x0, y - y0);
+            let (count, sums) = &mut eq.spread;
+            *count += 1;
+            for (acc, v) in sums
+                .iter_mut()
+                .zip([dx0, dy0, dx0 * dx0, dx0 * dy0, dy0 * dy0])
+            {
+                *acc += v;
             }
             // d/dγ of R_zᵀ (t_x, t_y) / t_z.
             let (dx, dy) = ((-s * t[0] + c * t[1]) / t[2], (-c * t[0] - s * t[1]) / t[2]);
@@ -935,17 +961,28 @@ impl Normal {
             d[0] / le - cr * e[1] / (le2 * le),
         ];
         let j = dfdp.map(|h| dot(g, h));
-        for (row, &ja) in self.jtj.iter_mut().zip(j.iter()) {
-            for (cell, &jb) in row.iter_mut().zip(j.iter()) {
-                *cell += ja * jb;
+        for ((row, crow), &ja) in self.jtj.iter_mut().zip(self.jtj_c.iter_mut()).zip(j.iter()) {
+            for ((cell, c), &jb) in row.iter_mut().zip(crow.iter_mut()).zip(j.iter()) {
+                kahan(cell, c, ja * jb);
             }
         }
-        for (g, &ja) in self.jtr.iter_mut().zip(j.iter()) {
-            *g += ja * res;
+        for ((g, c), &ja) in self.jtr.iter_mut().zip(self.jtr_c.iter_mut()).zip(j.iter()) {
+            kahan(g, c, ja * res);
         }
         self.ss += res * res;
         self.n += 1;
     }
+}
+
+/// `*sum += x` by Kahan's compensated summation, `c` the running
+/// compensation (the low part lost so far, negated): the sum's error
+/// stays about `2u` of the terms' absolute sum however many there are.
+/// (`f32` additions are not reassociated: the compensation survives.)
+fn kahan(sum: &mut f32, c: &mut f32, x: f32) {
+    let y = x - *c;
+    let t = *sum + y;
+    *c = (t - *sum) - y;
+    *sum = t;
 }
 
 /// The flows of motion `m` whose misalignment from the FOE `model`
@@ -990,10 +1027,10 @@ fn joint_fit(p: &Params, eq: &Normal, iterations: usize) -> Result<JointFit, Cal
     let rms = sqrt(eq.ss / eq.n as f32);
     let dof = eq.n.saturating_sub(5).max(1) as f32;
     let var = rms * rms * eq.n as f32 / dof;
-    // A fit the flows do not determine (a review's find: two motions, or
-    // translations on one line, gave `Ok` 90 px off with σ of a tenth of
-    // a pixel): refused, whatever the residuals.
-    if translations_conditioning(&eq.moments) < MIN_JOINT_SPREAD
+    // A fit the flows do not determine (an adversary's find: two motions,
+    // or translations on one line, gave `Ok` up to 109 px off with σ of a
+    // tenth of a pixel): refused, whatever the residuals.
+    if translations_spread(eq.spread) < MIN_JOINT_SPREAD
         || joint_conditioning(&eq.jtj) < MIN_JOINT_CONDITION
     {
         return Err(CalibrationError::Degenerate);
@@ -1116,7 +1153,7 @@ fn joint_conditioning(a: &[[f32; 5]; 5]) -> f32 {
     let mut least = f32::INFINITY;
     for (i, row) in l.iter().enumerate() {
         let p = row.get(i).copied().unwrap_or(0.0);
-        least = crate::math::fmin(least, p * p);
+        least = fmin(least, p * p);
     }
     if least.is_finite() {
         least
@@ -1125,18 +1162,28 @@ fn joint_conditioning(a: &[[f32; 5]; 5]) -> f32 {
     }
 }
 
-/// The conditioning of the motions' translations in a joint fit: the
-/// smallest Cholesky pivot of their moment matrix `Σ (1, x, y)ᵀ (1, x, y)`
-/// ([`Normal::moments`], its 3 × 3 block) scaled to a unit diagonal: 0
-/// where the points `(x, y)` lie on one line (or are fewer than three).
-fn translations_conditioning(m: &[[f32; 5]; 5]) -> f32 {
-    let mut a = *m;
-    for (i, row) in a.iter_mut().enumerate().skip(3) {
-        if let Some(d) = row.get_mut(i) {
-            *d = 1.0;
-        }
+/// The spread of the motions' points `(x, y)` in a joint fit
+/// ([`Normal::spread`]): `4 det C / (tr C)²` of their covariance matrix
+/// `C`, the product of its eigenvalues over their squared mean, between 0
+/// (the points on one line, or fewer than three) and 1 (spread alike in
+/// every direction, as the paper's five motions are). Unchanged by a
+/// rotation, a shift or a scaling of the points (taken from the first
+/// point, so that the sums do not cancel more than the spread itself).
+fn translations_spread((count, [sx, sy, sxx, sxy, syy]): (usize, [f32; 5])) -> f32 {
+    if count < 3 {
+        return 0.0;
     }
-    joint_conditioning(&a)
+    let n = count as f32;
+    let (mx, my) = (sx / n, sy / n);
+    let (cxx, cxy, cyy) = (sxx / n - mx * mx, sxy / n - mx * my, syy / n - my * my);
+    let (det, tr) = (cxx * cyy - cxy * cxy, cxx + cyy);
+    let q = 4.0 * det / (tr * tr);
+    // (A NaN or a rounding below 0: 0; above 1 only by rounding.)
+    if q > 0.0 {
+        fmin(q, 1.0)
+    } else {
+        0.0
+    }
 }
 
 /// Diagonal of the inverse of a 5×5 SPD matrix (for standard deviations).
@@ -1148,4 +1195,69 @@ fn inverse_diagonal5(a: [[f32; 5]; 5]) -> Option<[f32; 5]> {
         *o = *solve5(a, e)?.get(i)?;
     }
     Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Kahan's summation keeps a million terms' sum within the last place
+    /// of the `f64` sum, where the plain `f32` sum drifts by 30 times
+    /// that (what made a singular joint fit's pivot grow with its flows).
+    #[test]
+    fn compensated_sums_do_not_drift_with_the_terms() {
+        let (mut plain, mut sum, mut c, mut exact) = (0.0f32, 0.0f32, 0.0f32, 0.0f64);
+        for k in 0..1_000_000u32 {
+            let x = 0.1 + (k % 97) as f32 * 1.0e-3;
+            plain += x;
+            kahan(&mut sum, &mut c, x);
+            exact += f64::from(x);
+        }
+        let rel = |v: f32| ((f64::from(v) - exact) / exact).abs();
+        // (The `f32` result itself is within 2⁻²⁴ of the sum.)
+        assert!(rel(sum) < 1.0e-7, "{}", rel(sum));
+        assert!(rel(plain) > 1.0e-6, "{}", rel(plain));
+    }
+
+    /// The translations' spread is 0 on a line (and for fewer than three
+    /// points), 1 for points spread alike, and unchanged by turning,
+    /// shifting and scaling them (a review found the first measure, a
+    /// moment matrix scaled to a unit diagonal, 0.8 or 10⁻⁷ for the same
+    /// points as their line lay along an axis or not).
+    #[test]
+    fn the_spread_sees_a_line_in_any_direction() {
+        let spread_of = |pts: &[(f32, f32)]| {
+            let (x0, y0) = pts[0];
+            let mut sums = [0.0f32; 5];
+            for &(x, y) in pts {
+                let (dx, dy) = (x - x0, y - y0);
+                for (a, v) in sums.iter_mut().zip([dx, dy, dx * dx, dx * dy, dy * dy]) {
+                    *a += v;
+                }
+            }
+            translations_spread((pts.len(), sums))
+        };
+        let square = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+        assert!((spread_of(&square) - 1.0).abs() < 1e-6);
+        assert_eq!(spread_of(&square[..2]), 0.0);
+        for angle in [0.0f32, 0.3, 0.785, 1.2, 2.0] {
+            let (s, c) = (angle.sin(), angle.cos());
+            let turn = |(x, y): (f32, f32), k: f32, d: (f32, f32)| {
+                (k * (c * x - s * y) + d.0, k * (s * x + c * y) + d.1)
+            };
+            for (k, d) in [(1.0, (0.0, 0.0)), (0.01, (3.0, -2.0)), (50.0, (-0.4, 0.7))] {
+                let line: [(f32, f32); 5] =
+                    core::array::from_fn(|i| turn((i as f32 - 2.0, 0.0), k, d));
+                assert!(spread_of(&line) < 1e-6, "{angle} {k}");
+                // The middle point 5 % of the extent off the line, and
+                // 0.1 %: the same spread at every angle, scale and shift.
+                for (off, lo, hi) in [(0.2f32, 0.01, 0.03), (0.004, 0.0, 1e-4)] {
+                    let mut bent = line;
+                    bent[2] = turn((0.0, off), k, d);
+                    let q = spread_of(&bent);
+                    assert!(lo <= q && q < hi, "{angle} {k} {off}: {q}");
+                }
+            }
+        }
+    }
 }

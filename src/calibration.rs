@@ -722,19 +722,21 @@ pub const MIN_STEPWISE_CONDITION: f32 = 0.05;
 
 /// The least spread of the motions' translations [`calibrate_jointly`]
 /// accepts: `4 det C / (tr C)²` of the covariance `C` of their points
-/// `(t_x, t_y)/t_z`, 0 where they lie on one line (or are fewer than
-/// three), 1 where they spread alike in every direction (the paper's five
-/// motions); unchanged by turning, shifting or scaling the points. The
+/// `(t_x, t_y)/t_z`, about `4 λ_min/λ_max`, 0 where they lie on one line
+/// (or are fewer than three), 1 where they spread alike in every
+/// direction (the paper's five motions); unchanged by turning, shifting
+/// or scaling the points. The
 /// model's FOE `(c_x + f_x x', c_y + f_y y')`, `(x', y')` the point turned
 /// by the roll, is affine in the point, so points on one line determine
 /// four of the five parameters at most, and fewer than three motions
 /// likewise (an adversary's find: two motions, or five on a line, gave
-/// `Ok` results up to 109 px off). Measured: at most 2.3·10⁻⁹ on such
-/// sets, at least 0.55 over 2 730 random cameras with motions in four
-/// directions; `10⁻⁴` refuses too points that all lie within about half
-/// a per cent of their extent from one line (three points whose triangle
-/// is that flat, `q ≈ 5.3 (h/L)²`), where the fit is poorly determined
-/// anyway.
+/// `Ok` results up to 109 px off). Measured with this measure: at most
+/// 4.7·10⁻¹⁰ on such sets, at least 0.548 over 2 730 random cameras with
+/// motions in four directions, 1.0 on the paper's;
+/// `10⁻⁴` refuses too sets whose spread across their line is under about
+/// half a per cent of the spread along it (`λ_min/λ_max < 2.5·10⁻⁵`: three
+/// points whose triangle's height is under 0.43 % of its base, `q ≈ 5.3
+/// (h/L)²`), where the fit is poorly determined anyway.
 pub const MIN_JOINT_SPREAD: f32 = 1.0e-4;
 
 /// The least conditioning of the joint fit's normal equations
@@ -774,8 +776,8 @@ pub const JOINT_ITERATIONS: usize = 10;
 /// ([`CalibrationError::Overflow`] otherwise). A fit the motions cannot
 /// determine is [`CalibrationError::Degenerate`] whatever its residuals:
 /// fewer than three motions with two usable flows, their translations'
-/// points `(t_x, t_y)/t_z` on one line or within about half a per cent
-/// of their extent from it
+/// points `(t_x, t_y)/t_z` on one line or nearly (their spread across it
+/// under about half a per cent of that along it)
 /// ([`MIN_JOINT_SPREAD`]), or normal equations too close to singular for
 /// `f32` to tell ([`MIN_JOINT_CONDITION`]; e.g. motions whose flows each
 /// lie on one line through their FOE). The standard deviations are the linearised
@@ -874,12 +876,64 @@ struct Normal {
     /// reached [`MIN_JOINT_CONDITION`], a review's find).
     jtj_c: [[f32; 5]; 5],
     jtr_c: [f32; 5],
-    /// Over the motions used, with `(x, y)` each one's translation
-    /// `(t_x, t_y)/t_z` (turned by the roll) less the first one's: their
-    /// count and `Σx, Σy, Σx², Σxy, Σy²` ([`translations_spread`]).
-    spread: (usize, [f32; 5]),
-    /// The first used motion's point, the origin of `spread`.
+    /// The spread of the motions used: each one's point `(x, y)`, its
+    /// translation `(t_x, t_y)/t_z` turned by the roll.
+    spread: Spread,
+}
+
+/// The spread of points `(x, y)` (the motions' of a joint fit): their
+/// count, and the mean and co-moments of the points less the first one by
+/// Welford's update. Less the first point, the rounding does not grow with
+/// the points' distance from the origin (Welford's mean alone rounds to
+/// the coordinates' size: `q` 5·10⁻⁶ for five collinear points 3 from it
+/// and 0.01 apart); by Welford's update, not with the first point's
+/// distance from the others (plain shifted sums cancelled to `q` 4·10⁻⁴ on
+/// a thousand collinear points with the first 1 000 from them, a
+/// review's find).
+#[derive(Debug, Clone, Copy, Default)]
+struct Spread {
+    n: u32,
     origin: Option<(f32, f32)>,
+    mean: (f32, f32),
+    /// `Σ (x − x̄)², Σ (x − x̄)(y − ȳ), Σ (y − ȳ)²`.
+    m: (f32, f32, f32),
+}
+
+impl Spread {
+    fn push(&mut self, x: f32, y: f32) {
+        let (x0, y0) = *self.origin.get_or_insert((x, y));
+        let (x, y) = (x - x0, y - y0);
+        self.n = self.n.saturating_add(1);
+        let n = self.n as f32;
+        let (dx, dy) = (x - self.mean.0, y - self.mean.1);
+        self.mean = (self.mean.0 + dx / n, self.mean.1 + dy / n);
+        let (ex, ey) = (x - self.mean.0, y - self.mean.1);
+        self.m = (self.m.0 + dx * ex, self.m.1 + dx * ey, self.m.2 + dy * ey);
+    }
+
+    /// `4 det C / (tr C)²` of the points' covariance `C`, the product of
+    /// its eigenvalues over their squared mean: between 0 (the points on
+    /// one line, or fewer than three) and 1 (spread alike in every
+    /// direction, as the paper's five motions are), about `4 λ_min/λ_max`
+    /// where small; unchanged by turning, shifting or scaling the points
+    /// (each term taken over the trace before the product, so that
+    /// neither over- nor underflows).
+    fn q(&self) -> f32 {
+        if self.n < 3 {
+            return 0.0;
+        }
+        let (sxx, sxy, syy) = self.m;
+        let tr = sxx + syy;
+        let (a, b, c) = (sxx / tr, sxy / tr, syy / tr);
+        let q = 4.0 * (a * c - b * b);
+        // (A NaN, from a zero or non-finite trace, or a rounding below 0:
+        // 0; above 1 only by rounding.)
+        if q > 0.0 {
+            fmin(q, 1.0)
+        } else {
+            0.0
+        }
+    }
 }
 
 impl Normal {
@@ -900,8 +954,7 @@ impl Normal {
             n: 0,
             jtj_c: [[0.0f32; 5]; 5],
             jtr_c: [0.0f32; 5],
-            spread: (0, [0.0f32; 5]),
-            origin: None,
+            spread: Spread::default(),
         };
         for m in motions {
             let mut keep = [false; N];
@@ -910,16 +963,7 @@ impl Normal {
             }
             let t = m.translation;
             let (x, y) = ((c * t[0] + s * t[1]) / t[2], (-s * t[0] + c * t[1]) / t[2]);
-            let (x0, y0) = *eq.origin.get_or_insert((x, y));
-            let (dx0, dy0) = (x - x0, y - y0);
-            let (count, sums) = &mut eq.spread;
-            *count += 1;
-            for (acc, v) in sums
-                .iter_mut()
-                .zip([dx0, dy0, dx0 * dx0, dx0 * dy0, dy0 * dy0])
-            {
-                *acc += v;
-            }
+            eq.spread.push(x, y);
             // d/dγ of R_zᵀ (t_x, t_y) / t_z.
             let (dx, dy) = ((-s * t[0] + c * t[1]) / t[2], (-c * t[0] - s * t[1]) / t[2]);
             let foe = [model.cx + model.fx * x, model.cy + model.fy * y];
@@ -1030,9 +1074,7 @@ fn joint_fit(p: &Params, eq: &Normal, iterations: usize) -> Result<JointFit, Cal
     // A fit the flows do not determine (an adversary's find: two motions,
     // or translations on one line, gave `Ok` up to 109 px off with σ of a
     // tenth of a pixel): refused, whatever the residuals.
-    if translations_spread(eq.spread) < MIN_JOINT_SPREAD
-        || joint_conditioning(&eq.jtj) < MIN_JOINT_CONDITION
-    {
+    if eq.spread.q() < MIN_JOINT_SPREAD || joint_conditioning(&eq.jtj) < MIN_JOINT_CONDITION {
         return Err(CalibrationError::Degenerate);
     }
     let inv_diag = inverse_diagonal5(eq.jtj).ok_or(CalibrationError::Degenerate)?;
@@ -1162,30 +1204,6 @@ fn joint_conditioning(a: &[[f32; 5]; 5]) -> f32 {
     }
 }
 
-/// The spread of the motions' points `(x, y)` in a joint fit
-/// ([`Normal::spread`]): `4 det C / (tr C)²` of their covariance matrix
-/// `C`, the product of its eigenvalues over their squared mean, between 0
-/// (the points on one line, or fewer than three) and 1 (spread alike in
-/// every direction, as the paper's five motions are). Unchanged by a
-/// rotation, a shift or a scaling of the points (taken from the first
-/// point, so that the sums do not cancel more than the spread itself).
-fn translations_spread((count, [sx, sy, sxx, sxy, syy]): (usize, [f32; 5])) -> f32 {
-    if count < 3 {
-        return 0.0;
-    }
-    let n = count as f32;
-    let (mx, my) = (sx / n, sy / n);
-    let (cxx, cxy, cyy) = (sxx / n - mx * mx, sxy / n - mx * my, syy / n - my * my);
-    let (det, tr) = (cxx * cyy - cxy * cxy, cxx + cyy);
-    let q = 4.0 * det / (tr * tr);
-    // (A NaN or a rounding below 0: 0; above 1 only by rounding.)
-    if q > 0.0 {
-        fmin(q, 1.0)
-    } else {
-        0.0
-    }
-}
-
 /// Diagonal of the inverse of a 5×5 SPD matrix (for standard deviations).
 fn inverse_diagonal5(a: [[f32; 5]; 5]) -> Option<[f32; 5]> {
     let mut out = [0.0f32; 5];
@@ -1199,6 +1217,7 @@ fn inverse_diagonal5(a: [[f32; 5]; 5]) -> Option<[f32; 5]> {
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
     use super::*;
 
     /// Kahan's summation keeps a million terms' sum within the last place
@@ -1223,19 +1242,19 @@ mod tests {
     /// points), 1 for points spread alike, and unchanged by turning,
     /// shifting and scaling them (a review found the first measure, a
     /// moment matrix scaled to a unit diagonal, 0.8 or 10⁻⁷ for the same
-    /// points as their line lay along an axis or not).
+    /// points as their line lay along an axis or not), also for many
+    /// collinear points far from the first one or from the origin and at
+    /// scales from 10⁻¹⁵ to 10¹⁵ (reviews found sums shifted by the first
+    /// point cancelling to 4·10⁻⁴, and an unnormalised determinant
+    /// underflowing to 0 for a unit square scaled by 10⁻¹²).
     #[test]
     fn the_spread_sees_a_line_in_any_direction() {
         let spread_of = |pts: &[(f32, f32)]| {
-            let (x0, y0) = pts[0];
-            let mut sums = [0.0f32; 5];
+            let mut sp = Spread::default();
             for &(x, y) in pts {
-                let (dx, dy) = (x - x0, y - y0);
-                for (a, v) in sums.iter_mut().zip([dx, dy, dx * dx, dx * dy, dy * dy]) {
-                    *a += v;
-                }
+                sp.push(x, y);
             }
-            translations_spread((pts.len(), sums))
+            sp.q()
         };
         let square = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
         assert!((spread_of(&square) - 1.0).abs() < 1e-6);
@@ -1258,6 +1277,22 @@ mod tests {
                     assert!(lo <= q && q < hi, "{angle} {k} {off}: {q}");
                 }
             }
+        }
+        // A first point far from a thousand collinear ones, far from the
+        // origin, and the same points scaled.
+        for (far, at) in [(10.0f32, 0.0f32), (1000.0, 0.0), (0.0, 1.0e4)] {
+            let (s, c) = 0.785f32.sin_cos();
+            let mut pts = std::vec![(at + far * c, at + far * s)];
+            pts.extend((0..1000).map(|i| {
+                let t = i as f32 / 1000.0;
+                (at + t * c, at + t * s)
+            }));
+            assert!(spread_of(&pts) < 1e-5, "{far} {at}: {}", spread_of(&pts));
+        }
+        for k in [1.0e-15f32, 1.0e-12, 1.0e12, 1.0e15] {
+            let scaled: std::vec::Vec<(f32, f32)> =
+                square.iter().map(|&(x, y)| (x * k, y * k)).collect();
+            assert!((spread_of(&scaled) - 1.0).abs() < 1e-5, "{k}");
         }
     }
 }

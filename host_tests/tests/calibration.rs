@@ -928,22 +928,35 @@ fn stepwise_sensitivity_for_any_aspect() {
 }
 
 /// Exact flows (rounded to `f32` only) of `n` feature points at depths
-/// 8–40 for the translation `t`.
+/// 8–40 for the translation `t`: anywhere in the image, or with `line`
+/// on the image line from the motion's FOE towards that pixel (from the
+/// FOE to 1.5 times as far), which fixes the FOE in one direction only.
 fn exact_flows(
     cam: &TrueCamera,
     t: [f64; 3],
     n: usize,
+    line: Option<[f64; 2]>,
     rng: &mut host_tests::synth::Rng,
 ) -> Vec<Flow> {
+    let foe = cam.foe(t);
     let mut out = Vec::new();
-    for _ in 0..100 * n {
+    for _ in 0..1000 * n {
         if out.len() == n {
             break;
         }
-        let uv = [
-            rng.uniform(0.0, cam.width - 1.0),
-            rng.uniform(0.0, cam.height - 1.0),
-        ];
+        let uv = match line {
+            None => [
+                rng.uniform(0.0, cam.width - 1.0),
+                rng.uniform(0.0, cam.height - 1.0),
+            ],
+            Some(d) => {
+                let s = rng.uniform(0.0, 1.5);
+                [foe[0] + s * (d[0] - foe[0]), foe[1] + s * (d[1] - foe[1])]
+            }
+        };
+        if !(0.0..cam.width).contains(&uv[0]) || !(0.0..cam.height).contains(&uv[1]) {
+            continue;
+        }
         let p = cam.unproject(uv, rng.uniform(8.0, 40.0));
         let Some(q) = cam.project([p[0] - t[0], p[1] - t[1], p[2] - t[2]]) else {
             continue;
@@ -1041,7 +1054,7 @@ fn joint_fits_the_motions_cannot_determine_are_degenerate() {
                         if grid {
                             host_tests::calib::flows(&cam, t, 50, 0.0, &mut rng)
                         } else {
-                            exact_flows(&cam, t, 50, &mut rng)
+                            exact_flows(&cam, t, 50, None, &mut rng)
                         }
                     })
                     .collect();
@@ -1091,40 +1104,7 @@ fn joint_fits_whose_flows_fix_foes_in_one_direction_are_degenerate() {
         let sets: Vec<Vec<Flow>> = ts
             .iter()
             .zip(&toward)
-            .map(|(&t, &line)| {
-                let foe = cam.foe(t);
-                let mut out = Vec::new();
-                for _ in 0..100_000 {
-                    if out.len() == 200 {
-                        break;
-                    }
-                    let uv = match line {
-                        None => [
-                            rng.uniform(0.0, cam.width - 1.0),
-                            rng.uniform(0.0, cam.height - 1.0),
-                        ],
-                        Some(d) => {
-                            let s = rng.uniform(0.0, 1.5);
-                            [foe[0] + s * (d[0] - foe[0]), foe[1] + s * (d[1] - foe[1])]
-                        }
-                    };
-                    if !(0.0..cam.width).contains(&uv[0]) || !(0.0..cam.height).contains(&uv[1]) {
-                        continue;
-                    }
-                    let p = cam.unproject(uv, rng.uniform(8.0, 40.0));
-                    let Some(q) = cam.project([p[0] - t[0], p[1] - t[1], p[2] - t[2]]) else {
-                        continue;
-                    };
-                    let (from, to) = (
-                        Pixel::new(uv[0] as f32, uv[1] as f32),
-                        Pixel::new(q[0] as f32, q[1] as f32),
-                    );
-                    if from != to {
-                        out.push(Flow { from, to });
-                    }
-                }
-                out
-            })
+            .map(|(&t, &line)| exact_flows(&cam, t, 200, line, &mut rng))
             .collect();
         assert!(sets.iter().all(|s| s.len() == 200), "seed {seed}");
         let mf = host_tests::calib::motion_flows(&ts, &sets);

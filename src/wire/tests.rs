@@ -68,16 +68,23 @@ fn frame_packet(counter: u16, id: u32, bs: &[(f32, Vec<Pixel>)]) -> Vec<u8> {
 }
 
 fn motion_packet(counter: u16, from: u32, to: u32) -> Vec<u8> {
+    motion_link(
+        counter,
+        &MotionFields {
+            from,
+            to,
+            translation: [0.0, 0.0, 0.4],
+            rotation: [0.0, 0.01, 0.0],
+            translation_error: Some(0.01),
+            rotation_error: None,
+        },
+    )
+}
+
+/// The motion packet `m`, numbered `counter`, as the link carries it.
+fn motion_link(counter: u16, m: &MotionFields) -> Vec<u8> {
     let mut raw = [0u8; 80];
-    let m = MotionFields {
-        from,
-        to,
-        translation: [0.0, 0.0, 0.4],
-        rotation: [0.0, 0.01, 0.0],
-        translation_error: Some(0.01),
-        rotation_error: None,
-    };
-    let n = encode::motion(&mut raw, IDS.motion, counter, &m).unwrap();
+    let n = encode::motion(&mut raw, IDS.motion, counter, m).unwrap();
     link(&raw[..n])
 }
 
@@ -582,18 +589,28 @@ fn drive_step() -> crate::Motion {
 /// The motion packet from frame `to − 1` to `to` of [`drive_step`], with
 /// the error bounds given.
 fn drive_motion_packet(counter: u16, to: u32, te: Option<f32>, re: Option<[f32; 3]>) -> Vec<u8> {
+    drive_motion(counter, (to - 1, to), (te, re))
+}
+
+/// The motion packet of [`drive_step`] from frame `from` to `to`, with the
+/// error bounds given.
+fn drive_motion(
+    counter: u16,
+    (from, to): (u32, u32),
+    (te, re): (Option<f32>, Option<[f32; 3]>),
+) -> Vec<u8> {
     let step = drive_step();
-    let mut raw = [0u8; 80];
-    let m = MotionFields {
-        from: to - 1,
-        to,
-        translation: step.translation(),
-        rotation: step.angles(),
-        translation_error: te,
-        rotation_error: re,
-    };
-    let n = encode::motion(&mut raw, IDS.motion, counter, &m).unwrap();
-    link(&raw[..n])
+    motion_link(
+        counter,
+        &MotionFields {
+            from,
+            to,
+            translation: step.translation(),
+            rotation: step.angles(),
+            translation_error: te,
+            rotation_error: re,
+        },
+    )
 }
 
 /// A drive through the link into a key-frame fusion (`FrameJob::run_fused`)
@@ -737,22 +754,6 @@ fn run_fused_judges_the_motion_bounds_it_uses() {
     assert!(paired_absent >= 2, "{paired_absent}");
 }
 
-/// The motion packet of [`drive_step`] from frame `from` to `to`.
-fn motion_packet_between(counter: u16, from: u32, to: u32) -> Vec<u8> {
-    let step = drive_step();
-    let mut raw = [0u8; 80];
-    let m = MotionFields {
-        from,
-        to,
-        translation: step.translation(),
-        rotation: step.angles(),
-        translation_error: None,
-        rotation_error: None,
-    };
-    let n = encode::motion(&mut raw, IDS.motion, counter, &m).unwrap();
-    link(&raw[..n])
-}
-
 /// The chain `run_fused` goes on is the previous job's frame, not a frame
 /// id: a frame refused with the fusion's last id (an adversary's find:
 /// frame 9 of a drive sent as id 4, after frame 4, with a radius above
@@ -776,18 +777,9 @@ fn run_fused_chains_onto_the_previous_jobs_frame_not_its_id() {
                     id: u32,
                     at: f32,
                     r: f32| {
-        if let Some((from, to)) = motion {
-            rx.feed(&motion_packet_between(counter, from, to), |_| {});
-            counter += 1;
-        }
-        let pts = drive_edge(at, -1.0);
-        let packet = frame_packet(counter, id, &[(r, pts.clone()), (r, pts)]);
-        counter += 1;
         let mut got = None;
-        rx.feed(&packet, |e| {
-            if let super::Event::Frame(job) = e {
-                got = Some(job.run_fused(f));
-            }
+        send_job(rx, &mut counter, (motion, id, at, r), |j| {
+            got = Some(j.run_fused(f));
         });
         got.expect("a frame job")
     };
@@ -855,7 +847,7 @@ fn send_job(
     mut on: impl FnMut(&super::FrameJob<'_, 64, 2>),
 ) {
     if let Some((from, to)) = motion {
-        rx.feed(&motion_packet_between(*counter, from, to), |_| {});
+        rx.feed(&drive_motion(*counter, (from, to), (None, None)), |_| {});
         *counter += 1;
     }
     let pts = drive_edge(at, -1.0);
@@ -965,7 +957,7 @@ fn a_motion_before_the_kept_frame_pairs_nothing() {
     let mut rx = super::Receiver::<64, 2>::new(IDS, Config::DEFAULT);
     rx.feed(&[0], |_| {});
     rx.feed(&camera_packet(0), |_| {});
-    rx.feed(&motion_packet_between(1, 0, 1), |_| {});
+    rx.feed(&drive_motion(1, (0, 1), (None, None)), |_| {});
     let pts = |n: f32| drive_edge(n, -1.0);
     let mut log = Vec::new();
     for (c, id) in [(2u16, 0u32), (3, 1)] {

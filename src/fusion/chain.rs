@@ -28,7 +28,11 @@
 //!   `ω₁ + ω₂` (the triangle inequality on rotations).
 //!
 //! Each bound is rounded up by `2⁻¹⁶` of itself against the `f32` rounding
-//! of its own arithmetic. The translation bound grows with the travel, the
+//! of its own arithmetic, except where that arithmetic is exact: with no
+//! rotation error so far (`ω₁ = 0`, `ε₁ = 0`, the first step from the key
+//! frame) the terms the chain adds are exact zeros, so the first
+//! partner's bounds are the step's own (a step's bounds at the
+//! configuration's limit would otherwise be rounded past it). The translation bound grows with the travel, the
 //! rotation bound with the number of frames: a key frame's last partner is
 //! the last one whose bounds [`crate::Config`] still accepts (rotation
 //! errors summing to at most 0.1 rad), see [`crate::fusion`].
@@ -202,13 +206,27 @@ impl Chain {
                 ..*self
             };
         }
+        // No rotation error so far (`ω₁ = 0`, `ε₁ = 0`: the first step from
+        // the key frame, or steps without bounds before this one): every
+        // term the chain adds to this step's bounds is an exact 0, so the
+        // sums below are exact and are not rounded up. (Rounded up, the
+        // first partner's bounds were above the step's own, and a step's
+        // bounds at a configuration's limit, rotation errors summing to
+        // 0.1 rad, started a new key frame every frame: an adversary's
+        // find.) The translation bound's `a · row` is exact too where the
+        // orientation's rows sum to 1 (the identity).
+        let exact = self.omega == 0.0 && self.eps == [0.0; 3];
+        let up = |x: f32, exact: bool| if exact { x } else { x * ROUND_UP };
         let a = self.omega * (norm(t2) + SQRT3 * b.delta) + b.delta;
         let row = self
             .r
             .iter()
             .map(|[x, y, z]| x.abs() + y.abs() + z.abs())
             .fold(0.0f32, |m, s| if s > m { s } else { m });
-        let delta = (self.delta + a * row) * ROUND_UP;
+        let delta = up(
+            self.delta + a * row,
+            exact && self.delta == 0.0 && row == 1.0,
+        );
         let mut eps = [0.0f32; 3];
         for (k, e) in eps.iter_mut().enumerate() {
             let mut s = b.eps.get(k).copied().unwrap_or(0.0) + self.omega * b.omega;
@@ -216,14 +234,14 @@ impl Chain {
                 let rlk = row.get(k).copied().unwrap_or(0.0);
                 s += rlk.abs() * self.eps.get(l).copied().unwrap_or(0.0);
             }
-            *e = s * ROUND_UP;
+            *e = up(s, exact);
         }
         Chain {
             t,
             r,
             delta,
             eps,
-            omega: (self.omega + b.omega) * ROUND_UP,
+            omega: up(self.omega + b.omega, exact),
             round_t,
             round_r,
             pair_t,
@@ -452,6 +470,43 @@ mod tests {
         }
     }
 
+    /// Bounds at a configuration's limit (rotation errors summing to 0.1
+    /// rad, the largest translation error) still pair the key frame's
+    /// first partner: its bounds are the step's own, not rounded past
+    /// the limit (an adversary's find: every frame a new key frame,
+    /// `ErrorLimit`, nothing fused). The second partner's composed
+    /// rotation bound is past the limit, as it must be.
+    #[test]
+    fn bounds_at_the_limit_pair_the_first_partner() {
+        let m = Motion::new([0.1, 0.0, 0.4], [0.01, 0.02, 0.03]).unwrap();
+        let limit = crate::math::MAX_TRANSLATION;
+        for eps in [[0.0, 0.1, 0.0], [0.05, 0.03, 0.02], [0.1, 0.0, 0.0]] {
+            let base = Config::DEFAULT
+                .with_translation_error(limit)
+                .unwrap()
+                .with_rotation_error(eps)
+                .unwrap();
+            let b = StepBounds::of(&base);
+            let c = Chain::IDENTITY.then(&m, &b);
+            let (cfg, _) = c.config(&base).unwrap();
+            assert_eq!(cfg.rotation_error(), eps);
+            assert!(c.then(&m, &b).config(&base).is_err());
+        }
+        // After steps without bounds (the orientation no longer the
+        // identity), the rotation bound is still the step's own, and the
+        // translation bound holds the step's turned by the orientation.
+        let none = StepBounds::of(&Config::DEFAULT);
+        let base = Config::DEFAULT
+            .with_translation_error(0.01)
+            .unwrap()
+            .with_rotation_error([0.0, 0.1, 0.0])
+            .unwrap();
+        let b = StepBounds::of(&base);
+        let c = Chain::IDENTITY.then(&m, &none).then(&m, &b);
+        assert_eq!(c.eps, b.eps);
+        assert!(c.delta > 0.01, "{}", c.delta);
+    }
+
     #[test]
     fn first_partner_has_the_per_frame_bounds_and_they_grow() {
         let base = Config::DEFAULT
@@ -462,7 +517,9 @@ mod tests {
         let b = StepBounds::of(&base);
         let m = Motion::new([0.0, 0.0, 0.4], [0.0, 0.02, 0.0]).unwrap();
         let mut c = Chain::IDENTITY.then(&m, &b);
-        assert!((c.delta - 0.02).abs() < 1e-6 && (c.eps[0] - 0.004).abs() < 1e-6);
+        // Exactly the step's own (the composition with the key frame's
+        // identity is exact).
+        assert_eq!((c.delta, c.eps, c.omega), (b.delta, b.eps, b.omega));
         let (cfg, _) = c.config(&base).unwrap();
         assert!(cfg.translation_error() >= 0.02);
         let mut frames = 1;

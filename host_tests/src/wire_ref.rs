@@ -337,8 +337,13 @@ fn motion_payload(p: &[u8]) -> Out {
         }
     }
     if let Some(r) = re {
-        if let Err(e) = Config::DEFAULT.with_rotation_error(r) {
-            return Out::Err(WireError::MotionBounds(e));
+        // The bounds as sent, then their box about the camera's axes.
+        let axes = roadstereo::motion_error::euler_error_box(motion.angles(), r)
+            .unwrap_or([f32::INFINITY; 3]);
+        for v in [r, axes] {
+            if let Err(e) = Config::DEFAULT.with_rotation_error(v) {
+                return Out::Err(WireError::MotionBounds(e));
+            }
         }
     }
     if p.len() != 52 {

@@ -267,7 +267,6 @@ fn main() -> ! {
     let rx: &'static mut Receiver<N, B> = RECEIVER.take();
     let mut runner = Runner::new();
     let mut raw = [0u8; RAW];
-    let mut framed = [0u8; wire::cobs_max(RAW)];
     let (mut results, mut reports) = (0u16, 0u16);
     defmt::info!(
         "roadstereo link: UART0, capacity {=usize} x {=usize}, budget {=u32} instructions/frame, within a deadline {=bool} (limit {=u32}), fused {=bool}",
@@ -282,7 +281,7 @@ fn main() -> ! {
         "sizes receiver={=usize} uart_link={=usize} result_buffers={=usize}",
         core::mem::size_of::<Receiver<N, B>>(),
         core::mem::size_of::<UartLink<Uart0>>(),
-        RAW + wire::cobs_max(RAW)
+        RAW
     );
     loop {
         let mut end = false;
@@ -308,8 +307,8 @@ fn main() -> ! {
                 match encode::result(&mut raw, ids.result, results, &head, &step, &quality) {
                     Ok(n) => {
                         results = results.wrapping_add(1);
-                        if write_packet(&mut tx, raw.get(..n).unwrap_or(&[]), &mut framed).is_err() {
-                            defmt::error!("result packet too large");
+                        if write_packet(&mut tx, raw.get(..n).unwrap_or(&[])).is_err() {
+                            defmt::error!("result packet not written");
                         }
                     }
                     Err(e) => defmt::error!("result packet: {}", e),
@@ -319,7 +318,7 @@ fn main() -> ! {
                 defmt::warn!("link error: {}", e);
                 if let Ok(n) = encode::report(&mut raw, ids.report, reports, &e) {
                     reports = reports.wrapping_add(1);
-                    let _ = write_packet(&mut tx, raw.get(..n).unwrap_or(&[]), &mut framed);
+                    let _ = write_packet(&mut tx, raw.get(..n).unwrap_or(&[]));
                 }
             }
             Event::End => end = true,
@@ -331,7 +330,7 @@ fn main() -> ! {
         if end {
             let c = *rx.counters();
             if let Ok(n) = encode::summary(&mut raw, ids.summary, 0, &c.values()) {
-                let _ = write_packet(&mut tx, raw.get(..n).unwrap_or(&[]), &mut framed);
+                let _ = write_packet(&mut tx, raw.get(..n).unwrap_or(&[]));
             }
             defmt::info!(
                 "done bytes={=u32} frames={=u32} motions={=u32} cameras={=u32} errors={=u32}",

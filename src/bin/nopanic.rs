@@ -259,8 +259,6 @@ fn main() -> ! {
         let mut rx = Receiver::<N, 2>::new(DataIds::DEFAULT, Config::DEFAULT);
         let mut link = UartLink::new(Opaque);
         let mut raw = [0u8; roadstereo::wire::result_packet_max(N, 2)];
-        let mut framed =
-            [0u8; roadstereo::wire::cobs_max(roadstereo::wire::result_packet_max(N, 2))];
         let mut out = Opaque;
         for _ in 0..black_box(3) {
             let _ = link.poll(&mut rx, |ev| match ev {
@@ -274,14 +272,13 @@ fn main() -> ! {
                         if let Ok(n) =
                             encode::result(&mut raw, 1, 2, &head, &step, &job.kept_quality)
                         {
-                            let _ =
-                                write_packet(&mut out, raw.get(..n).unwrap_or(&[]), &mut framed);
+                            let _ = write_packet(&mut out, raw.get(..n).unwrap_or(&[]));
                         }
                     }
                 }
                 Event::Error(e) => {
                     if let Ok(n) = encode::report(&mut raw, 1, 2, &e) {
-                        let _ = write_packet(&mut out, raw.get(..n).unwrap_or(&[]), &mut framed);
+                        let _ = write_packet(&mut out, raw.get(..n).unwrap_or(&[]));
                     }
                 }
                 _ => {}

@@ -50,8 +50,6 @@ pub enum Error<E, P = core::convert::Infallible> {
         /// The largest accepted.
         max: u16,
     },
-    /// The output buffer is too small for the packet.
-    Encode(crate::wire::encode::EncodeError),
 }
 
 impl<E: fmt::Debug, P: fmt::Debug> fmt::Display for Error<E, P> {
@@ -64,7 +62,6 @@ impl<E: fmt::Debug, P: fmt::Debug> fmt::Display for Error<E, P> {
             Self::TooLarge { len, max } => {
                 write!(f, "packet of {len} bytes announced, at most {max}")
             }
-            Self::Encode(e) => write!(f, "{e}"),
         }
     }
 }

@@ -12,6 +12,11 @@
 //! 2. the `n` bytes, in transactions of up to [`SPI_CHUNK`] bytes, each
 //!    going on where the last stopped.
 //!
+//! Each transaction is one [`SpiDevice::transaction`] of a single
+//! [`Operation::Read`] (the controller clocks out whatever the device
+//! sends back on MOSI; a mock expects exactly these reads: 4 bytes, then
+//! chunks of `min(SPI_CHUNK, what is left)`).
+//!
 //! Each chunk goes to the [`Receiver`] as it arrives, so no packet buffer
 //! is needed and a short read or a corrupt byte is the decoder's typed
 //! error. A bus error ends the packet in progress where it stands and the

@@ -400,8 +400,7 @@ fn uart_chunks_read_error_and_write() {
     );
     let mut raw = [0u8; 64];
     let n = encode::report(&mut raw, IDS.report, 0, &WireError::BadCrc).unwrap();
-    let mut scratch = [0u8; 80];
-    super::write_packet(link.io(), &raw[..n], &mut scratch).unwrap();
+    super::write_packet(link.io(), &raw[..n]).unwrap();
     let w = &link.release().written;
     assert_eq!(w.last(), Some(&0));
     let mut dec = w.clone();
@@ -419,22 +418,70 @@ fn uart_write_packet_one_byte_at_a_time_and_a_write_of_nothing() {
     let mut raw = [0u8; 64];
     let n = encode::report(&mut raw, IDS.report, 3, &WireError::BadCrc).unwrap();
     let framed = framed(&raw[..n]);
-    let mut scratch = [0u8; 80];
     let mut one = Uart {
         reads: Vec::new(),
         written: Vec::new(),
         writes: vec![Some(1); 200],
     };
-    super::write_packet(&mut one, &raw[..n], &mut scratch).unwrap();
+    super::write_packet(&mut one, &raw[..n]).unwrap();
     assert_eq!(one.written, framed);
+    // The first block's code byte taken, then nothing of its bytes.
     let mut zero = Uart {
         reads: Vec::new(),
         written: Vec::new(),
-        writes: vec![Some(5), Some(0)],
+        writes: vec![None, Some(0)],
     };
     assert_eq!(
-        super::write_packet(&mut zero, &raw[..n], &mut scratch),
+        super::write_packet(&mut zero, &raw[..n]),
         Err(Error::WriteZero)
     );
-    assert_eq!(zero.written, framed[..5]);
+    assert_eq!(zero.written, framed[..1]);
+}
+
+/// `write_packet` frames as it writes, with no buffer: the bytes are the
+/// `cobs` crate's encoding and the delimiter (`encode::cobs_frame`), for
+/// packets of every shape a COBS block has an edge at (empty, all zeros,
+/// runs of 253 to 255 and 508 to 510 bytes without a zero, a zero first
+/// or last) and random ones, under writes that take random amounts.
+#[test]
+fn write_packet_frames_as_the_cobs_crate_does() {
+    let mut rng = crate::test_rng::Rng(11);
+    let mut cases: Vec<Vec<u8>> = vec![Vec::new(), vec![0], vec![0; 3], vec![7]];
+    for run in [1, 253, 254, 255, 508, 509, 510] {
+        let body: Vec<u8> = (0..run).map(|i| (i % 255 + 1) as u8).collect();
+        cases.push(body.clone());
+        cases.push([&[0u8][..], &body].concat());
+        cases.push([&body[..], &[0u8]].concat());
+        cases.push([&body[..], &[0u8], &body].concat());
+    }
+    // A whole number below `k`.
+    let mut below = |k: u32| (rng.next() * k as f32) as u32;
+    for _ in 0..300 {
+        let len = below(1200) as usize;
+        let zeros = 1 + below(400);
+        cases.push(
+            (0..len)
+                .map(|_| {
+                    if below(zeros) == 0 {
+                        0
+                    } else {
+                        below(256) as u8
+                    }
+                })
+                .collect(),
+        );
+    }
+    for (case, raw) in cases.iter().enumerate() {
+        let want = framed(raw);
+        let writes = (0..4 * want.len() + 4)
+            .map(|_| (below(3) != 0).then(|| 1 + below(300) as usize))
+            .collect();
+        let mut uart = Uart {
+            reads: Vec::new(),
+            written: Vec::new(),
+            writes,
+        };
+        super::write_packet(&mut uart, raw).unwrap();
+        assert_eq!(uart.written, want, "case {case}, {} bytes", raw.len());
+    }
 }

@@ -4,7 +4,6 @@
 use embedded_io::{Read, Write};
 
 use super::{cut, Error};
-use crate::wire::encode::{cobs_frame, EncodeError};
 use crate::wire::{Event, Receiver};
 
 /// Bytes asked of the UART per read.
@@ -58,20 +57,44 @@ impl<IO: Read + Write> UartLink<IO> {
     }
 }
 
-/// COBS-frame the packet `raw` into `scratch` and write it all to `w`,
-/// then flush. At most one `write` a byte: each must take at least one
+/// COBS-frame the packet `raw` as it is written to `w`, then the `0x00`
+/// delimiter, then flush: the same bytes as
+/// [`crate::wire::encode::cobs_frame`] gives, without a buffer for them
+/// (each block's code byte, then its bytes straight from `raw`; a result
+/// packet of 2 × 256 points is about 10.8 KB, which a framing buffer
+/// would double). Each `write` must take at least one byte
 /// ([`Error::WriteZero`] if one takes none; embedded-io's `write_all`
-/// panics there).
-pub fn write_packet<W: Write>(
-    w: &mut W,
-    raw: &[u8],
-    scratch: &mut [u8],
-) -> Result<(), Error<W::Error>> {
-    let n = cobs_frame(raw, scratch).map_err(Error::Encode)?;
-    let mut rest = scratch
-        .get(..n)
-        .ok_or(Error::Encode(EncodeError::BufferTooSmall))?;
-    for _ in 0..n {
+/// panics there); at most one `write` a byte.
+pub fn write_packet<W: Write>(w: &mut W, raw: &[u8]) -> Result<(), Error<W::Error>> {
+    let mut rest = raw;
+    // Each block takes at least one byte of `raw` but the last: at most
+    // `raw.len() + 1` blocks.
+    for _ in 0..=raw.len() {
+        // A block: up to 254 bytes without a zero, then the zero it ends
+        // at (taken, not written), the code byte their count plus one.
+        let run = rest.iter().take(COBS_RUN).position(|&b| b == 0);
+        let len = run.unwrap_or(rest.len().min(COBS_RUN));
+        let (block, after) = rest.split_at_checked(len).unwrap_or((rest, &[]));
+        write_all(w, &[u8::try_from(len + 1).unwrap_or(u8::MAX)])?;
+        write_all(w, block)?;
+        match run {
+            // The zero taken: a block follows, empty if `raw` ends here.
+            Some(_) => rest = after.get(1..).unwrap_or(&[]),
+            None if after.is_empty() => break,
+            None => rest = after,
+        }
+    }
+    write_all(w, &[0])?;
+    w.flush().map_err(Error::Bus)
+}
+
+/// The most bytes of a COBS block without its code byte.
+const COBS_RUN: usize = 254;
+
+/// All of `bytes` to `w`, one `write` a byte at most.
+fn write_all<W: Write>(w: &mut W, bytes: &[u8]) -> Result<(), Error<W::Error>> {
+    let mut rest = bytes;
+    for _ in 0..bytes.len() {
         if rest.is_empty() {
             break;
         }
@@ -81,5 +104,5 @@ pub fn write_packet<W: Write>(
             k => rest = rest.get(k..).unwrap_or(&[]),
         }
     }
-    w.flush().map_err(Error::Bus)
+    Ok(())
 }

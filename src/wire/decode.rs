@@ -20,6 +20,7 @@ use super::{
     raw_to_px, raw_to_radius, DataIds, PacketType, WireError, BOUNDARY_HEAD_LEN, CAMERA_LEN, CRC,
     CRC_LEN, FRAME_HEAD_LEN, HEADER_LEN, MAGIC, MOTION_LEN, POINT_LEN, RESIDUE, VERSION,
 };
+use crate::motion_error::euler_error_box;
 use crate::{Camera, Config, Frame, Motion, Pixel};
 
 /// A frame packet's fields other than the points.
@@ -70,11 +71,29 @@ pub struct MotionPacket {
     /// Bound on each translation component's error (validated for
     /// [`Config::with_translation_error`]).
     pub translation_error: Option<f32>,
-    /// Bound on each rotation angle's error (validated for
-    /// [`Config::with_rotation_error`]).
+    /// Bounds on the errors of the rotation angles `(α, β, γ)` as sent
+    /// (radians, the angles of [`Motion::new`]). The pair's configuration
+    /// takes their box about the camera's axes,
+    /// [`MotionPacket::axis_rotation_error`], which the decoder checks
+    /// with [`Config::with_rotation_error`].
     pub rotation_error: Option<[f32; 3]>,
     /// The packet's counter.
     pub counter: u16,
+}
+
+impl MotionPacket {
+    /// The rotation error bounds about the frame-2 camera's axes, as
+    /// [`Config::with_rotation_error`] takes them: the box
+    /// [`crate::motion_error::euler_error_box`] gives for
+    /// [`Self::rotation_error`] at the packet's angles (an error in `α`
+    /// alone reaches the `y` axis when `γ ≠ 0`, so the angles' bounds
+    /// cannot be used as they are). `None` when the packet gives none.
+    pub fn axis_rotation_error(&self) -> Option<[f32; 3]> {
+        // The motion's angles were validated by `Motion::new`, so the box
+        // exists; `None` otherwise, which the decoder refuses.
+        self.rotation_error
+            .and_then(|r| euler_error_box(self.motion.angles(), r).ok())
+    }
 }
 
 /// One complete packet.
@@ -939,19 +958,25 @@ impl<const N: usize, const B: usize> Decoder<N, B> {
                 return self.fault(WireError::MotionBounds(e));
             }
         }
-        if let Some(r) = re {
-            if let Err(e) = Config::DEFAULT.with_rotation_error(r) {
-                return self.fault(WireError::MotionBounds(e));
-            }
-        }
-        self.motion = Some(MotionPacket {
+        let packet = MotionPacket {
             from: le32(b, 0),
             to: le32(b, 4),
             motion,
             translation_error: te,
             rotation_error: re,
             counter: self.counter,
-        });
+        };
+        if let Some(r) = re {
+            // The angles' bounds as sent, and their box about the axes
+            // (what the pair's configuration takes).
+            let axes = packet.axis_rotation_error().unwrap_or([f32::INFINITY; 3]);
+            for v in [r, axes] {
+                if let Err(e) = Config::DEFAULT.with_rotation_error(v) {
+                    return self.fault(WireError::MotionBounds(e));
+                }
+            }
+        }
+        self.motion = Some(packet);
         self.content_done();
     }
 

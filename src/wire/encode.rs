@@ -21,7 +21,7 @@ pub enum EncodeError {
     /// A point is outside what the format holds (`[−1, 4078.875]` px,
     /// after rounding to the sixteenth) or not finite.
     PointRange,
-    /// A radius is negative, NaN or above [`super::MAX_RADIUS_PX`].
+    /// A radius is negative, NaN or above [`MAX_RADIUS_PX`](super::MAX_RADIUS_PX).
     Radius,
     /// More than 255 boundaries, or more than 65 535 points or bytes.
     TooLarge,
@@ -309,7 +309,12 @@ pub struct MotionFields {
     pub rotation: [f32; 3],
     /// Bound on each translation component's error, if known.
     pub translation_error: Option<f32>,
-    /// Bound on each rotation angle's error, radians, if known.
+    /// Bound on each rotation angle's error (`α`, `β`, `γ` of
+    /// [`Self::rotation`]), radians, if known. The controller widens them
+    /// to a box about the camera's axes at these angles
+    /// ([`crate::wire::MotionPacket::axis_rotation_error`]); that box must
+    /// pass [`crate::Config::with_rotation_error`] (at most 0.1 rad in
+    /// all), or the packet is refused.
     pub rotation_error: Option<[f32; 3]>,
 }
 

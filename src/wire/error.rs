@@ -27,7 +27,7 @@ pub enum WireError {
     },
     /// The CRC over the packet does not check out (corrupt bytes).
     BadCrc,
-    /// The packet does not start with [`super::MAGIC`].
+    /// The packet does not start with [`MAGIC`](super::MAGIC).
     BadMagic,
     /// A format version this decoder does not read.
     UnknownVersion {
@@ -97,7 +97,7 @@ pub enum WireError {
         got: u8,
     },
     /// A boundary's localisation-error radius is above
-    /// [`super::MAX_RADIUS_PX`].
+    /// [`MAX_RADIUS_PX`](super::MAX_RADIUS_PX).
     Radius {
         /// Boundary.
         boundary: u8,
@@ -228,6 +228,13 @@ impl ErrorKind {
     }
 }
 
+impl fmt::Display for ErrorKind {
+    /// [`ErrorKind::name`].
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 impl WireError {
     /// The kind.
     pub fn kind(&self) -> ErrorKind {
@@ -307,7 +314,19 @@ impl WireError {
     }
 }
 
-impl core::error::Error for WireError {}
+impl core::error::Error for WireError {
+    /// The library's own error behind a boundary, camera or motion
+    /// packet's refusal.
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            Self::Boundary { error, .. } => Some(error),
+            Self::Camera(e) => Some(e),
+            Self::Motion(e) => Some(e),
+            Self::MotionBounds(e) => Some(e),
+            _ => None,
+        }
+    }
+}
 
 impl fmt::Display for WireError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

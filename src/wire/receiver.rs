@@ -70,6 +70,7 @@ impl Counters {
 
 /// A frame ready for the processor: [`FrameJob::run`] it.
 #[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FrameJob<'a, const N: usize, const B: usize> {
     /// The validated frame (in the decoder).
     pub frame: &'a Frame<N, B>,
@@ -218,6 +219,7 @@ impl<const N: usize, const B: usize> FrameJob<'_, N, B> {
 
 /// What the receiver hands out, in order.
 #[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Event<'a, const N: usize, const B: usize> {
     /// A frame to process.
     Frame(FrameJob<'a, N, B>),
@@ -465,7 +467,10 @@ fn pair_config(base: &Config, e1: f32, e2: f32, m: &MotionPacket) -> Result<Conf
             .with_translation_error(t)
             .map_err(WireError::MotionBounds)?;
     }
-    if let Some(r) = m.rotation_error {
+    if m.rotation_error.is_some() {
+        // The angles' bounds as a box about the camera's axes (the decoder
+        // has checked it; an infinite box is refused here too).
+        let r = m.axis_rotation_error().unwrap_or([f32::INFINITY; 3]);
         c = c.with_rotation_error(r).map_err(WireError::MotionBounds)?;
     }
     Ok(c)

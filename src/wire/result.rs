@@ -78,6 +78,31 @@ pub struct Report {
     pub details: (u8, u16, [u32; 4]),
 }
 
+/// Parse a summary payload (the controller's answer to an end packet:
+/// the receiver's [`super::Counters`], as [`super::Counters::values`]
+/// orders them), or `None` if its length is not a summary's.
+pub fn summary(payload: &[u8]) -> Option<super::Counters> {
+    let mut v = [0u32; 4 + ErrorKind::ALL.len()];
+    if payload.len() != 4 * v.len() {
+        return None;
+    }
+    for (k, d) in v.iter_mut().enumerate() {
+        *d = le32(payload, 4 * k);
+    }
+    let [bytes, frames, motions, cameras, ..] = v;
+    let mut errors = [0u32; ErrorKind::ALL.len()];
+    for (d, s) in errors.iter_mut().zip(v.iter().skip(4)) {
+        *d = *s;
+    }
+    Some(super::Counters {
+        bytes,
+        frames,
+        motions,
+        cameras,
+        errors,
+    })
+}
+
 /// Parse a report payload.
 pub fn report(payload: &[u8]) -> Option<Report> {
     if payload.len() != REPORT_LEN {

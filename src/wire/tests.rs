@@ -409,6 +409,32 @@ fn cobs_paths_agree_with_the_crate() {
     }
 }
 
+/// A summary packet round-trips: the counters a receiver keeps, encoded
+/// as the link firmware answers an end packet, parse back to themselves
+/// (every field distinct, so a shifted or swapped field shows); any
+/// other payload length is not a summary.
+#[test]
+fn a_summary_parses_back_to_its_counters() {
+    let mut c = Counters {
+        bytes: 0xdead_beef,
+        frames: 2,
+        motions: 3,
+        cameras: 4,
+        ..Counters::default()
+    };
+    for (k, e) in c.errors.iter_mut().enumerate() {
+        *e = 100 + k as u32;
+    }
+    let mut raw = [0u8; 256];
+    let n = encode::summary(&mut raw, IDS.result, 9, &c.values()).unwrap();
+    let checked = result::check(&raw[..n]).unwrap();
+    assert_eq!(checked.ptype, PacketType::Summary);
+    assert_eq!(result::summary(checked.payload), Some(c));
+    assert_eq!(c.errors_of(ErrorKind::MissingMotion), 120);
+    let p = checked.payload;
+    assert_eq!(result::summary(&p[..p.len() - 4]), None);
+}
+
 /// The result packet's flags byte carries `Structure::deadline_expired`:
 /// set when the caller's clock cut the frame short (every point then
 /// `over_budget`, for a clock that says yes at once), clear without a
@@ -752,6 +778,58 @@ fn run_fused_judges_the_motion_bounds_it_uses() {
         }
     }
     assert!(paired_absent >= 2, "{paired_absent}");
+}
+
+/// A motion packet's rotation error bounds are the Euler angles' (as the
+/// packet's rotation is), and the pair is configured with their box about
+/// the camera's axes (an integrator's find: the receiver put the angles'
+/// bounds into the configuration as they were, so with `γ = 0.5` an error
+/// of `ε` in `α`, which turns the camera by about `ε (cos γ, −sin γ, 0)`
+/// about its axes, was bounded by `(ε, 0, 0)`: nothing about `y`). Bounds
+/// whose box is past what a configuration takes (0.1 rad in all) are a
+/// typed error, although the angles' own sum is 0.1.
+#[test]
+fn a_motions_angle_error_bounds_reach_every_axis_they_turn() {
+    let (eps, gamma) = (0.001f32, 0.5f32);
+    let fields = |re| MotionFields {
+        from: 0,
+        to: 1,
+        translation: [0.0, 0.0, 0.4],
+        rotation: [0.0, 0.0, gamma],
+        translation_error: None,
+        rotation_error: Some(re),
+    };
+    let mut rx = Receiver::<64, 2>::new(IDS, crate::Config::DEFAULT);
+    let mut seen = Vec::new();
+    let mut feed = |bytes: &[u8], seen: &mut Vec<Result<[f32; 3], WireError>>| {
+        rx.feed(bytes, |e| match e {
+            Event::Frame(job) => seen.push(Ok(job.config.rotation_error())),
+            Event::Error(err) => seen.push(Err(err)),
+            _ => {}
+        });
+    };
+    feed(&[0], &mut seen);
+    feed(&camera_packet(0), &mut seen);
+    feed(&frame_packet(1, 0, &[(0.5, line(8, 100.0))]), &mut seen);
+    feed(&motion_link(2, &fields([eps, 0.0, 0.0])), &mut seen);
+    feed(&frame_packet(3, 1, &[(0.5, line(8, 101.0))]), &mut seen);
+    // The turn an error of `ε` in `α` makes about each axis, to first order.
+    let turn = [eps * libm::cosf(gamma), eps * libm::sinf(gamma), 0.0];
+    let got = seen.last().copied().expect("two frame jobs");
+    let Ok(axes) = got else { panic!("{got:?}") };
+    for k in 0..3 {
+        assert!(axes[k] >= turn[k], "axis {k}: {axes:?} against {turn:?}");
+    }
+    assert!(axes[1] > 0.47 * eps, "{axes:?}");
+    // Angles' bounds of 0.1 in all, whose box about the axes is more.
+    let before = seen.len();
+    feed(&motion_link(3, &fields([0.05, 0.0, 0.05])), &mut seen);
+    assert_eq!(
+        seen.get(before).copied(),
+        Some(Err(WireError::MotionBounds(
+            crate::ConfigError::RotationError
+        )))
+    );
 }
 
 /// The chain `run_fused` goes on is the previous job's frame, not a frame

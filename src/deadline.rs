@@ -42,7 +42,7 @@
 //!   passes over a whole boundary (the certified step 1, the fold test's
 //!   rule from the keys, its index build and the envelopes' clearing, the
 //!   frame-2 keys and index build, the band path's radial levels) ask the
-//!   clock between parts of 64 items (`search::CHUNK`); a pass
+//!   clock between parts of 64 items; a pass
 //!   it stops leaves its index unused and the boundary's points flagged.
 //!   So the longest stretch is one point's capped search, or up to 64
 //!   items of each of a boundary's few passes (a few thousand
@@ -50,8 +50,7 @@
 //!   the flags after the yes (a status store a point,
 //!   [`crate::PointResult`]) and the number of questions. The bench
 //!   measures the lateness where it is worst at 2 × 256 and 2 × 512
-//!   (`docs/VEHICLE.md`, "Within a deadline": 21 101 and 29 086
-//!   instructions; 51 051 and 101 082 before these questions).
+//!   (README, "Within a deadline"; how it got there, `docs/VEHICLE.md`).
 //!
 //! **What the cap costs.** The cap holds even while the clock says no, so
 //! a point whose search needs more than `CARRY · w` units at once comes

@@ -530,14 +530,15 @@ impl Hull {
 /// along its boundary) — of the same road from the same camera mounting,
 /// e.g. successive frame pairs. A `(θ, h)` must agree with the points of
 /// all views (all but `outliers` of them, for wrong matches); the width is
-/// the median over the views of each view's median boundary distance. `N`
-/// is the capacity for the plane fit's points together; when there are
+/// the median over the views of each view's median boundary distance. `P`
+/// is the capacity for the plane fit's points together (the caller names
+/// it, as in `road_geometry::<512>(&views, 0)`; not the processor's `N`); when there are
 /// more, every boundary of every view keeps the same number of its
 /// nearest points (by the stick's middle, in any order given), as many as
 /// fit, and the farther ones are left out.
 ///
 /// Input: 1 to [`MAX_VIEWS`] views, no more boundaries (`2 · views`) than
-/// `N`, [`MIN_POINTS`] to `N` samples on each boundary, every sample
+/// `P`, [`MIN_POINTS`] to `P` samples on each boundary, every sample
 /// finite with `|x|, |y| ≤` [`MAX_NORMALISED`] and `0 ≤ z_near ≤ z_far ≤`
 /// [`MAX_SAMPLE_DEPTH`], `outliers` below the plane fit's points; anything
 /// else is a typed error (naming the first bad sample).
@@ -550,18 +551,18 @@ impl Hull {
 /// gives one.
 ///
 /// Work: `G = 1200` tilt cells (a constant), each with `O(M log M)` for
-/// the heights of the `M ≤ N` plane-fit points (16 times more in a cell
+/// the heights of the `M ≤ P` plane-fit points (16 times more in a cell
 /// with any), and at most `G + 1` grid tilts with `O(V · m²)` for the
-/// widths of `V ≤ 16` views of `m ≤ N` points per boundary — a check of
+/// widths of `V ≤ 16` views of `m ≤ P` points per boundary — a check of
 /// the reconstruction, not a per-frame task.
-pub fn road_geometry<const N: usize>(
+pub fn road_geometry<const P: usize>(
     views: &[(&[Sample], &[Sample])],
     outliers: usize,
 ) -> Result<RoadGeometry, GeometryError> {
     // 1. Validate the input.
-    check_views::<N>(views)?;
+    check_views::<P>(views)?;
     // 2. Gather the points of the plane fit.
-    let mut all = [Sample::default(); N];
+    let mut all = [Sample::default(); P];
     let points = plane_points(views, &mut all)?;
     if outliers >= points.len() {
         return Err(GeometryError::TooManyOutliers);
@@ -581,9 +582,9 @@ pub fn road_geometry<const N: usize>(
         let b = (tb, sin_cos(tb));
         let cell = Cell { a: a.1, b: b.1 };
         let mut width_b = None;
-        if heights::<N>(points, &cell, outliers).is_some() {
-            let wa = *width_a.get_or_insert_with(|| median_width::<N>(views, a.1 .0, a.1 .1));
-            let wb = median_width::<N>(views, b.1 .0, b.1 .1);
+        if heights::<P>(points, &cell, outliers).is_some() {
+            let wa = *width_a.get_or_insert_with(|| median_width::<P>(views, a.1 .0, a.1 .1));
+            let wb = median_width::<P>(views, b.1 .0, b.1 .1);
             width_b = Some(wb);
             // The cell's heights from its `SUB_CELLS` parts (each a
             // superset of its own, and the parts cover the cell).
@@ -596,7 +597,7 @@ pub fn road_geometry<const N: usize>(
                 };
                 let sb = (t, sin_cos(t));
                 let sub = Cell { a: sa.1, b: sb.1 };
-                if let Some(h) = heights::<N>(points, &sub, outliers) {
+                if let Some(h) = heights::<P>(points, &sub, outliers) {
                     hull.add((sa.0, sb.0), h, [wa, wb]);
                 }
                 sa = sb;

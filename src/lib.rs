@@ -96,6 +96,11 @@ pub mod thin;
 mod wedge;
 pub mod wire;
 
+/// The `heapless` crate this one's API takes (`RoadMap::samples` and
+/// `geometry::samples` fill a `heapless::Vec`), so that a user need not
+/// depend on the same version by hand.
+pub use heapless;
+
 pub use boundary::{Boundary, BoundaryError, Frame};
 pub use camera::{Camera, CameraError, Pixel, IMAGE_MARGIN_PX};
 pub use config::{Config, ConfigError};

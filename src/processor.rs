@@ -132,7 +132,7 @@ use step4::{flag_pending, match_boundary, unmatched};
 ///     panic!("expected a structure");
 /// }
 /// ```
-#[derive(Debug, Clone)]
+#[derive(Clone)]
 pub struct Processor<const N: usize, const B: usize> {
     config: Config,
     previous: Frame<N, B>,
@@ -152,6 +152,20 @@ pub struct Processor<const N: usize, const B: usize> {
     fold_counting: bool,
     index: Index<N>,
     output: Structure<N, B>,
+}
+
+/// The configuration, the kept frame (its live points), the rule's switch
+/// and the last structure; not the search index (internal, and `N`
+/// entries of it whatever the frame).
+impl<const N: usize, const B: usize> core::fmt::Debug for Processor<N, B> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Processor")
+            .field("config", &self.config)
+            .field("kept", &self.has_previous.then_some(&self.previous))
+            .field("fold_counting", &self.fold_counting)
+            .field("output", &self.output)
+            .finish_non_exhaustive()
+    }
 }
 
 impl<const N: usize, const B: usize> Processor<N, B> {
@@ -285,10 +299,9 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     /// another result where that call ran out of budget (`Ok`, or `Folded`
     /// where the fold test's pass the clock stopped had found the point
     /// folding before an unkeyed point sent that call to the index, which
-    /// ran out: a review's find). The call returned at most 29 086
-    /// instructions after the clock's last no over everything measured
-    /// (README, "Within a deadline": allow 40 000, about 60 000 estimated
-    /// Cortex-M4F cycles for a cycle counter).
+    /// ran out: a review's find). How late the call returns after the
+    /// clock's yes, as measured, and the margin to leave for it: README,
+    /// "Within a deadline".
     pub fn process_within<D: Deadline>(
         &mut self,
         frame: &Frame<N, B>,

@@ -9,7 +9,10 @@ use crate::camera::{Camera, Pixel};
 use crate::depth::DepthInterval;
 
 /// Outcome for one frame-1 boundary point. Only [`Status::Ok`] is unflagged.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+///
+/// Its `Default` is [`Status::NoIntersection`] (what a result slot holds
+/// before its point is matched: no depth).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[repr(u8)]
 #[non_exhaustive]
@@ -303,6 +306,13 @@ impl PointResult {
             z_near: self.z_near,
             z_far: self.z_far,
         })
+    }
+    /// The stick's length relative to the depth
+    /// ([`DepthInterval::relative_width`] at [`Self::depth`]), if given:
+    /// what to filter uninformative sticks by.
+    pub fn relative_width(&self) -> Option<f32> {
+        let (stick, z) = (self.interval()?, self.depth()?);
+        Some(stick.relative_width(z))
     }
 }
 

@@ -497,6 +497,26 @@ pub enum KeyReason {
     ErrorLimit,
 }
 
+impl KeyReason {
+    /// Short lower-case name.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::First => "first",
+            Self::Partners => "partners",
+            Self::FewMatched => "few_matched",
+            Self::MotionLimit => "motion_limit",
+            Self::ErrorLimit => "error_limit",
+        }
+    }
+}
+
+impl fmt::Display for KeyReason {
+    /// [`KeyReason::name`].
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// What one frame did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -526,6 +546,13 @@ pub struct FusionStep {
 /// frame's counts are 16-bit; checked at compile time); `M` points per
 /// boundary in the map, `0 < M < 65535` (checked at compile time:
 /// [`RoadMap`]).
+///
+/// The largest `N` compiles, the next does not (these two examples show
+/// the check only: a value this large, 5.5 MB, is built on the stack
+/// before `Box::new` moves it, which overflows a test thread's stack in
+/// a debug build. Put a fusion in a `static`, as README's "In a
+/// firmware: a static processor" does, or reuse one with
+/// [`Fusion::reset_with`]):
 ///
 /// ```no_run
 /// # use roadstereo::{fusion::{Fusion, FusionConfig}, Config};
@@ -723,22 +750,10 @@ impl<const N: usize, const B: usize, const M: usize> Fusion<N, B, M> {
     /// the matching (one pass over the key frame's points, the map) is not
     /// cut: it is linear in the key frame's points plus a constant
     /// (`docs/FUSION.md`, "The fusion's own work"), so leave room for it in
-    /// the limit. Measured on the emulated Cortex-M4F, `Fusion<256, 2,
-    /// 512>`, not a bound: 75 instructions a key-frame point (38 071 a
-    /// step) where a key frame retires into a full map, its points
-    /// entering over that step and the next (module docs, "The retirement
-    /// over two steps"), on the bench's sideways drives; 72 (31 207) on
-    /// its forward drive, whose room is made in a batch the camera is
-    /// passing; up to 77 in a paired step in an adversarial review's
-    /// drives with full key frames on a still road (78 in a second
-    /// review's search of about 500), and at a retirement at a motion
-    /// limit, in a step without a pair, 39 in its step and 74 in the
-    /// next in the same review's harness (108 when it was whole); more a
-    /// point with smaller key frames (80–105 with 90–184 points), and
-    /// where the pairs disagree (166, 84 664, on the bench's wobbling road:
-    /// every matched point a conflict); with
-    /// the sight check on ([`FusionConfig::with_sight_check`]) 283; 56
-    /// and 184 on the demo drive, whose map never fills.
+    /// the limit. Its figures on the emulated Cortex-M4F (measured by
+    /// `cargo xtask bench`, not a bound; more a point where key frames
+    /// are small, shrink, or their pairs disagree): README, "Within a
+    /// deadline".
     pub fn step_within<D: Deadline>(
         &mut self,
         id: u32,

@@ -263,6 +263,12 @@ impl<const N: usize, const B: usize> Processor<N, B> {
     /// [`Step::First`] returned; `motion` is then ignored. On error nothing
     /// changes. On success the new frame becomes the previous one.
     ///
+    /// Each frame is projected with its own [`crate::Camera`]: the two
+    /// frames of a pair may have different intrinsics and image sizes (a
+    /// zoom, a recalibration), and the guarantees hold for each as given.
+    /// After a change of camera *mounting* the motion between the frames
+    /// must say so, or [`Self::reset`] first.
+    ///
     /// Each boundary of `frame` is **thinned** before it is searched
     /// ([`crate::thin`]): the vertices within `ε = e₂/256` of the chord
     /// between their neighbours dropped (on a detector's rounded straight

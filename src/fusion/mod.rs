@@ -12,6 +12,34 @@
 //! matches). When the key frame retires, its fused points move into the
 //! [`RoadMap`], which carries them forward in the current vehicle frame.
 //!
+//! # At a glance
+//! * **Per frame:** [`Fusion::step`] (or [`Fusion::step_within`] with
+//!   your clock) with the frame's id, the frame, and the motion from the
+//!   frame before it ([`ChainedMotion`]; `None` only for the first frame
+//!   or after [`Fusion::reset`]). From the link: [`crate::wire::FrameJob::run_fused`].
+//! * **On an error** ([`FusionError`]: a missing motion, a motion that
+//!   does not chain from the last frame, a repeated id) nothing changes;
+//!   the caller may [`Fusion::reset`] and go on. A motion or error bound
+//!   the processor does not accept is no error: the frame starts a new
+//!   key frame ([`KeyReason`]).
+//! * **What holds:** every fused interval of a point that is not
+//!   [`FusedStatus::Inconsistent`] contains the true depth when every pair
+//!   was within the error model (README, "What holds and what does not,
+//!   today"); an inconsistent
+//!   point keeps the interval most of its pairs agree on, flagged. Each
+//!   road-map point's truth lies within its radius of its near–far segment
+//!   ([`crate::map`], "The radius: how far the true point may be from the
+//!   stick").
+//! * **Reading:** the key frame's points by [`Fusion::key`] (intervals,
+//!   counts) and [`Fusion::key_point`] (with the pixel and the ray;
+//!   `None` between a retirement and the next step), the map by
+//!   [`RoadMap::points`] in the current vehicle frame; what a step did by
+//!   [`FusionStep`].
+//! * **A range sensor:** [`Fusion::constrain`] with [`Fusion::key_ref`].
+//! * **Cost:** the matching of one pair a frame (the processor's), plus
+//!   the fusion's own work, linear in the key frame's points (measured:
+//!   README, "Within a deadline"). The sections below say how and why.
+//!
 //! # The motion from the key frame
 //! Each frame comes with the motion from the frame before it, named by
 //! frame ids ([`ChainedMotion`]); the motion from the key frame is their

@@ -24,7 +24,7 @@ use cortex_m_rt::entry;
 use defmt_semihosting as _;
 #[cfg(feature = "link-fused")]
 use roadstereo::fusion::{Fusion, FusionConfig};
-use roadstereo::link::{write_packet, UartLink};
+use roadstereo::link::{write_packet, write_result, UartLink};
 use roadstereo::wire::encode::ResultHead;
 use roadstereo::wire::{self, encode, DataIds, Event, FrameJob, Receiver};
 #[cfg(not(feature = "link-fused"))]
@@ -144,7 +144,10 @@ mod uart0 {
 
 use uart0::Uart0;
 
-const RAW: usize = wire::result_packet_max(N, B);
+/// The buffer for the report and summary packets (a summary: header 10,
+/// four counters and one a kind, CRC 4); results go out through
+/// `write_result`, with no buffer for the packet.
+const RAW: usize = 14 + 4 * (4 + wire::ErrorKind::ALL.len());
 
 /// The receiver (its frame under assembly) and the processor in statics,
 /// laid out at build time: their constructors are `const`.
@@ -304,13 +307,8 @@ fn main() -> ! {
                         s.digest()
                     );
                 }
-                match encode::result(&mut raw, ids.result, results, &head, &step, &quality) {
-                    Ok(n) => {
-                        results = results.wrapping_add(1);
-                        if write_packet(&mut tx, raw.get(..n).unwrap_or(&[])).is_err() {
-                            defmt::error!("result packet not written");
-                        }
-                    }
+                match write_result(&mut tx, ids.result, results, &head, &step, &quality) {
+                    Ok(()) => results = results.wrapping_add(1),
                     Err(e) => defmt::error!("result packet: {}", e),
                 }
             }

@@ -18,7 +18,7 @@ use roadstereo::calibration::{
 };
 use roadstereo::fusion::{ChainedMotion, Fusion, FusionConfig};
 use roadstereo::geometry::Sample;
-use roadstereo::link::{write_packet, SpiLink, UartLink};
+use roadstereo::link::{write_packet, write_result, SpiLink, UartLink};
 use roadstereo::wire::{encode, result, DataIds, Event, Receiver, ResultView};
 use roadstereo::{Camera, Config, Frame, Motion, Pixel, Processor, Step};
 
@@ -274,6 +274,7 @@ fn main() -> ! {
                         {
                             let _ = write_packet(&mut out, raw.get(..n).unwrap_or(&[]));
                         }
+                        let _ = write_result(&mut out, 1, 2, &head, &step, &job.kept_quality);
                     }
                 }
                 Event::Error(e) => {

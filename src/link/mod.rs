@@ -9,7 +9,7 @@ mod spi;
 mod uart;
 
 pub use spi::{SpiLink, SPI_CHUNK, SPI_HEADER_LEN};
-pub use uart::{write_packet, UartLink, UART_CHUNK};
+pub use uart::{write_packet, write_result, UartLink, UART_CHUNK};
 
 use core::fmt;
 
@@ -50,6 +50,10 @@ pub enum Error<E, P = core::convert::Infallible> {
         /// The largest accepted.
         max: u16,
     },
+    /// Writing a result, the structure is too large for the format (more
+    /// than 255 boundaries, or 65 535 points or bytes): nothing was
+    /// written.
+    Encode(crate::wire::encode::EncodeError),
 }
 
 impl<E: fmt::Debug, P: fmt::Debug> fmt::Display for Error<E, P> {
@@ -62,11 +66,18 @@ impl<E: fmt::Debug, P: fmt::Debug> fmt::Display for Error<E, P> {
             Self::TooLarge { len, max } => {
                 write!(f, "packet of {len} bytes announced, at most {max}")
             }
+            Self::Encode(e) => write!(f, "{e}"),
         }
     }
 }
 
 impl<E: fmt::Debug, P: fmt::Debug> core::error::Error for Error<E, P> {}
+
+impl<E, P> From<crate::wire::encode::EncodeError> for Error<E, P> {
+    fn from(e: crate::wire::encode::EncodeError) -> Self {
+        Self::Encode(e)
+    }
+}
 
 use crate::wire::Receiver;
 

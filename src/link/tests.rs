@@ -425,7 +425,7 @@ fn uart_write_packet_one_byte_at_a_time_and_a_write_of_nothing() {
     };
     super::write_packet(&mut one, &raw[..n]).unwrap();
     assert_eq!(one.written, framed);
-    // The first block's code byte taken, then nothing of its bytes.
+    // The first block taken, then nothing of the second.
     let mut zero = Uart {
         reads: Vec::new(),
         written: Vec::new(),
@@ -435,7 +435,8 @@ fn uart_write_packet_one_byte_at_a_time_and_a_write_of_nothing() {
         super::write_packet(&mut zero, &raw[..n]),
         Err(Error::WriteZero)
     );
-    assert_eq!(zero.written, framed[..1]);
+    // (The first block whole: its code byte says how long it is.)
+    assert_eq!(zero.written, framed[..usize::from(framed[0])]);
 }
 
 /// `write_packet` frames as it writes, with no buffer: the bytes are the
@@ -484,4 +485,96 @@ fn write_packet_frames_as_the_cobs_crate_does() {
         super::write_packet(&mut uart, raw).unwrap();
         assert_eq!(uart.written, want, "case {case}, {} bytes", raw.len());
     }
+}
+
+/// `write_result` writes what `encode::result` and `write_packet` write,
+/// byte for byte, without a buffer for the packet: a first frame, a frame
+/// the clock cut (every point flagged), and whole pairs of two boundaries
+/// whose results run past several COBS blocks (points with depths, each
+/// 21 bytes, and flagged ones, 1), under writes that take random amounts.
+#[test]
+fn write_result_writes_what_the_buffered_path_writes() {
+    use crate::{Frame, Motion, Processor, Step};
+    let mut rng = crate::test_rng::Rng(5);
+    let mut below = |k: u32| (rng.next() * k as f32) as u32;
+    let frame = |u0: f32, n: usize, m: usize| {
+        let mut f = Frame::<64, 2>::new(cam());
+        let a: Vec<Pixel> = (0..n)
+            .map(|i| Pixel::new(u0 + 0.5 * i as f32, 470.0 - 3.0 * i as f32))
+            .collect();
+        let b: Vec<Pixel> = (0..m)
+            .map(|i| Pixel::new(u0 + 200.0 - 0.5 * i as f32, 470.0 - 3.0 * i as f32))
+            .collect();
+        f.push_boundary(&a).unwrap();
+        f.push_boundary(&b).unwrap();
+        f
+    };
+    let head = encode::ResultHead {
+        frame_id: 0x0100_0002,
+        kept_id: 1,
+        timestamp_us: 0x00ff_0000_0000_0007,
+        instructions: 12345,
+    };
+    let motion = Motion::new([0.0, 0.0, 0.4], [0.0, 0.0, 0.0]).unwrap();
+    let mut p = Processor::<64, 2>::new(Config::DEFAULT);
+    let (mut cases, mut longest) = (0, 0);
+    for (n, m) in [(2, 2), (40, 64), (64, 12), (13, 64)] {
+        let (f1, f2) = (frame(100.0, n, m), frame(96.0, n, m));
+        p.reset();
+        for kind in 0..3 {
+            let mut raw = vec![0u8; crate::wire::result_packet_max(64, 2)];
+            let nbytes = match kind {
+                0 => {
+                    p.reset();
+                    let s = p.process(&f1, None).unwrap();
+                    encode::result(&mut raw, IDS.result, 7, &head, &s, &[3, 4]).unwrap()
+                }
+                1 => {
+                    let s = p
+                        .process_against_kept_within(&f2, &motion, &mut || true)
+                        .unwrap();
+                    let s = Step::Structure(s);
+                    encode::result(&mut raw, IDS.result, 8, &head, &s, &[3, 4]).unwrap()
+                }
+                _ => {
+                    let s = Step::Structure(p.process_against_kept(&f2, &motion).unwrap());
+                    encode::result(&mut raw, IDS.result, 9, &head, &s, &[3, 4]).unwrap()
+                }
+            };
+            let want = framed(&raw[..nbytes]);
+            let writes = (0..4 * want.len() + 4)
+                .map(|_| (below(3) != 0).then(|| 1 + below(300) as usize))
+                .collect();
+            let mut uart = Uart {
+                reads: Vec::new(),
+                written: Vec::new(),
+                writes,
+            };
+            match kind {
+                0 => {
+                    p.reset();
+                    let s = p.process(&f1, None).unwrap();
+                    super::write_result(&mut uart, IDS.result, 7, &head, &s, &[3, 4]).unwrap();
+                }
+                1 => {
+                    let s = p
+                        .process_against_kept_within(&f2, &motion, &mut || true)
+                        .unwrap();
+                    let s = Step::Structure(s);
+                    super::write_result(&mut uart, IDS.result, 8, &head, &s, &[3, 4]).unwrap();
+                }
+                _ => {
+                    let s = Step::Structure(p.process_against_kept(&f2, &motion).unwrap());
+                    super::write_result(&mut uart, IDS.result, 9, &head, &s, &[3, 4]).unwrap();
+                }
+            }
+            assert_eq!(uart.written, want, "boundaries of {n} and {m}, kind {kind}");
+            longest = longest.max(want.len());
+            cases += 1;
+        }
+    }
+    assert_eq!(cases, 12);
+    // Several blocks of 254 (and the depths of matched points) in the
+    // longest.
+    assert!(longest > 3 * 255, "{longest}");
 }

@@ -64,6 +64,42 @@ struct Writer<'a> {
     at: usize,
 }
 
+/// Where a packet's bytes go, in order: a buffer ([`Writer`]), a count of
+/// them, or a link that frames them as they come
+/// (`crate::link::write_result`).
+pub(crate) trait Sink {
+    type Error: From<EncodeError>;
+    /// Take `b`, after what came before.
+    fn put(&mut self, b: &[u8]) -> Result<(), Self::Error>;
+}
+
+/// A sink that only counts.
+pub(crate) struct Count(pub(crate) usize);
+
+impl Sink for Count {
+    type Error = EncodeError;
+    fn put(&mut self, b: &[u8]) -> Result<(), EncodeError> {
+        self.0 = self.0.checked_add(b.len()).ok_or(EncodeError::TooLarge)?;
+        Ok(())
+    }
+}
+
+impl Sink for Writer<'_> {
+    type Error = EncodeError;
+    fn put(&mut self, b: &[u8]) -> Result<(), EncodeError> {
+        self.bytes(b)
+    }
+}
+
+/// A packet's header, its payload `len` bytes long.
+pub(crate) fn header(t: PacketType, data_id: u16, counter: u16, len: u16) -> [u8; HEADER_LEN] {
+    let [d0, d1] = data_id.to_le_bytes();
+    let [c0, c1] = counter.to_le_bytes();
+    let [l0, l1] = len.to_le_bytes();
+    let [m0, m1] = MAGIC;
+    [m0, m1, VERSION, t as u8, d0, d1, c0, c1, l0, l1]
+}
+
 impl Writer<'_> {
     fn bytes(&mut self, b: &[u8]) -> Result<(), EncodeError> {
         let end = self.at.checked_add(b.len()).ok_or(EncodeError::TooLarge)?;
@@ -98,12 +134,7 @@ impl Writer<'_> {
     }
     /// Write the header with a zero length (patched by [`Writer::finish`]).
     fn header(&mut self, t: PacketType, data_id: u16, counter: u16) -> Result<(), EncodeError> {
-        self.bytes(&MAGIC)?;
-        self.u8(VERSION)?;
-        self.u8(t as u8)?;
-        self.u16(data_id)?;
-        self.u16(counter)?;
-        self.u16(0)
+        self.bytes(&header(t, data_id, counter, 0))
     }
     /// Patch the payload length, append the CRC; the packet's length.
     fn finish(mut self) -> Result<usize, EncodeError> {
@@ -441,43 +472,66 @@ pub fn result<const N: usize, const B: usize>(
 ) -> Result<usize, EncodeError> {
     let mut w = Writer { buf: out, at: 0 };
     w.header(PacketType::Result, data_id, counter)?;
-    w.u32(head.frame_id)?;
-    w.u32(head.kept_id)?;
-    w.bytes(&head.timestamp_us.to_le_bytes())?;
+    result_payload(&mut w, head, step, quality)?;
+    w.finish()
+}
+
+/// A result packet's payload (README's layout, `docs/wire.md`), into any
+/// sink: [`result`]'s buffer, or a link that frames it as it goes
+/// (`crate::link::write_result`).
+pub(crate) fn result_payload<S: Sink, const N: usize, const B: usize>(
+    w: &mut S,
+    head: &ResultHead,
+    step: &Step<'_, N, B>,
+    quality: &[u8],
+) -> Result<(), S::Error> {
+    w.put(&head.frame_id.to_le_bytes())?;
+    w.put(&head.kept_id.to_le_bytes())?;
+    w.put(&head.timestamp_us.to_le_bytes())?;
     let s: Option<&Structure<N, B>> = match step {
         Step::First => None,
         Step::Structure(s) => Some(s),
     };
-    w.u8(u8::from(s.is_some()))?;
     let nb = s.map_or(0, |s| s.boundaries().len());
-    w.u8(u8::try_from(nb).map_err(|_| EncodeError::TooLarge)?)?;
     // Flags: bit 0, the caller's deadline cut the frame short.
-    w.u8(u8::from(s.is_some_and(|s| s.deadline_expired())))?;
-    w.u8(0)?;
-    w.u32(head.instructions)?;
-    w.u32(s.map_or(0, |s| s.digest()))?;
+    w.put(&[
+        u8::from(s.is_some()),
+        u8::try_from(nb).map_err(|_| EncodeError::TooLarge)?,
+        u8::from(s.is_some_and(|s| s.deadline_expired())),
+        0,
+    ])?;
+    w.put(&head.instructions.to_le_bytes())?;
+    w.put(&s.map_or(0, |s| s.digest()).to_le_bytes())?;
     let counts = s.map(|s| s.status_counts()).unwrap_or_default();
     for &st in Status::ALL {
-        w.u16(u16::try_from(counts.get(st)).unwrap_or(u16::MAX))?;
+        w.put(
+            &u16::try_from(counts.get(st))
+                .unwrap_or(u16::MAX)
+                .to_le_bytes(),
+        )?;
     }
-    w.u16(0)?;
+    w.put(&[0, 0])?;
     if let Some(s) = s {
         for (k, b) in s.boundaries().iter().enumerate() {
             let pts = b.points();
-            w.u16(u16::try_from(pts.len()).map_err(|_| EncodeError::TooLarge)?)?;
-            w.u8(quality.get(k).copied().unwrap_or(0))?;
-            w.u8(0)?;
+            let [n0, n1] = u16::try_from(pts.len())
+                .map_err(|_| EncodeError::TooLarge)?
+                .to_le_bytes();
+            w.put(&[n0, n1, quality.get(k).copied().unwrap_or(0), 0])?;
             for r in pts {
-                w.u8(r.status() as u8)?;
+                w.put(&[r.status() as u8])?;
                 if let (Some([x, y, z]), Some(i)) = (s.point(r), r.interval()) {
-                    for v in [x, y, z, i.z_near, i.z_far] {
-                        w.f32(v)?;
+                    let mut v = [0u8; 20];
+                    let bytes = [x, y, z, i.z_near, i.z_far].map(|x| x.to_bits().to_le_bytes());
+                    for (d, s) in v.iter_mut().zip(bytes.iter().flatten()) {
+                        *d = *s;
                     }
+                    w.put(&v)?;
                 }
             }
         }
     }
-    w.finish()
+    Ok(())
 }
 
 /// COBS-encode the packet `raw` into `out` (with the `cobs` crate) and

@@ -592,8 +592,8 @@ impl Intrinsics {
 /// from 1/10 to 10 (host test `stepwise_sensitivity_for_any_aspect`):
 /// every sign pattern along the diagonals within 1.002 times the first
 /// form, errors in eight directions each within 0.92 times the second.
-/// (The square-pixel form, quoted here until an adversarial review in
-/// the thirtieth session, fell 3.9 times short at `f = (100, 1 000)`.)
+/// (A square-pixel form of these bounds falls 3.9 times short at `f =
+/// (100, 1 000)`, an adversarial review found.)
 pub fn calibrate_stepwise(
     straight: Pixel,
     diagonal: [Pixel; 4],

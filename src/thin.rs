@@ -95,10 +95,9 @@
 //! call makes the new frame the previous one at its end anyway). The calls
 //! against a kept frame keep that frame and search frame 2's boundaries
 //! as given; so does every call of the fusion, even its last partner's,
-//! which replaces the key frame: tried, so that it thinned, in the
-//! twenty-sixth session and not kept, so that every partner of a key frame
-//! is searched alike (`docs/PERFORMANCE.md`, "Frame 2's boundary thinned
-//! on every path").
+//! which replaces the key frame, so that every partner of a key frame is
+//! searched alike (thinning that last one was tried and not kept:
+//! `docs/PERFORMANCE.md`, "Frame 2's boundary thinned on every path").
 
 use crate::camera::Pixel;
 use crate::search::{expired, Tick, CHUNK};

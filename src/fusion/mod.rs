@@ -92,8 +92,8 @@
 //! # The retirement over two steps
 //! A retiring key frame's admitted points are copied into the map (their
 //! rays, their coded ends, the batch's bounds): the costliest part of the
-//! fusion, about 100 instructions a point when this was written (about 65
-//! since the twenty-ninth session), and all of it in one frame. So
+//! fusion (about 65 instructions a point, 100 when this split was made),
+//! and all of it in one frame. So
 //! the retiring step looks at no more of them than 35.5 % of the key
 //! frame's points, rounded up (entered, or left out as
 //! [`crate::map::Retired::unbounded`]; boundary by boundary, in order; the
@@ -155,9 +155,9 @@
 //! frame's pixels stays until it pairs again (keeping a frame touches
 //! only the kept frame and the flag of an expired deadline), so the rest
 //! enters at the start of the next step as after a last pair. Such a
-//! step has no pair to fuse, so it is the lighter of the two (until the
-//! twenty-second session it retired whole, a review's 108 instructions a
-//! key-frame point). A share of 1000 ‰ retires every key frame whole.
+//! step has no pair to fuse, so it is the lighter of the two (retired
+//! whole, a review measured 108 instructions a key-frame point). A share
+//! of 1000 ‰ retires every key frame whole.
 //! The map after the next step is the one a whole retirement leaves (the
 //! same points, bounds and counts: `host_tests/tests/fusion/`,
 //! `a_retirement_over_two_steps_leaves_the_whole_ones_map` and

@@ -92,11 +92,10 @@
 //!   tested. (A batch the whole-batch bound finds behind is gone before:
 //!   the carry, which precedes a retirement in its step, drops it; one
 //!   whose points are all behind but that the bound does not find so is
-//!   taken like any other. Until the twenty-third
-//!   session each point dropped from a batch the camera is passing was
-//!   tested and counted behind when it was: about 38 instructions a drop,
-//!   13 660 in a retirement of the bench's forward drive, for a count 30
-//!   of its 357 drops moved, `docs/PERFORMANCE.md`.)
+//!   taken like any other. Testing each point dropped from a batch the
+//!   camera is passing, to count it behind when it was, cost about 38
+//!   instructions a drop, 13 660 in a retirement of the bench's forward
+//!   drive, for a count 30 of its 357 drops moved: `docs/PERFORMANCE.md`.)
 //!
 //! A retiring key frame may enter over two steps ([`Retired::pending`];
 //! [`crate::fusion`], "The retirement over two steps"): its batch holds
@@ -250,9 +249,8 @@ pub struct MapPoint {
 /// dropped between two readings as `now.wrapping_sub(then)`). At the
 /// bench's sideways drive, 504 points dropped for room every 8 frames,
 /// and 30 frames a second, that is after about 26 days without a
-/// [`crate::fusion::Fusion::reset`]; a saturating count (until the
-/// twenty-third session) would then have stopped, and every difference
-/// with it, without a sign.
+/// [`crate::fusion::Fusion::reset`]; a saturating count would then stop,
+/// and every difference with it, without a sign.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct MapDrops {

@@ -150,10 +150,10 @@ impl<const N: usize, const B: usize> FrameJob<'_, N, B> {
     /// last frame came from another receiver; or the fusion's last step
     /// was the caller's own [`Fusion::step`]), resets the fusion first
     /// ([`Fusion::reset`]) and starts it anew: the chain of motions is
-    /// broken and the map cannot be carried to this frame. (Until the
-    /// thirty-first session the frame ids alone decided: a refused frame
-    /// with the fusion's last id let the next motion chain onto the older
-    /// frame.) Jobs are told apart by a serial unique over every receiver
+    /// broken and the map cannot be carried to this frame. (Frame ids
+    /// alone cannot decide: a refused frame with the fusion's last id
+    /// would let the next motion chain onto the older frame.) Jobs are
+    /// told apart by a serial unique over every receiver
     /// of the program where the target has 32-bit atomics (`thumbv7em`
     /// has); on a target without them, within one receiver only: reset
     /// the fusion before feeding it from a new receiver. Where the chain

@@ -187,6 +187,18 @@ pub fn rotation_shift_bound(p: Pixel, cam2: &Camera, eps: [f32; 3]) -> f32 {
 /// `γ = 5°` an error of `ε` in `α` alone gives `(0.996 ε, 0.087 ε, 0)`, not
 /// `(ε, 0, 0)`: a box of `ε` per axis would not hold it.
 ///
+/// The processor takes the matrix [`Motion::new`] builds from the angles
+/// given for the motion, and that matrix is within `3·10⁻⁷` of their
+/// exact rotation an entry ([`Motion::rotation_matrix`]), so where the
+/// angles are the truth within `eps` that difference is part of the
+/// error too: the rotation vector of `R_f32ᵀ R_exact` has components of at
+/// most `√3 · 3·10⁻⁷` (a column of `R_f32` sums to at most `√3` in
+/// absolute value, its non-orthogonality is symmetric), and each
+/// component of the box gets [`MATRIX_AXIS_ERROR`] more. (Without it the
+/// `s²` term covered the matrix only for `s` above about `5.5·10⁻⁴`: an
+/// adversary's note.) Bounds of exactly 0 give the box 0: the motion is
+/// then taken as given, as without bounds.
+///
 /// Angles as [`Motion::new`] takes them (`|angle| ≤`
 /// [`crate::motion::MAX_ROTATION_RAD`]), or an [`crate::AngleError`].
 ///
@@ -215,7 +227,11 @@ pub fn euler_error_box(
     let (sg, cg) = crate::math::sin_cos_reduced(angles[2])?;
     let [ea, eb, eg] = eps.map(f32::abs);
     let s = ea + eb + eg;
-    let second = s * s;
+    let second = if s > 0.0 {
+        s * s + MATRIX_AXIS_ERROR
+    } else {
+        0.0
+    };
     let up = 1.0 + 9.536_743e-7;
     Ok([
         (ea * cg.abs() + eb * (ca * sg).abs() + second) * up,
@@ -223,6 +239,11 @@ pub fn euler_error_box(
         (eb * sa.abs() + eg + second) * up,
     ])
 }
+
+/// What the matrix [`Motion::new`] builds may turn about each axis against
+/// the exact rotation of its angles: `√3 · 3·10⁻⁷` rounded up
+/// ([`euler_error_box`]).
+pub const MATRIX_AXIS_ERROR: f32 = 6.0e-7;
 
 /// [`rotation_shift_bound`] on the per-frame path: `p` as `[u, v]`, the
 /// intrinsics as `(f_x, f_y, c_x, c_y)`.

@@ -554,3 +554,60 @@ fn in_accepted_view(p: roadstereo::Pixel, w: u16, h: u16) -> bool {
         && p.v >= -grow
         && p.v <= f32::from(h) - 1.0 + grow
 }
+
+/// `euler_error_box` holds the matrix's own rounding too: with Euler-angle
+/// bounds far below it (10⁻⁹ to 10⁻⁶ rad), the error rotation from the
+/// matrix `Motion::new` builds to the exact (`f64`) rotation of true angles
+/// within the bounds, `R_f32ᵀ R_true`, has every component of its rotation
+/// vector within the box (an adversary's note: the box covered the matrix
+/// only through its `s²` term, for bounds summing above about 5.5·10⁻⁴).
+/// The truth is `synth::rotation`, independent of the library's sines.
+#[test]
+fn euler_error_box_holds_the_matrix_own_rounding() {
+    use roadstereo::motion_error::euler_error_box;
+    let mut g = synth::Rng(0x3E7);
+    let lim = 60f64.to_radians();
+    let mut worst = 0.0f64;
+    for case in 0..20_000 {
+        let angles = [0, 1, 2].map(|_| g.uniform(-lim, lim) as f32);
+        let scale = 10f64.powf(g.uniform(-9.0, -6.0));
+        let eps = [0, 1, 2].map(|_| (scale * g.uniform(0.0, 1.0)) as f32);
+        let Ok(abox) = euler_error_box(angles, eps) else {
+            continue;
+        };
+        let Ok(m) = Motion::new([0.0, 0.0, 0.4], angles) else {
+            continue;
+        };
+        let r = m.rotation_matrix().map(|row| row.map(f64::from));
+        // True angles at a corner of the bounds (or inside).
+        let truth: [f64; 3] = [0, 1, 2].map(|k| {
+            let d = f64::from(eps[k]);
+            f64::from(angles[k])
+                + match case % 3 {
+                    0 => d,
+                    1 => -d,
+                    _ => d * g.uniform(-1.0, 1.0),
+                }
+        });
+        let t = synth::rotation(truth);
+        // Ω = Rᵀ T; its rotation vector to first order (the angles are
+        // below 10⁻⁵ here, the second order below 10⁻¹⁰ of them).
+        let o = |i: usize, j: usize| (0..3).map(|k| r[k][i] * t[k][j]).sum::<f64>();
+        let w = [
+            (o(2, 1) - o(1, 2)) / 2.0,
+            (o(0, 2) - o(2, 0)) / 2.0,
+            (o(1, 0) - o(0, 1)) / 2.0,
+        ];
+        for k in 0..3 {
+            worst = worst.max(w[k].abs() / f64::from(abox[k]));
+            assert!(
+                w[k].abs() <= f64::from(abox[k]),
+                "case {case}: angles {angles:?} eps {eps:?}: axis {k} turns {:e} > box {:e}",
+                w[k],
+                abox[k]
+            );
+        }
+    }
+    // The matrix's rounding is what the small bounds leave to the box.
+    assert!(worst > 0.05, "{worst}");
+}

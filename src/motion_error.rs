@@ -189,15 +189,21 @@ pub fn rotation_shift_bound(p: Pixel, cam2: &Camera, eps: [f32; 3]) -> f32 {
 ///
 /// The processor takes the matrix [`Motion::new`] builds from the angles
 /// given for the motion, and that matrix is within `3·10⁻⁷` of their
-/// exact rotation an entry ([`Motion::rotation_matrix`]), so where the
-/// angles are the truth within `eps` that difference is part of the
-/// error too: the rotation vector of `R_f32ᵀ R_exact` has components of at
-/// most `√3 · 3·10⁻⁷` (a column of `R_f32` sums to at most `√3` in
-/// absolute value, its non-orthogonality is symmetric), and each
-/// component of the box gets [`MATRIX_AXIS_ERROR`] more. (Without it the
-/// `s²` term covered the matrix only for `s` above about `5.5·10⁻⁴`: an
-/// adversary's note.) Bounds of exactly 0 give the box 0: the motion is
-/// then taken as given, as without bounds.
+/// exact rotation an entry ([`Motion::rotation_matrix`]: measured, not
+/// derived), so where the angles are the truth within `eps` that
+/// difference is part of the error too. `R_f32ᵀ R_exact` is `I` plus a
+/// part whose antisymmetric half is a rotation with components of at most
+/// `√3 · 3·10⁻⁷` (a column of `R_f32` sums to at most about `√3` in
+/// absolute value) and whose symmetric half (`R_f32`'s non-orthogonality)
+/// this argument does not bound: each component of the box gets
+/// [`MATRIX_AXIS_ERROR`] more, and the pixel a compensated point moves by
+/// the whole difference is measured within about an eighth of the
+/// box's shift bound (host test `the_converted_box_holds_the_matrix_whole`:
+/// image corners, edges and centre, 25 000 angle triples to 60°, bounds of
+/// `10⁻⁹` rad). (Without the term the `s²` term covered the matrix only
+/// for `s` above about `5.5·10⁻⁴`: an adversary's note.) Bounds of exactly
+/// 0 give the box 0: the motion is then taken as given, as without
+/// bounds.
 ///
 /// Angles as [`Motion::new`] takes them (`|angle| ≤`
 /// [`crate::motion::MAX_ROTATION_RAD`]), or an [`crate::AngleError`].
@@ -238,6 +244,39 @@ pub fn euler_error_box(
         (ea * sg.abs() + eb * (ca * cg).abs() + second) * up,
         (eb * sa.abs() + eg + second) * up,
     ])
+}
+
+/// [`euler_error_box`] at any angles: a box about the axes that holds
+/// every error of at most `eps` in the Euler angles whatever the angles
+/// are (each `|cos|` and `|sin|` of the at-angle box taken as 1, and
+/// rounded up twice, so it holds that box component by component even
+/// where a computed sine or cosine is an ulp above 1). What
+/// to configure a key-frame fusion with when a front end sends the
+/// angles' bounds over the link ([`crate::wire::FrameJob::run_fused`]
+/// compares each frame's at-angle box with the fusion's bounds).
+///
+/// ```
+/// use roadstereo::motion_error::{euler_error_box, euler_error_box_any_angles};
+/// let eps = [0.001, 0.002, 0.0005];
+/// let any = euler_error_box_any_angles(eps);
+/// let at = euler_error_box([0.3, -0.9, 1.0], eps).unwrap();
+/// assert!(at.iter().zip(&any).all(|(a, b)| a <= b));
+/// assert!(roadstereo::Config::DEFAULT.with_rotation_error(any).is_ok());
+/// ```
+pub fn euler_error_box_any_angles(eps: [f32; 3]) -> [f32; 3] {
+    let [ea, eb, eg] = eps.map(f32::abs);
+    let s = ea + eb + eg;
+    let second = if s > 0.0 {
+        s * s + MATRIX_AXIS_ERROR
+    } else {
+        0.0
+    };
+    let up = 1.0 + 9.536_743e-7;
+    [
+        (ea + eb + second) * up * up,
+        (ea + eb + second) * up * up,
+        (eb + eg + second) * up * up,
+    ]
 }
 
 /// What the matrix [`Motion::new`] builds may turn about each axis against

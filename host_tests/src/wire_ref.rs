@@ -337,7 +337,10 @@ fn motion_payload(p: &[u8]) -> Out {
         }
     }
     if let Some(r) = re {
-        // The bounds as sent, then their box about the camera's axes.
+        // The bounds as sent, then their box about the camera's axes (the
+        // library's `euler_error_box`, not a second form of it: a box a
+        // rounding apart would split the verdicts at the limit; the box
+        // itself is held to `f64` rotations in `tests/motion_error.rs`).
         let axes = roadstereo::motion_error::euler_error_box(motion.angles(), r)
             .unwrap_or([f32::INFINITY; 3]);
         for v in [r, axes] {

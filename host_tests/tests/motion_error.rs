@@ -611,3 +611,73 @@ fn euler_error_box_holds_the_matrix_own_rounding() {
     // The matrix's rounding is what the small bounds leave to the box.
     assert!(worst > 0.05, "{worst}");
 }
+
+/// The whole of the matrix's rounding, not only its rotation: the
+/// compensated pixel under the exact (`f64`) rotation of true angles within
+/// tiny bounds (10⁻⁹ rad) moves from the one under the matrix
+/// `Motion::new` builds by at most `rotation_shift_bound` of the converted
+/// box, at the image's corners, edges and centre, for both `R_f32ᵀ T` and
+/// `Tᵀ R_f32` (the non-orthogonal part of `R_f32` included, which the box's
+/// argument leaves to this measurement). A review's probe, kept.
+#[test]
+fn the_converted_box_holds_the_matrix_whole() {
+    use roadstereo::motion_error::{euler_error_box, rotation_shift_bound};
+    use roadstereo::{Camera, Pixel};
+    let mut g = synth::Rng(0x51);
+    let lim = 60f64.to_radians();
+    let mut worst = 0.0f64;
+    for (f, cases) in [(2000.0f32, 20_000), (300.0, 5_000)] {
+        let cam = Camera::new(f, f, 511.5, 383.5, 1024, 768).unwrap();
+        let f = f64::from(f);
+        for case in 0..cases {
+            let angles = [0, 1, 2].map(|_| g.uniform(-lim, lim) as f32);
+            let eps = [0, 1, 2].map(|_| (1e-9 * g.uniform(0.0, 1.0)) as f32);
+            let (Ok(abox), Ok(m)) = (
+                euler_error_box(angles, eps),
+                Motion::new([0.0, 0.0, 0.4], angles),
+            ) else {
+                continue;
+            };
+            let r = m.rotation_matrix().map(|row| row.map(f64::from));
+            let truth: [f64; 3] =
+                [0, 1, 2].map(|k| f64::from(angles[k]) + f64::from(eps[k]) * g.uniform(-1.0, 1.0));
+            let t = synth::rotation(truth);
+            let g1 = |i: usize, j: usize| (0..3).map(|k| r[k][i] * t[k][j]).sum::<f64>();
+            let g2 = |i: usize, j: usize| (0..3).map(|k| t[k][i] * r[k][j]).sum::<f64>();
+            let corners = [
+                (511.5, 383.5),
+                (0.0, 0.0),
+                (1023.0, 767.0),
+                (0.0, 767.0),
+                (1023.0, 0.0),
+                (511.5, 0.0),
+                (0.0, 383.5),
+            ];
+            for (u, v) in corners {
+                let (x, y) = ((u - 511.5) / f, (v - 383.5) / f);
+                let ray = [x, y, 1.0];
+                let bound = f64::from(rotation_shift_bound(
+                    Pixel::new(u as f32, v as f32),
+                    &cam,
+                    abox,
+                ));
+                for which in 0..2 {
+                    let q = [0, 1, 2].map(|i| {
+                        (0..3)
+                            .map(|j| if which == 0 { g1(i, j) } else { g2(i, j) } * ray[j])
+                            .sum::<f64>()
+                    });
+                    let (du, dv) = (f * (q[0] / q[2] - x), f * (q[1] / q[2] - y));
+                    let shift = (du * du + dv * dv).sqrt();
+                    worst = worst.max(shift / bound);
+                    assert!(
+                        shift <= bound,
+                        "f {f} case {case}: angles {angles:?} at ({u}, {v}): {shift:e} > {bound:e}"
+                    );
+                }
+            }
+        }
+    }
+    // (About an eighth of the bound at worst: the rounding is seen.)
+    assert!(worst > 0.01, "{worst}");
+}

@@ -71,13 +71,16 @@ impl Gen {
         let mut p = Vec::new();
         p.extend_from_slice(&from.to_le_bytes());
         p.extend_from_slice(&to.to_le_bytes());
+        // Roll and yaw too, sometimes: where the angles' bounds and their
+        // box about the axes differ most.
+        let turn = if self.p(0.5) { 0.6 } else { 0.0 };
         let vals: [f32; 6] = [
             (self.rng.unit() as f32 - 0.5) * 0.2,
             0.0,
             0.1 + self.rng.unit() as f32,
-            0.0,
+            (self.rng.unit() as f32 - 0.5) * turn,
             (self.rng.unit() as f32 - 0.5) * 0.1,
-            0.0,
+            (self.rng.unit() as f32 - 0.5) * turn,
         ];
         for v in vals {
             p.extend_from_slice(&v.to_le_bytes());
@@ -87,7 +90,14 @@ impl Gen {
         p.extend_from_slice(&[0, 0, 0]);
         let te: f32 = if self.p(0.1) { -1.0 } else { 0.01 };
         p.extend_from_slice(&te.to_le_bytes());
-        for v in [0.001f32, 0.002, if self.p(0.1) { f32::NAN } else { 0.0 }] {
+        // Small bounds, bounds whose own sum is within 0.1 but whose box
+        // about the axes is not (refused for the box), or a NaN.
+        let rot = if self.p(0.3) {
+            [0.04f32, 0.03, 0.029]
+        } else {
+            [0.001, 0.002, if self.p(0.1) { f32::NAN } else { 0.0 }]
+        };
+        for v in rot {
             p.extend_from_slice(&v.to_le_bytes());
         }
         p

@@ -66,7 +66,10 @@ impl<IO: Read + Write> UartLink<IO> {
 /// block (255 bytes) in place of one for the whole framed packet. Each
 /// `write` must take at least one byte ([`Error::WriteZero`] if one takes
 /// none; embedded-io's `write_all` panics there); at most one `write` a
-/// byte.
+/// byte. After an error the packet is cut where it stands, without its
+/// delimiter: write a `0x00` before the next packet, so that the
+/// receiver drops only the cut one (its bytes and the next packet's would
+/// otherwise decode as one, both refused).
 pub fn write_packet<W: Write>(w: &mut W, raw: &[u8]) -> Result<(), Error<W::Error>> {
     let mut f = Framer::new(w);
     f.put_raw(raw)?;

@@ -314,19 +314,10 @@ impl WireError {
     }
 }
 
-impl core::error::Error for WireError {
-    /// The library's own error behind a boundary, camera or motion
-    /// packet's refusal.
-    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
-        match self {
-            Self::Boundary { error, .. } => Some(error),
-            Self::Camera(e) => Some(e),
-            Self::Motion(e) => Some(e),
-            Self::MotionBounds(e) => Some(e),
-            _ => None,
-        }
-    }
-}
+/// The library's own error behind a boundary, camera or motion packet's
+/// refusal is part of the message (`Display`), so `source` gives none: a
+/// reporter that walks the chain would print it twice.
+impl core::error::Error for WireError {}
 
 impl fmt::Display for WireError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

@@ -18,8 +18,10 @@
 //!   frame-wide, so a boundary with a smaller radius than another gets the
 //!   larger one: its sticks are longer than they need be, never too short.
 //! * the motion packet's error bounds, when it has them
-//!   ([`Config::with_translation_error`], [`Config::with_rotation_error`]);
-//!   the base configuration's otherwise.
+//!   ([`Config::with_translation_error`]; [`Config::with_rotation_error`]
+//!   with the angles' bounds as their box about the camera's axes,
+//!   [`MotionPacket::axis_rotation_error`]); the base configuration's
+//!   otherwise.
 
 use super::decode::{FrameInfo, MotionPacket, Packet};
 use super::encode::ResultHead;
@@ -142,7 +144,11 @@ impl<const N: usize, const B: usize> FrameJob<'_, N, B> {
     /// component. Otherwise
     /// [`FusionError::ErrorsAboveConfig`] and nothing changes: the sticks
     /// would not be guaranteed. Make the fusion with the largest errors the
-    /// front end and the odometry declare. A frame whose motion does not
+    /// front end and the odometry declare, the rotation's as the box any
+    /// angles give them
+    /// ([`crate::motion_error::euler_error_box_any_angles`]: each packet's
+    /// angle bounds are compared as their box about the axes, which is
+    /// larger than the bounds themselves). A frame whose motion does not
     /// start from the frame the fusion took last, the previous job's of
     /// this receiver (the motion packet was lost, [`Self::motion`] `None`;
     /// the frame before was refused or not run into this fusion, also when

@@ -832,6 +832,60 @@ fn a_motions_angle_error_bounds_reach_every_axis_they_turn() {
     );
 }
 
+/// A fusion fed by the link, made as `run_fused` says (the rotation's
+/// bound as `euler_error_box_any_angles` of the odometry's angle bounds),
+/// takes every frame whose packet declares those angle bounds and fuses
+/// them; made with the angle bounds themselves it refuses the frames
+/// whose motion chains on (their box about the axes is larger: a review's
+/// find, when the docs still said to make it with the declared bounds).
+#[test]
+fn a_link_fed_fusion_made_with_the_any_angle_box_takes_every_frame() {
+    use crate::fusion::{Fusion, FusionConfig, FusionError};
+    use crate::motion_error::euler_error_box_any_angles;
+    use crate::Config;
+    let eps = [0.001f32; 3];
+    let made = |rot| Config::DEFAULT.with_rotation_error(rot).unwrap();
+    for (base, refused) in [
+        (made(euler_error_box_any_angles(eps)), false),
+        (made(eps), true),
+    ] {
+        let mut f = Fusion::<64, 2, 128>::new(base, FusionConfig::new(4, 500).unwrap());
+        let mut rx = super::Receiver::<64, 2>::new(IDS, Config::DEFAULT);
+        rx.feed(&[0], |_| {});
+        rx.feed(&camera_packet(0), |_| {});
+        let (mut taken, mut paired) = (0, 0);
+        for id in 0..10u32 {
+            if id > 0 {
+                rx.feed(&drive_motion_packet(id as u16, id, None, Some(eps)), |_| {});
+            }
+            let packet = frame_packet(
+                100 + id as u16,
+                id,
+                &[
+                    (0.5, drive_edge(id as f32, -1.0)),
+                    (0.5, drive_edge(id as f32, 1.0)),
+                ],
+            );
+            rx.feed(&packet, |e| {
+                if let super::Event::Frame(job) = e {
+                    match job.run_fused(&mut f) {
+                        Ok(s) => {
+                            taken += 1;
+                            paired += usize::from(s.paired.is_some());
+                        }
+                        Err(e) => assert_eq!(e, FusionError::ErrorsAboveConfig),
+                    }
+                }
+            });
+        }
+        if refused {
+            assert!(taken < 10 && paired == 0, "{taken} taken, {paired} paired");
+        } else {
+            assert_eq!((taken, paired), (10, 9));
+        }
+    }
+}
+
 /// The chain `run_fused` goes on is the previous job's frame, not a frame
 /// id: a frame refused with the fusion's last id (an adversary's find:
 /// frame 9 of a drive sent as id 4, after frame 4, with a radius above

@@ -28,11 +28,10 @@
 //!   `ω₁ + ω₂` (the triangle inequality on rotations).
 //!
 //! Each bound is rounded up by `2⁻¹⁶` of itself against the `f32` rounding
-//! of its own arithmetic, except where that arithmetic is exact: with no
-//! rotation error so far (`ω₁ = 0`, `ε₁ = 0`, the first step from the key
-//! frame) the terms the chain adds are exact zeros, so the first
-//! partner's bounds are the step's own (a step's bounds at the
-//! configuration's limit would otherwise be rounded past it). The translation bound grows with the travel, the
+//! of its own arithmetic, except on the first step from the key frame,
+//! whose composition with the identity is exact: the first partner's
+//! bounds are the step's own (a step's bounds at the configuration's
+//! limit would otherwise be rounded past it). The translation bound grows with the travel, the
 //! rotation bound with the number of frames: a key frame's last partner is
 //! the last one whose bounds [`crate::Config`] still accepts (rotation
 //! errors summing to at most 0.1 rad), see [`crate::fusion`].
@@ -206,29 +205,37 @@ impl Chain {
                 ..*self
             };
         }
-        // No rotation error so far (`ω₁ = 0`, `ε₁ = 0`: the first step from
-        // the key frame, or steps without bounds before this one): every
-        // term the chain adds to this step's bounds is an exact 0, so the
-        // sums below are exact and are not rounded up. (Rounded up, the
-        // first partner's bounds were above the step's own, and a step's
-        // bounds at a configuration's limit, rotation errors summing to
-        // 0.1 rad, started a new key frame every frame: an adversary's
-        // find.) The translation bound's `a · row` is exact too where the
-        // orientation is the identity (each row sums to 1 exactly).
-        let exact = self.omega == 0.0 && self.eps == [0.0; 3];
-        let up = |x: f32, exact: bool| if exact { x } else { x * ROUND_UP };
+        // The first step from the key frame (no error so far, the
+        // identity's orientation): the composed motion is the step's own
+        // (`1 x + 0 y + 0 z = x`), and so are its bounds, exactly. (The
+        // sums below, rounded up, gave the first partner bounds above the
+        // step's own, and a step's bounds at a configuration's limit,
+        // rotation errors summing to 0.1 rad, started a new key frame
+        // every frame: an adversary's find.)
+        if self.delta == 0.0
+            && self.omega == 0.0
+            && self.eps == [0.0; 3]
+            && self.r == Chain::IDENTITY.r
+        {
+            return Chain {
+                t,
+                r,
+                delta: b.delta,
+                eps: b.eps,
+                omega: b.omega,
+                round_t,
+                round_r,
+                pair_t,
+                pair_r,
+            };
+        }
         let a = self.omega * (norm(t2) + SQRT3 * b.delta) + b.delta;
         let row = self
             .r
             .iter()
             .map(|[x, y, z]| x.abs() + y.abs() + z.abs())
             .fold(0.0f32, |m, s| if s > m { s } else { m });
-        // (Only for the identity itself: a row that merely sums to 1 in
-        // `f32` may sum to more, a review's find.)
-        let delta = up(
-            self.delta + a * row,
-            exact && self.delta == 0.0 && self.r == Chain::IDENTITY.r,
-        );
+        let delta = (self.delta + a * row) * ROUND_UP;
         let mut eps = [0.0f32; 3];
         for (k, e) in eps.iter_mut().enumerate() {
             let mut s = b.eps.get(k).copied().unwrap_or(0.0) + self.omega * b.omega;
@@ -236,14 +243,14 @@ impl Chain {
                 let rlk = row.get(k).copied().unwrap_or(0.0);
                 s += rlk.abs() * self.eps.get(l).copied().unwrap_or(0.0);
             }
-            *e = up(s, exact);
+            *e = s * ROUND_UP;
         }
         Chain {
             t,
             r,
             delta,
             eps,
-            omega: up(self.omega + b.omega, exact),
+            omega: (self.omega + b.omega) * ROUND_UP,
             round_t,
             round_r,
             pair_t,
@@ -495,17 +502,17 @@ mod tests {
             assert!(c.then(&m, &b).config(&base).is_err());
         }
         // After steps without bounds (the orientation no longer the
-        // identity), the rotation bound is still the step's own, and the
-        // translation bound holds the step's turned by the orientation.
+        // identity) the sums are rounded up as any: the translation bound
+        // holds the step's turned by the orientation.
         let none = StepBounds::of(&Config::DEFAULT);
         let base = Config::DEFAULT
             .with_translation_error(0.01)
             .unwrap()
-            .with_rotation_error([0.0, 0.1, 0.0])
+            .with_rotation_error([0.0, 0.05, 0.0])
             .unwrap();
         let b = StepBounds::of(&base);
         let c = Chain::IDENTITY.then(&m, &none).then(&m, &b);
-        assert_eq!(c.eps, b.eps);
+        assert!(c.eps[1] > b.eps[1], "{:?}", c.eps);
         assert!(c.delta > 0.01, "{}", c.delta);
         // A turn too small for a row's `f32` sum to leave 1 (3·10⁻⁸ rad
         // about `z`) still turns the translation error into more than

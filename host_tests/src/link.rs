@@ -334,7 +334,7 @@ fn receive_loop(
                 out.push(raw[..n].to_vec());
             }
             Event::End => end = true,
-            Event::Motion(_) | Event::Camera => {}
+            Event::Motion(_) | Event::Camera(_) => {}
         });
         if end {
             let c = *rx.counters();

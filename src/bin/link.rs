@@ -320,7 +320,7 @@ fn main() -> ! {
                 }
             }
             Event::End => end = true,
-            Event::Motion(_) | Event::Camera => {}
+            Event::Motion(_) | Event::Camera(_) => {}
         });
         if polled.is_err() {
             defmt::error!("UART read error");

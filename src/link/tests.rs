@@ -79,7 +79,7 @@ fn record(log: &mut Vec<std::string::String>) -> impl FnMut(Event<'_, 32, 2>) + 
     move |e| {
         log.push(match e {
             Event::Frame(j) => std::format!("frame {}", j.info.frame_id),
-            Event::Camera => "camera".into(),
+            Event::Camera(_) => "camera".into(),
             Event::Motion(_) => "motion".into(),
             Event::End => "end".into(),
             Event::Error(e) => std::format!("error {}", e.kind().name()),
@@ -254,7 +254,7 @@ fn spi_small_capacity_takes_motion_and_camera_packets() {
     for _ in 0..2 {
         let polled = link.poll(&mut rx, |e| {
             log.push(match e {
-                Event::Camera => "camera",
+                Event::Camera(_) => "camera",
                 Event::Motion(_) => "motion",
                 _ => "other",
             })

@@ -28,7 +28,7 @@ use super::encode::ResultHead;
 use super::{DataIds, Decoder, ErrorKind, WireError};
 use crate::fusion::{ChainedMotion, Fusion, FusionError, FusionStep};
 use crate::math::fmin;
-use crate::{Config, Frame, Motion, ProcessError, Processor, Step};
+use crate::{Camera, Config, Frame, Motion, ProcessError, Processor, Step};
 
 /// What the receiver counted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -231,8 +231,9 @@ pub enum Event<'a, const N: usize, const B: usize> {
     Frame(FrameJob<'a, N, B>),
     /// A motion packet was taken.
     Motion(MotionPacket),
-    /// A camera packet was taken.
-    Camera,
+    /// A camera packet was taken: the intrinsics the next frames are
+    /// seen with (already the decoder's camera).
+    Camera(Camera),
     /// A typed error (see [`WireError`]). A damaged stream can give one
     /// for every two bytes (`01 00` repeated is a truncated packet each
     /// time): a firmware that answers each with a packet of its own, as
@@ -343,9 +344,9 @@ impl<const N: usize, const B: usize> Receiver<N, B> {
             }
             match d.packet {
                 Err(e) => report(counters, e, &mut on),
-                Ok(Packet::Camera(_)) => {
+                Ok(Packet::Camera(c)) => {
                     counters.cameras = counters.cameras.saturating_add(1);
-                    on(Event::Camera);
+                    on(Event::Camera(c));
                 }
                 Ok(Packet::Motion(m)) => {
                     counters.motions = counters.motions.saturating_add(1);

@@ -409,6 +409,26 @@ fn cobs_paths_agree_with_the_crate() {
     }
 }
 
+/// A camera packet's event carries the intrinsics the next frames are
+/// seen with (an integrator's note: it carried nothing, though the
+/// decoder's packet had them), and a changed camera's event the new ones.
+#[test]
+fn a_camera_event_carries_its_camera() {
+    let mut rx = Receiver::<64, 2>::new(IDS, crate::Config::DEFAULT);
+    let other = Camera::new(700.0, 710.0, 300.25, 200.5, 640, 400).unwrap();
+    let mut raw = [0u8; 64];
+    let n = encode::camera(&mut raw, IDS.camera, 1, &other).unwrap();
+    let mut seen = Vec::new();
+    for bytes in [vec![0], camera_packet(0), link(&raw[..n])] {
+        rx.feed(&bytes, |e| {
+            if let Event::Camera(c) = e {
+                seen.push(c);
+            }
+        });
+    }
+    assert_eq!(seen, [cam(), other]);
+}
+
 /// A summary packet round-trips: the counters a receiver keeps, encoded
 /// as the link firmware answers an end packet, parse back to themselves
 /// (every field distinct, so a shifted or swapped field shows); any

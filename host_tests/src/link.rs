@@ -4,7 +4,7 @@
 //! receive loop (the reference the firmware is compared with, bit for bit).
 
 use roadstereo::fusion::{Fusion, FusionConfig};
-use roadstereo::wire::encode::{self, BoundaryHead, FrameHead, MotionFields, ResultHead};
+use roadstereo::wire::encode::{self, BoundaryHead, FrameHead, MotionFields, ResultHead, Sender};
 use roadstereo::wire::{
     cobs_max, frame_packet_max, result_packet_max, DataIds, Event, FrameJob, PacketType, Receiver,
 };
@@ -89,17 +89,15 @@ pub fn framed(raw: &[u8]) -> Vec<u8> {
 /// motion packet before each frame that has one; every boundary with the
 /// localisation-error radius `radius` px; an end packet last.
 pub fn packets(frames: &[LinkFrame], radius: f32) -> Result<Vec<LinkPacket>, String> {
-    let ids = DataIds::DEFAULT;
-    let (mut cc, mut mc, mut fc) = (0u16, 0u16, 0u16);
+    // (The sender numbers each data id's packets as the receiver checks.)
+    let mut tx = Sender::new(DataIds::DEFAULT);
     let mut out = Vec::new();
     let mut raw = vec![0u8; frame_packet_max(N.max(4096), B.max(8))];
     let mut last_camera: Option<Camera> = None;
     for (i, f) in frames.iter().enumerate() {
         let id = i as u32;
         if last_camera != Some(f.camera) || i % 8 == 0 {
-            let n =
-                encode::camera(&mut raw, ids.camera, cc, &f.camera).map_err(|e| e.to_string())?;
-            cc = cc.wrapping_add(1);
+            let n = tx.camera(&mut raw, &f.camera).map_err(|e| e.to_string())?;
             out.push(LinkPacket {
                 kind: Kind::Camera,
                 bytes: framed(&raw[..n]),
@@ -115,8 +113,7 @@ pub fn packets(frames: &[LinkFrame], radius: f32) -> Result<Vec<LinkPacket>, Str
                 translation_error: None,
                 rotation_error: None,
             };
-            let n = encode::motion(&mut raw, ids.motion, mc, &m).map_err(|e| e.to_string())?;
-            mc = mc.wrapping_add(1);
+            let n = tx.motion(&mut raw, &m).map_err(|e| e.to_string())?;
             out.push(LinkPacket {
                 kind: Kind::Motion,
                 bytes: framed(&raw[..n]),
@@ -145,15 +142,15 @@ pub fn packets(frames: &[LinkFrame], radius: f32) -> Result<Vec<LinkPacket>, Str
                 )
             })
             .collect();
-        let n = encode::frame(&mut raw, ids.frame, fc, &head, &list)
+        let n = tx
+            .frame(&mut raw, &head, &list)
             .map_err(|e| format!("frame {i}: {e}"))?;
-        fc = fc.wrapping_add(1);
         out.push(LinkPacket {
             kind: Kind::Frame,
             bytes: framed(&raw[..n]),
         });
     }
-    let n = encode::end(&mut raw, ids.end, 0).map_err(|e| e.to_string())?;
+    let n = tx.end(&mut raw).map_err(|e| e.to_string())?;
     out.push(LinkPacket {
         kind: Kind::End,
         bytes: framed(&raw[..n]),

@@ -25,8 +25,8 @@ use defmt_semihosting as _;
 #[cfg(feature = "link-fused")]
 use roadstereo::fusion::{Fusion, FusionConfig};
 use roadstereo::link::{write_packet, write_result, UartLink};
-use roadstereo::wire::encode::ResultHead;
-use roadstereo::wire::{self, encode, DataIds, Event, FrameJob, Receiver};
+use roadstereo::wire::encode::{ResultHead, Sender};
+use roadstereo::wire::{self, DataIds, Event, FrameJob, PacketType, Receiver};
 #[cfg(not(feature = "link-fused"))]
 use roadstereo::Processor;
 use roadstereo::{Config, Status, Step};
@@ -270,7 +270,8 @@ fn main() -> ! {
     let rx: &'static mut Receiver<N, B> = RECEIVER.take();
     let mut runner = Runner::new();
     let mut raw = [0u8; RAW];
-    let (mut results, mut reports) = (0u16, 0u16);
+    // (Numbers each output data id's packets.)
+    let mut sender = Sender::new(ids);
     defmt::info!(
         "roadstereo link: UART0, capacity {=usize} x {=usize}, budget {=u32} instructions/frame, within a deadline {=bool} (limit {=u32}), fused {=bool}",
         B,
@@ -307,15 +308,15 @@ fn main() -> ! {
                         s.digest()
                     );
                 }
-                match write_result(&mut tx, ids.result, results, &head, &step, &quality) {
-                    Ok(()) => results = results.wrapping_add(1),
+                let counter = sender.next_counter(PacketType::Result);
+                match write_result(&mut tx, ids.result, counter, &head, &step, &quality) {
+                    Ok(()) => sender.skip(PacketType::Result),
                     Err(e) => defmt::error!("result packet: {}", e),
                 }
             }
             Event::Error(e) => {
                 defmt::warn!("link error: {}", e);
-                if let Ok(n) = encode::report(&mut raw, ids.report, reports, &e) {
-                    reports = reports.wrapping_add(1);
+                if let Ok(n) = sender.report(&mut raw, &e) {
                     let _ = write_packet(&mut tx, raw.get(..n).unwrap_or(&[]));
                 }
             }
@@ -327,7 +328,7 @@ fn main() -> ! {
         }
         if end {
             let c = *rx.counters();
-            if let Ok(n) = encode::summary(&mut raw, ids.summary, 0, &c.values()) {
+            if let Ok(n) = sender.summary(&mut raw, &c.values()) {
                 let _ = write_packet(&mut tx, raw.get(..n).unwrap_or(&[]));
             }
             defmt::info!(

@@ -9,7 +9,7 @@ use super::{
 };
 use crate::{Camera, Motion, Pixel, Status, Step, Structure};
 
-use super::WireError;
+use super::{DataIds, WireError};
 
 /// Why a packet could not be written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -532,6 +532,152 @@ pub(crate) fn result_payload<S: Sink, const N: usize, const B: usize>(
         }
     }
     Ok(())
+}
+
+/// The sending side of a stream: its data ids and each one's next
+/// counter (`+1` a packet of that data id, wrapping, as the receiver
+/// checks it: `docs/wire.md`), so the packets it writes number
+/// themselves. A packet that could not be written takes no number.
+/// Each method writes the raw packet into `out` as the free function of
+/// its name does ([`frame`], [`motion`], ...); frame it for the link
+/// with [`cobs_frame`] or `link::write_packet`.
+///
+/// ```
+/// use roadstereo::wire::encode::{cobs_frame, Sender};
+/// use roadstereo::wire::{DataIds, Event, Receiver};
+/// use roadstereo::{Camera, Config};
+/// let cam = Camera::new(800.0, 800.0, 255.5, 239.5, 512, 480)?;
+/// let mut tx = Sender::new(DataIds::DEFAULT);
+/// let mut rx = Receiver::<64, 2>::new(DataIds::DEFAULT, Config::DEFAULT);
+/// let (mut raw, mut link) = ([0u8; 64], [0u8; 80]);
+/// let mut cameras = 0;
+/// for _ in 0..3 {
+///     let n = tx.camera(&mut raw, &cam)?;
+///     let m = cobs_frame(&raw[..n], &mut link)?;
+///     rx.feed(&link[..m], |e| cameras += usize::from(matches!(e, Event::Camera(_))));
+/// }
+/// // Numbered 0, 1, 2: no counter jump, no repeat.
+/// assert_eq!((cameras, rx.counters().total_errors()), (3, 0));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Sender {
+    ids: DataIds,
+    /// The next counter of frame, motion, camera, end, result, report and
+    /// summary packets.
+    next: [u16; 7],
+}
+
+impl Sender {
+    /// A stream with the data ids `ids`, every counter at 0.
+    pub const fn new(ids: DataIds) -> Self {
+        Self { ids, next: [0; 7] }
+    }
+
+    /// The data ids.
+    pub const fn ids(&self) -> DataIds {
+        self.ids
+    }
+
+    /// The counter the next packet of `t` will carry.
+    pub fn next_counter(&self, t: PacketType) -> u16 {
+        self.next.get(Self::slot(t)).copied().unwrap_or(0)
+    }
+
+    fn slot(t: PacketType) -> usize {
+        match t {
+            PacketType::Frame => 0,
+            PacketType::Motion => 1,
+            PacketType::Camera => 2,
+            PacketType::End => 3,
+            PacketType::Result => 4,
+            PacketType::Report => 5,
+            PacketType::Summary => 6,
+        }
+    }
+
+    /// The data id and counter for a packet of `t`; `write` makes it, and
+    /// the counter moves on only if it did.
+    fn numbered(
+        &mut self,
+        t: PacketType,
+        write: impl FnOnce(u16, u16) -> Result<usize, EncodeError>,
+    ) -> Result<usize, EncodeError> {
+        let id = match t {
+            PacketType::Frame => self.ids.frame,
+            PacketType::Motion => self.ids.motion,
+            PacketType::Camera => self.ids.camera,
+            PacketType::End => self.ids.end,
+            PacketType::Result => self.ids.result,
+            PacketType::Report => self.ids.report,
+            PacketType::Summary => self.ids.summary,
+        };
+        let n = write(id, self.next_counter(t))?;
+        if let Some(c) = self.next.get_mut(Self::slot(t)) {
+            *c = c.wrapping_add(1);
+        }
+        Ok(n)
+    }
+
+    /// A frame packet ([`frame`]).
+    pub fn frame(
+        &mut self,
+        out: &mut [u8],
+        head: &FrameHead,
+        boundaries: &[(BoundaryHead, &[Pixel])],
+    ) -> Result<usize, EncodeError> {
+        self.numbered(PacketType::Frame, |id, c| {
+            frame(out, id, c, head, boundaries)
+        })
+    }
+
+    /// A motion packet ([`motion`]).
+    pub fn motion(&mut self, out: &mut [u8], m: &MotionFields) -> Result<usize, EncodeError> {
+        self.numbered(PacketType::Motion, |id, c| motion(out, id, c, m))
+    }
+
+    /// A camera packet ([`camera`]).
+    pub fn camera(&mut self, out: &mut [u8], cam: &Camera) -> Result<usize, EncodeError> {
+        self.numbered(PacketType::Camera, |id, c| camera(out, id, c, cam))
+    }
+
+    /// An end packet ([`end`]).
+    pub fn end(&mut self, out: &mut [u8]) -> Result<usize, EncodeError> {
+        self.numbered(PacketType::End, |id, c| end(out, id, c))
+    }
+
+    /// A result packet ([`result`]; `link::write_result` writes one without
+    /// a buffer, with [`Self::next_counter`] and a [`Self::skip`] after).
+    pub fn result<const N: usize, const B: usize>(
+        &mut self,
+        out: &mut [u8],
+        head: &ResultHead,
+        step: &Step<'_, N, B>,
+        quality: &[u8],
+    ) -> Result<usize, EncodeError> {
+        self.numbered(PacketType::Result, |id, c| {
+            result(out, id, c, head, step, quality)
+        })
+    }
+
+    /// A report packet ([`report`]).
+    pub fn report(&mut self, out: &mut [u8], e: &WireError) -> Result<usize, EncodeError> {
+        self.numbered(PacketType::Report, |id, c| report(out, id, c, e))
+    }
+
+    /// A summary packet ([`summary`]).
+    pub fn summary(&mut self, out: &mut [u8], values: &[u32]) -> Result<usize, EncodeError> {
+        self.numbered(PacketType::Summary, |id, c| summary(out, id, c, values))
+    }
+
+    /// Move the counter of `t` on by one: a packet of it was written
+    /// elsewhere (e.g. by `link::write_result`) with [`Self::next_counter`].
+    pub fn skip(&mut self, t: PacketType) {
+        if let Some(c) = self.next.get_mut(Self::slot(t)) {
+            *c = c.wrapping_add(1);
+        }
+    }
 }
 
 /// COBS-encode the packet `raw` into `out` (with the `cobs` crate) and

@@ -429,6 +429,68 @@ fn a_camera_event_carries_its_camera() {
     assert_eq!(seen, [cam(), other]);
 }
 
+/// A `Sender` numbers each data id's packets on its own, as the receiver
+/// checks them: interleaved camera, motion and frame packets (one frame
+/// packet failing for a short buffer, which takes no number) reach a
+/// receiver with no counter error, every frame paired with its motion;
+/// the same stream with one frame's counter skipped is a `counter_jump`.
+#[test]
+fn a_sender_numbers_each_streams_packets() {
+    let run = |skip_one: bool| {
+        let mut tx = encode::Sender::new(IDS);
+        let mut rx = Receiver::<64, 2>::new(IDS, crate::Config::DEFAULT);
+        let mut raw = vec![0u8; frame_packet_max(64, 2)];
+        let (mut frames, mut paired, mut errors) = (0, 0, Vec::new());
+        let mut feed = |rx: &mut Receiver<64, 2>, bytes: &[u8]| {
+            rx.feed(&link(bytes), |e| match e {
+                Event::Frame(job) => {
+                    frames += 1;
+                    paired += usize::from(job.motion.is_some());
+                }
+                Event::Error(e) => errors.push(e.kind()),
+                _ => {}
+            });
+        };
+        rx.feed(&[0], |_| {});
+        for id in 0..6u32 {
+            if id % 3 == 0 {
+                let n = tx.camera(&mut raw, &cam()).unwrap();
+                feed(&mut rx, &raw[..n]);
+            }
+            if id > 0 {
+                let m = encode::MotionFields::of(id - 1, id, &drive_step());
+                let n = tx.motion(&mut raw, &m).unwrap();
+                feed(&mut rx, &raw[..n]);
+            }
+            let head = encode::FrameHead {
+                timestamp_us: u64::from(id),
+                frame_id: id,
+                width: 512,
+                height: 480,
+            };
+            let pts = drive_edge(id as f32, -1.0);
+            let bh = encode::BoundaryHead {
+                quality: 1,
+                radius_px: 0.5,
+            };
+            let list = [(bh, pts.as_slice())];
+            // A buffer too short: an error, and no number taken.
+            let before = tx.next_counter(PacketType::Frame);
+            assert!(tx.frame(&mut raw[..20], &head, &list).is_err());
+            assert_eq!(tx.next_counter(PacketType::Frame), before);
+            if skip_one && id == 4 {
+                tx.skip(PacketType::Frame);
+            }
+            let n = tx.frame(&mut raw, &head, &list).unwrap();
+            feed(&mut rx, &raw[..n]);
+        }
+        (frames, paired, errors)
+    };
+    assert_eq!(run(false), (6, 5, vec![]));
+    let (frames, _, errors) = run(true);
+    assert_eq!((frames, errors), (6, vec![ErrorKind::CounterJump]));
+}
+
 /// A summary packet round-trips: the counters a receiver keeps, encoded
 /// as the link firmware answers an end packet, parse back to themselves
 /// (every field distinct, so a shifted or swapped field shows); any

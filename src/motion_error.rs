@@ -231,14 +231,7 @@ pub fn euler_error_box(
     }
     let (sa, ca) = crate::math::sin_cos_reduced(angles[0])?;
     let (sg, cg) = crate::math::sin_cos_reduced(angles[2])?;
-    let [ea, eb, eg] = eps.map(f32::abs);
-    let s = ea + eb + eg;
-    let second = if s > 0.0 {
-        s * s + MATRIX_AXIS_ERROR
-    } else {
-        0.0
-    };
-    let up = 1.0 + 9.536_743e-7;
+    let ([ea, eb, eg], second, up) = euler_terms(eps);
     Ok([
         (ea * cg.abs() + eb * (ca * sg).abs() + second) * up,
         (ea * sg.abs() + eb * (ca * cg).abs() + second) * up,
@@ -264,19 +257,27 @@ pub fn euler_error_box(
 /// assert!(roadstereo::Config::DEFAULT.with_rotation_error(any).is_ok());
 /// ```
 pub fn euler_error_box_any_angles(eps: [f32; 3]) -> [f32; 3] {
-    let [ea, eb, eg] = eps.map(f32::abs);
-    let s = ea + eb + eg;
-    let second = if s > 0.0 {
-        s * s + MATRIX_AXIS_ERROR
-    } else {
-        0.0
-    };
-    let up = 1.0 + 9.536_743e-7;
+    let ([ea, eb, eg], second, up) = euler_terms(eps);
     [
         (ea + eb + second) * up * up,
         (ea + eb + second) * up * up,
         (eb + eg + second) * up * up,
     ]
+}
+
+/// The parts both Euler boxes share: the bounds' sizes, the term each
+/// component gets whatever the angles (the second order and the matrix's
+/// rounding, none for bounds of 0), and the factor that rounds a
+/// component up.
+fn euler_terms(eps: [f32; 3]) -> ([f32; 3], f32, f32) {
+    let e = eps.map(f32::abs);
+    let s = e[0] + e[1] + e[2];
+    let second = if s > 0.0 {
+        s * s + MATRIX_AXIS_ERROR
+    } else {
+        0.0
+    };
+    (e, second, 1.0 + 9.536_743e-7)
 }
 
 /// What the matrix [`Motion::new`] builds may turn about each axis against

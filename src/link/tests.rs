@@ -307,6 +307,22 @@ struct Uart {
     /// after the script, all).
     writes: Vec<Option<usize>>,
 }
+impl Uart {
+    /// A UART for writing about `len` bytes whose writes each take a
+    /// random amount (1 to 300 bytes, or all they are given), from
+    /// `below(k)`, a whole number under `k`.
+    fn taking_at_random(len: usize, below: &mut impl FnMut(u32) -> u32) -> Self {
+        let writes = (0..4 * len + 4)
+            .map(|_| (below(3) != 0).then(|| 1 + below(300) as usize))
+            .collect();
+        Self {
+            reads: Vec::new(),
+            written: Vec::new(),
+            writes,
+        }
+    }
+}
+
 #[derive(Debug, PartialEq)]
 struct UartError;
 impl core::fmt::Display for UartError {
@@ -474,14 +490,7 @@ fn write_packet_frames_as_the_cobs_crate_does() {
     }
     for (case, raw) in cases.iter().enumerate() {
         let want = framed(raw);
-        let writes = (0..4 * want.len() + 4)
-            .map(|_| (below(3) != 0).then(|| 1 + below(300) as usize))
-            .collect();
-        let mut uart = Uart {
-            reads: Vec::new(),
-            written: Vec::new(),
-            writes,
-        };
+        let mut uart = Uart::taking_at_random(want.len(), &mut below);
         super::write_packet(&mut uart, raw).unwrap();
         assert_eq!(uart.written, want, "case {case}, {} bytes", raw.len());
     }
@@ -542,14 +551,7 @@ fn write_result_writes_what_the_buffered_path_writes() {
                 }
             };
             let want = framed(&raw[..nbytes]);
-            let writes = (0..4 * want.len() + 4)
-                .map(|_| (below(3) != 0).then(|| 1 + below(300) as usize))
-                .collect();
-            let mut uart = Uart {
-                reads: Vec::new(),
-                written: Vec::new(),
-                writes,
-            };
+            let mut uart = Uart::taking_at_random(want.len(), &mut below);
             match kind {
                 0 => {
                     p.reset();
